@@ -1,0 +1,3 @@
+from scalesynth.cli import main
+
+main()

@@ -1,0 +1,234 @@
+"""Command-line interface (typer). Thin: parse -> library call -> print / exit code.
+
+Exit codes: 0 ok, 1 run failed, 2 bad input (one line on stderr naming what is wrong).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Callable
+from functools import wraps
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from scalesynth.errors import InvalidPose, ScalesynthError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="Multi-objective dimensional synthesis of parallel mechanisms.",
+    pretty_exceptions_enable=False,
+)
+
+SetOpt = Annotated[
+    list[str] | None,
+    typer.Option("--set", "-s", help="override: design parameter, option or dotted config path, as key=value"),
+]
+JsonOpt = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout and nothing else")]
+
+
+def _fail(message: str, code: int) -> None:
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(code)
+
+
+def handles_errors(func: Callable) -> Callable:
+    """Map library errors to a one-line message and the contract's exit codes."""
+
+    @wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except ScalesynthError as err:
+            _fail(str(err), err.exit_code)
+        except KeyboardInterrupt:
+            _fail("interrupted", 1)
+        except OSError as err:
+            _fail(f"{getattr(err, 'filename', '') or ''}: {err.strerror or err}", 1)
+
+    return wrapper
+
+
+def _warn(message: str) -> None:
+    typer.echo(f"warning: {message}", err=True)
+
+
+def _parse_vector(what: str, text: str, n: int) -> list[float]:
+    try:
+        values = [float(t) for t in text.split(",")]
+    except ValueError:
+        raise InvalidPose(f"{what}: expected {n} comma-separated numbers, got {text!r}") from None
+    if len(values) != n or any(v != v or v in (float("inf"), float("-inf")) for v in values):
+        raise InvalidPose(f"{what}: expected {n} finite comma-separated numbers, got {text!r}")
+    return values
+
+
+def _mech_inputs(mech_name: str, sets: list[str] | None):
+    from scalesynth.config import apply_overrides
+    from scalesynth.mechanisms import get
+
+    mech = get(mech_name)
+    data = apply_overrides({}, sets, set(mech.parameter_names))
+    extra = set(data) - {"design", "options"}
+    if extra:
+        raise InvalidPose(f"--set {sorted(extra)[0]}: only design parameters and options apply here")
+    design = mech.resolve_design(data.get("design"))
+    options = mech.resolve_options(data.get("options"))
+    return mech, design, options
+
+
+def _print_json(obj: Any) -> None:
+    sys.stdout.write(json.dumps(obj, indent=None, sort_keys=False) + "\n")
+
+
+@app.command("mechanisms")
+@handles_errors
+def mechanisms_cmd(as_json: JsonOpt = False) -> None:
+    """List registered mechanisms and their parameters."""
+    from scalesynth.mechanisms import available, get
+
+    rows = []
+    for name in available():
+        m = get(name)
+        rows.append(
+            {
+                "name": m.name,
+                "title": m.title,
+                "seed": m.seed,
+                "motion": m.motion,
+                "task_axes": list(m.task_axes),
+                "joints": list(m.joints),
+                "parameters": {p.name: {"default": p.default, "doc": p.doc} for p in m.parameters},
+                "options": {o.name: {"default": o.default, "doc": o.doc} for o in m.options},
+            }
+        )
+    if as_json:
+        _print_json(rows)
+        return
+    for r in rows:
+        typer.echo(f"{r['name']:<16} seed {r['seed']}  {r['motion']:<5} {r['title']}")
+        typer.echo("    parameters: " + ", ".join(f"{k}={v['default']:g}" for k, v in r["parameters"].items()))
+        if r["options"]:
+            typer.echo("    options:    " + ", ".join(f"{k}={v['default']!r}" for k, v in r["options"].items()))
+
+
+@app.command("evaluate")
+@handles_errors
+def evaluate_cmd(
+    config: Annotated[Path, typer.Argument(help="run config (YAML)")],
+    sets: SetOpt = None,
+    resolution: Annotated[int | None, typer.Option(help="cells per axis (overrides grid.resolution)")] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Evaluate one design: workspace measure, GCI, FCI, band shares, voxels, seconds."""
+    from scalesynth.config import load_config
+    from scalesynth.evaluate import evaluate
+
+    overrides = list(sets or [])
+    if resolution is not None:
+        overrides.append(f"grid.resolution={resolution}")
+    cfg = load_config(config, overrides)
+    mech = cfg.mech
+    design = cfg.resolved_design()
+    for key, (lo, hi) in cfg.bounds.items():
+        if not lo <= design[key] <= hi:
+            _warn(f"design.{key}={design[key]:g} is outside the optimisation bounds [{lo:g}, {hi:g}]")
+    report = evaluate(
+        mech,
+        design,
+        cfg.resolved_options(),
+        resolution=cfg.grid.resolution,
+        region=cfg.grid.region,
+        band_edges=cfg.dexterity.band_edges,
+        length_unit=cfg.units.length,
+    )
+    out = report.to_dict()
+    if as_json:
+        _print_json(out)
+        return
+    typer.echo(f"{mech.name}  design " + ", ".join(f"{k}={v:g}" for k, v in design.items()))
+    typer.echo(f"  {report.measure_key:<14} {report.measure:.6g}")
+    for key in ("gci", "fci", "min_lci", "max_lci"):
+        typer.echo(f"  {key:<14} {out[key]:.6g}")
+    edges = report.band_edges
+    for b in range(len(edges) - 1):
+        share = out[f"band{b}_share"] * 100
+        typer.echo(f"  band {b} LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]: {share:6.2f} %")
+    typer.echo(
+        f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
+    )
+
+
+@app.command("ik")
+@handles_errors
+def ik_cmd(
+    mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
+    pose: Annotated[str, typer.Option("--pose", help="task coordinates, comma-separated")],
+    sets: SetOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """All inverse-kinematics branches of a pose."""
+    mech, design, options = _mech_inputs(mechanism, sets)
+    p = _parse_vector("--pose", pose, len(mech.task_axes))
+    sols = mech.inverse_kinematics(design, options, p)
+    rows = []
+    for s in sols:
+        row = s.as_dict()
+        try:
+            row["singularity"] = mech.singularity(design, options, p, s.values)
+            row["lci"] = mech.lci(design, options, p, s.values)
+        except NotImplementedError:
+            pass
+        rows.append(row)
+    _print_solutions(mech.joints, rows, as_json, "pose out of reach: no IK solution")
+
+
+@app.command("fk")
+@handles_errors
+def fk_cmd(
+    mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
+    inputs: Annotated[str, typer.Option("--inputs", help="joint inputs, comma-separated")],
+    sets: SetOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """All forward-kinematics assembly modes of a joint-input vector."""
+    mech, design, options = _mech_inputs(mechanism, sets)
+    q = _parse_vector("--inputs", inputs, len(mech.joints))
+    rows = [s.as_dict() for s in mech.forward_kinematics(design, options, q)]
+    _print_solutions(mech.task_axes, rows, as_json, "no isolated assembly: inputs out of reach or degenerate")
+
+
+def _print_solutions(names, rows, as_json: bool, empty_msg: str) -> None:
+    if as_json:
+        _print_json({"names": list(names), "solutions": rows})
+        return
+    if not rows:
+        typer.echo(empty_msg)
+        return
+    for r in rows:
+        vals = ", ".join(f"{n}={v:.6f}" for n, v in zip(names, r["values"], strict=True))
+        extra = ""
+        if "singularity" in r:
+            extra = f"  singularity={r['singularity']} lci={r['lci']:.6f}"
+        typer.echo(f"{r['branch']:>6}: {vals}{extra}")
+
+
+def _load_commands() -> None:
+    """Register the commands defined in ``scalesynth.commands`` (one module per command group)."""
+    import importlib
+    import pkgutil
+
+    import scalesynth.commands as pkg
+
+    for info in pkgutil.iter_modules(pkg.__path__):
+        importlib.import_module(f"{pkg.__name__}.{info.name}")
+
+
+_load_commands()
+
+
+def main() -> None:
+    app()

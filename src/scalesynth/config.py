@@ -1,0 +1,257 @@
+"""Run configuration: pydantic models and ``load_config(path, overrides)``.
+
+Every validation problem becomes a one-line ConfigError that names the field path, e.g.
+``bounds.l1: lower bound 1.5 must be below upper bound 0.5``.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from scalesynth.errors import ConfigError, ScalesynthError
+
+METRICS = ("volume", "gci", "fci", "min_lci", "max_lci", "band_share", "band_volume")
+LENGTH_UNITS = ("m", "mm", "cm", "dm")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=False)
+
+
+class GridConfig(_Strict):
+    resolution: int = Field(64, ge=4, le=1024, description="cells per axis")
+    region: dict[Literal["x", "y", "z"], tuple[float, float]] | None = Field(
+        None, description="override of the mechanism's bounding box, per axis [lo, hi]"
+    )
+
+    @field_validator("region")
+    @classmethod
+    def _region_ok(cls, v):
+        if v is None:
+            return v
+        for axis, (lo, hi) in v.items():
+            if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
+                raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+        return v
+
+
+class DexterityConfig(_Strict):
+    band_edges: list[float] = Field(default_factory=lambda: [0.0, 0.1, 0.3, 1.0])
+
+    @field_validator("band_edges")
+    @classmethod
+    def _edges_ok(cls, v):
+        if len(v) < 2 or len(v) > 17:
+            raise ValueError("need between 2 and 17 edges")
+        if v[0] != 0.0 or v[-1] != 1.0:
+            raise ValueError("must start at 0 and end at 1")
+        if any(not b > a for a, b in zip(v, v[1:], strict=False)):
+            raise ValueError("must be strictly increasing")
+        return v
+
+
+class ObjectiveConfig(_Strict):
+    metric: Literal[METRICS]  # type: ignore[valid-type]
+    sense: Literal["max", "min"] = "max"
+    band: int | None = Field(None, ge=0, description="band index for band_share / band_volume")
+
+
+class ConstraintConfig(_Strict):
+    metric: Literal[METRICS]  # type: ignore[valid-type]
+    min: float | None = None
+    max: float | None = None
+    band: int | None = Field(None, ge=0)
+
+    @model_validator(mode="after")
+    def _one_side(self):
+        if self.min is None and self.max is None:
+            raise ValueError("give min, max or both")
+        if self.min is not None and self.max is not None and not self.min <= self.max:
+            raise ValueError(f"min {self.min} must not exceed max {self.max}")
+        return self
+
+
+class AlgorithmConfig(_Strict):
+    name: Literal["nsga2"] = "nsga2"
+    pop_size: int = Field(200, ge=4, le=100_000)
+    n_gen: int = Field(200, ge=1, le=100_000)
+    eta_crossover: float = Field(20.0, gt=0)
+    eta_mutation: float = Field(20.0, gt=0)
+    prob_crossover: float = Field(0.9, ge=0, le=1)
+    prob_mutation: float | None = Field(None, ge=0, le=1, description="per variable; null = 1/n_var")
+    seed: int = Field(1, ge=0, le=2**32 - 1)
+
+
+class OutputConfig(_Strict):
+    dir: str | None = Field(None, description="results directory; null = results/<name>")
+    checkpoint_every: int = Field(5, ge=1)
+
+
+class UnitsConfig(_Strict):
+    length: Literal[LENGTH_UNITS] = "m"  # type: ignore[valid-type]
+
+
+class RunConfig(_Strict):
+    name: str = Field(..., min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")
+    mechanism: str
+    units: UnitsConfig = Field(default_factory=UnitsConfig)
+    design: dict[str, float] = Field(default_factory=dict, description="design evaluated by `evaluate`")
+    options: dict[str, Any] = Field(default_factory=dict)
+    bounds: dict[str, tuple[float, float]] = Field(default_factory=dict)
+    grid: GridConfig = Field(default_factory=GridConfig)
+    dexterity: DexterityConfig = Field(default_factory=DexterityConfig)
+    objectives: list[ObjectiveConfig] = Field(
+        default_factory=lambda: [ObjectiveConfig(metric="volume"), ObjectiveConfig(metric="gci")]
+    )
+    constraints: list[ConstraintConfig] = Field(default_factory=list)
+    algorithm: AlgorithmConfig = Field(default_factory=AlgorithmConfig)
+    output: OutputConfig = Field(default_factory=OutputConfig)
+
+    @field_validator("design")
+    @classmethod
+    def _design_finite(cls, v):
+        for key, value in v.items():
+            if not math.isfinite(value):
+                raise ValueError(f"{key}: must be finite, got {value}")
+        return v
+
+    @field_validator("bounds")
+    @classmethod
+    def _bounds_ok(cls, v):
+        for key, (lo, hi) in v.items():
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                raise ValueError(f"{key}: bounds must be finite, got [{lo}, {hi}]")
+            if not lo < hi:
+                raise ValueError(f"{key}: lower bound {lo} must be below upper bound {hi}")
+        return v
+
+    @model_validator(mode="after")
+    def _against_mechanism(self):
+        from scalesynth.mechanisms import get
+
+        mech = get(self.mechanism)
+        mech.resolve_design(self.design)
+        mech.resolve_options(self.options)
+        params = {p.name: p for p in mech.parameters}
+        for key, (lo, _) in self.bounds.items():
+            if key not in params:
+                raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} (known: {', '.join(params)})")
+            if params[key].positive and lo <= 0:
+                raise ValueError(f"bounds.{key}: lower bound must be > 0 for a length, got {lo}")
+        n_bands = len(self.dexterity.band_edges) - 1
+        for where, items in (("objectives", self.objectives), ("constraints", self.constraints)):
+            for i, item in enumerate(items):
+                if item.metric.startswith("band_"):
+                    if item.band is None:
+                        raise ValueError(f"{where}[{i}].band: required for metric {item.metric}")
+                    if item.band >= n_bands:
+                        raise ValueError(f"{where}[{i}].band: {item.band} out of range (0..{n_bands - 1})")
+        if len(self.objectives) < 1:
+            raise ValueError("objectives: need at least one")
+        return self
+
+    # convenient views
+    @property
+    def mech(self):
+        from scalesynth.mechanisms import get
+
+        return get(self.mechanism)
+
+    def resolved_design(self) -> dict[str, float]:
+        return self.mech.resolve_design(self.design)
+
+    def resolved_options(self) -> dict[str, Any]:
+        return self.mech.resolve_options(self.options)
+
+    def output_dir(self) -> Path:
+        return Path(self.output.dir) if self.output.dir else Path("results") / self.name
+
+
+def _format_validation_error(err: ValidationError) -> str:
+    first = err.errors()[0]
+    loc = ".".join(str(p) for p in first["loc"])
+    msg = first["msg"]
+    msg = msg.removeprefix("Value error, ")
+    if first["type"] == "extra_forbidden":
+        msg = "unknown key"
+    return f"{loc}: {msg}" if loc else msg
+
+
+def _parse_scalar(text: str) -> Any:
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+
+
+def apply_overrides(data: dict, overrides: list[str] | None, design_keys: set[str] | None = None) -> dict:
+    """Apply ``key=value`` overrides. A bare key naming a design parameter sets ``design.<key>``; a bare key
+    naming an option sets ``options.<key>``; a dotted key sets that path."""
+    for item in overrides or []:
+        if "=" not in item:
+            raise ConfigError(f"--set {item}: expected key=value")
+        key, _, raw = item.partition("=")
+        key = key.strip()
+        if not key:
+            raise ConfigError(f"--set {item}: empty key")
+        value = _parse_scalar(raw.strip())
+        path = key.split(".")
+        if len(path) == 1:
+            if design_keys is not None and key in design_keys:
+                path = ["design", key]
+            else:
+                path = ["options", key]
+        node = data
+        for part in path[:-1]:
+            nxt = node.setdefault(part, {})
+            if not isinstance(nxt, dict):
+                raise ConfigError(f"--set {key}: {part} is not a section")
+            node = nxt
+        node[path[-1]] = value
+    return data
+
+
+def config_from_dict(data: Any, overrides: list[str] | None = None) -> RunConfig:
+    if not isinstance(data, dict):
+        raise ConfigError("config: top level must be a mapping")
+    data = dict(data)
+    if overrides:
+        design_keys = None
+        try:
+            from scalesynth.mechanisms import get
+
+            design_keys = set(get(str(data.get("mechanism"))).parameter_names)
+        except ScalesynthError:
+            pass
+        data = apply_overrides(data, overrides, design_keys)
+    try:
+        return RunConfig.model_validate(data)
+    except ValidationError as err:
+        raise ConfigError(_format_validation_error(err)) from None
+    except ScalesynthError as err:
+        raise ConfigError(str(err)) from None
+
+
+def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConfig:
+    """Read a YAML config (safe loader: no object construction), apply overrides and validate."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such config file")
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise ConfigError(f"{path}: invalid YAML{where}") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: cannot read ({err.__class__.__name__})") from None
+    return config_from_dict(data, overrides)
+
+
+def dump_config(cfg: RunConfig) -> str:
+    return yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False)

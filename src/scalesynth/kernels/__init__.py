@@ -1,0 +1,1 @@
+"""Numba kernels: closed-form conditioning and the generic voxel-grid evaluator."""

@@ -1,0 +1,195 @@
+"""The Mechanism interface: what every registered mechanism provides.
+
+A mechanism is a small object describing one parallel-mechanism type: its design parameters, its options
+(working mode, joint limits, ...), a Numba *point kernel* used by the voxel evaluator, and plain NumPy
+kinematics (IK with all branches, FK with all assembly modes, Jacobian, singularity type) for the CLI and tests.
+
+Point-kernel contract (Numba ``@njit``): ``kernel(p, x, y, z) -> float``, where ``p`` is the float64 array
+returned by :meth:`Mechanism.pack`; the result is the LCI (in [0, 1]) of the pose if it is reachable under every
+limit, else ``-1.0``. Planar mechanisms ignore ``z``. The kernel must never return NaN.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from scalesynth.errors import InvalidParameter, InvalidPose
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A numeric design parameter (a length unless ``unit`` says otherwise)."""
+
+    name: str
+    default: float
+    doc: str
+    unit: str = "length"
+    positive: bool = True  # must be > 0; otherwise any finite value
+
+
+@dataclass(frozen=True)
+class Option:
+    """A non-design setting (working mode, limits, offsets). ``default`` None means 'off' or 'derived'."""
+
+    name: str
+    default: Any
+    doc: str
+
+
+@dataclass(frozen=True)
+class Solution:
+    """One IK branch or FK assembly mode: a label (e.g. '+-') and its value vector."""
+
+    label: str
+    values: np.ndarray
+
+    def as_dict(self) -> dict:
+        return {"branch": self.label, "values": [float(v) for v in self.values]}
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """Base description; concrete mechanisms subclass and fill the methods."""
+
+    name: str
+    title: str
+    seed: str
+    motion: str  # e.g. "3T", "2R1T"
+    task_axes: tuple[str, ...]
+    task_units: tuple[str, ...]  # "length" or "angle" per task axis
+    joints: tuple[str, ...]
+    joint_units: tuple[str, ...]
+    parameters: tuple[Parameter, ...]
+    options: tuple[Option, ...] = field(default_factory=tuple)
+    default_length_unit: str = "m"
+
+    # ----- parameters ---------------------------------------------------------------------------
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def option_names(self) -> tuple[str, ...]:
+        return tuple(o.name for o in self.options)
+
+    @property
+    def planar(self) -> bool:
+        return len(self.task_axes) == 2
+
+    def default_design(self) -> dict[str, float]:
+        return {p.name: float(p.default) for p in self.parameters}
+
+    def default_options(self) -> dict[str, Any]:
+        return {o.name: o.default for o in self.options}
+
+    def resolve_design(self, values: Mapping[str, Any] | None = None) -> dict[str, float]:
+        """Defaults overlaid by ``values``; raise InvalidParameter naming the first bad entry."""
+        design = self.default_design()
+        for key, value in (values or {}).items():
+            if key not in design:
+                raise InvalidParameter(
+                    f"design.{key}: unknown parameter of {self.name} (known: {', '.join(design)})"
+                )
+            design[key] = _finite_float(f"design.{key}", value)
+        for p in self.parameters:
+            if p.positive and design[p.name] <= 0:
+                raise InvalidParameter(f"design.{p.name}: must be > 0, got {design[p.name]:g}")
+        return design
+
+    def resolve_options(self, values: Mapping[str, Any] | None = None) -> dict[str, Any]:
+        options = self.default_options()
+        for key, value in (values or {}).items():
+            if key not in options:
+                known = ", ".join(options) or "none"
+                raise InvalidParameter(f"options.{key}: unknown option of {self.name} (known: {known})")
+            options[key] = value
+        self.check_options(options)
+        return options
+
+    def check_options(self, options: dict[str, Any]) -> None:
+        """Validate option values in place (override); raise InvalidParameter naming the option."""
+
+    # ----- what subclasses provide ----------------------------------------------------------------
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        """Flatten a resolved design and options into the float64 vector the point kernel reads."""
+        raise NotImplementedError  # abstract: every registered mechanism overrides it
+
+    @property
+    def point_kernel(self):  # pragma: no cover - abstract
+        raise NotImplementedError  # abstract: every registered mechanism overrides it
+
+    def bounding_box(self, design: Mapping[str, float], options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+        """Box (lo, hi), 3 entries each, that contains the whole reachable set."""
+        raise NotImplementedError  # abstract
+
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        raise NotImplementedError  # abstract
+
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        raise NotImplementedError  # abstract
+
+    def kernel_branch(self, options: Mapping[str, Any]) -> str:
+        """Label of the IK branch (working mode) whose LCI the point kernel returns."""
+        raise NotImplementedError  # abstract
+
+    def lci(self, design, options, pose, q) -> float:
+        """LCI at a pose with joint values q, computed with NumPy (SVD); the point kernel's reference."""
+        raise NotImplementedError  # abstract
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'none', 'inverse', 'forward' or 'both'."""
+        raise NotImplementedError  # abstract
+
+    # ----- helpers shared by the CLI ------------------------------------------------------------
+    def measure_name(self) -> str:
+        return "area" if self.planar else "volume"
+
+    def measure_unit(self, length_unit: str) -> str:
+        """Unit suffix of the workspace measure, e.g. 'm3', 'mm2', 'mm_rad2'."""
+        n_len = sum(1 for u in self.task_units if u == "length")
+        n_ang = sum(1 for u in self.task_units if u == "angle")
+        parts = []
+        if n_len:
+            parts.append(length_unit + (str(n_len) if n_len > 1 else ""))
+        if n_ang:
+            parts.append("rad" + (str(n_ang) if n_ang > 1 else ""))
+        return "_".join(parts)
+
+    def measure_key(self, length_unit: str) -> str:
+        return f"{self.measure_name()}_{self.measure_unit(length_unit)}"
+
+    def check_vector(self, what: str, values, expected: int) -> np.ndarray:
+        arr = np.asarray(values, dtype=float)
+        if arr.shape != (expected,) or not np.all(np.isfinite(arr)):
+            raise InvalidPose(f"{what}: expected {expected} finite numbers, got {values!r}")
+        return arr
+
+
+def _finite_float(field_name: str, value: Any) -> float:
+    if isinstance(value, bool):
+        raise InvalidParameter(f"{field_name}: expected a number, got {value!r}")
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameter(f"{field_name}: expected a number, got {value!r}") from None
+    if not math.isfinite(out):
+        raise InvalidParameter(f"{field_name}: must be finite, got {value!r}")
+    return out
+
+
+def parse_range(name: str, value: Any) -> tuple[float, float] | None:
+    """Option helper: None or a [lo, hi] pair with lo < hi (finite)."""
+    if value is None:
+        return None
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        raise InvalidParameter(f"options.{name}: expected [lo, hi], got {value!r}")
+    lo = _finite_float(f"options.{name}[0]", value[0])
+    hi = _finite_float(f"options.{name}[1]", value[1])
+    if not lo < hi:
+        raise InvalidParameter(f"options.{name}: lower bound {lo:g} must be below upper bound {hi:g}")
+    return lo, hi

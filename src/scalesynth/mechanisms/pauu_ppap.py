@@ -1,0 +1,301 @@
+"""2PaUU-PPaP three-translation parallel mechanism (seed 000), convention T of the spec (§1).
+
+Design parameters m, n, l1, l2, c (lengths); inputs q = (theta1, theta2, d); output P = (x, y, z).
+The chain geometry depends on m and n only through delta = m - n (spec §1.1). Default vertical offset
+e = 2c: only this value reproduces the paper's Tables 2 and 3 (spec §1.8); without z-limits e only
+translates the workspace.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from scalesynth.errors import InvalidParameter
+from scalesynth.kernels.conditioning import lci_3x3
+from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+
+MODES = ("++", "+-", "-+", "--")
+
+# packed-parameter layout (see PauuPpap.pack)
+_DELTA, _L1, _L2, _E, _S1, _S2 = 0, 1, 2, 3, 4, 5
+_T1LO, _T1HI, _T2LO, _T2HI, _DLO, _DHI, _ZMIN, _HAS_THETA = 6, 7, 8, 9, 10, 11, 12, 13
+N_PACKED = 14
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _chain_angle(a, b, yy, l1, l2, sigma):
+    """cos(theta), sin(theta) of one chain's IK root sigma, without transcendental calls.
+
+    theta = atan2(-b, a) + sigma * arccos(k), k = T3 / (2 l1 r), r = |(a, b)|.
+    Returns (ok, cos, sin); ok is False when the pose is out of the chain's reach.
+    """
+    r2 = a * a + b * b
+    if r2 <= 1e-300:
+        return False, 0.0, 0.0
+    r = math.sqrt(r2)
+    k = (r2 + yy + l1 * l1 - l2 * l2) / (2.0 * l1 * r)
+    if k > 1.0 or k < -1.0:
+        return False, 0.0, 0.0
+    sg = math.sqrt(1.0 - k * k)
+    c0 = a / r
+    s0 = -b / r
+    return True, c0 * k - sigma * s0 * sg, s0 * k + sigma * c0 * sg
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _angle_in(c, s, lo, hi):
+    t = math.atan2(s, c)
+    two_pi = 2.0 * math.pi
+    return (lo <= t <= hi) or (lo <= t - two_pi <= hi) or (lo <= t + two_pi <= hi)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z):
+    """LCI (1/kappa_2 of J) at P = (x, y, z) in the packed working mode, or -1 if unreachable."""
+    if z < p[_ZMIN] or y < p[_DLO] or y > p[_DHI]:
+        return -1.0
+    delta = p[_DELTA]
+    l1 = p[_L1]
+    l2 = p[_L2]
+    b = z - p[_E]
+    yy = y * y
+    if yy >= l2 * l2:
+        return -1.0
+    a1 = x - delta
+    a2 = -x - delta
+    ok1, c1, s1 = _chain_angle(a1, b, yy, l1, l2, p[_S1])
+    if not ok1:
+        return -1.0
+    ok2, c2, s2 = _chain_angle(a2, b, yy, l1, l2, p[_S2])
+    if not ok2:
+        return -1.0
+    if p[_HAS_THETA] > 0.0:
+        if not _angle_in(c1, s1, p[_T1LO], p[_T1HI]) or not _angle_in(c2, s2, p[_T2LO], p[_T2HI]):
+            return -1.0
+    # w_i = D_i - C_i; chain 2 mirrored in x
+    w1x = a1 - l1 * c1
+    w1z = b + l1 * s1
+    w2x = -(a2 - l1 * c2)
+    w2z = b + l1 * s2
+    q1 = -l1 * (a1 * s1 + b * c1)
+    q2 = -l1 * (a2 * s2 + b * c2)
+    if q1 == 0.0 or q2 == 0.0:
+        return 0.0  # inverse (type-1) singularity
+    # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J)
+    iq1 = 1.0 / q1
+    iq2 = 1.0 / q2
+    return lci_3x3(w1x * iq1, y * iq1, w1z * iq1, w2x * iq2, y * iq2, w2z * iq2, 0.0, 1.0, 0.0)
+
+
+class PauuPpap(Mechanism):
+    """Seed-000 mechanism; see module docstring."""
+
+    def check_options(self, options: dict[str, Any]) -> None:
+        if options["mode"] not in MODES:
+            raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
+        for name in ("theta1_limits", "theta2_limits", "stroke_limits"):
+            options[name] = parse_range(name, options[name])
+        for name in ("e", "z_min"):
+            value = options[name]
+            if value is not None:
+                if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                    raise InvalidParameter(f"options.{name}: expected a finite number or null, got {value!r}")
+                options[name] = float(value)
+
+    def offset_e(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
+        e = options.get("e")
+        return 2.0 * design["c"] if e is None else float(e)
+
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        p = np.empty(N_PACKED)
+        p[_DELTA] = design["m"] - design["n"]
+        p[_L1] = design["l1"]
+        p[_L2] = design["l2"]
+        p[_E] = self.offset_e(design, options)
+        mode = options["mode"]
+        p[_S1] = 1.0 if mode[0] == "+" else -1.0
+        p[_S2] = 1.0 if mode[1] == "+" else -1.0
+        t1 = options.get("theta1_limits")
+        t2 = options.get("theta2_limits")
+        p[_HAS_THETA] = 1.0 if (t1 is not None or t2 is not None) else 0.0
+        p[_T1LO], p[_T1HI] = t1 if t1 is not None else (-4.0 * math.pi, 4.0 * math.pi)
+        p[_T2LO], p[_T2HI] = t2 if t2 is not None else (-4.0 * math.pi, 4.0 * math.pi)
+        d = options.get("stroke_limits")
+        p[_DLO], p[_DHI] = d if d is not None else (-math.inf, math.inf)
+        z_min = options.get("z_min")
+        p[_ZMIN] = -math.inf if z_min is None else z_min
+        return p
+
+    @property
+    def point_kernel(self):
+        return point_lci
+
+    def kernel_branch(self, options) -> str:
+        return options["mode"]
+
+    def bounding_box(self, design, options):
+        """Tight box of the reachable set: |x| <= l1 + l2 - |m - n| (both annuli), |y| < l2, |z - e| <= l1 + l2,
+        clipped by the stroke limits and z_min (spec §1.9/§1.10; the spec's box uses l1 + l2 + |m - n| in x)."""
+        delta = abs(design["m"] - design["n"])
+        l1, l2 = design["l1"], design["l2"]
+        e = self.offset_e(design, options)
+        reach = l1 + l2
+        xr = max(reach - delta, 0.0)
+        lo = np.array([-xr, -l2, e - reach])
+        hi = np.array([xr, l2, e + reach])
+        d = options.get("stroke_limits")
+        if d is not None:
+            lo[1], hi[1] = max(lo[1], d[0]), min(hi[1], d[1])
+        if options.get("z_min") is not None:
+            lo[2] = max(lo[2], options["z_min"])
+        hi = np.maximum(hi, lo)
+        return lo, hi
+
+    # ----- NumPy kinematics (CLI, tests) ----------------------------------------------------------
+    def _chains(self, design, options):
+        delta = design["m"] - design["n"]
+        return delta, design["l1"], design["l2"], self.offset_e(design, options)
+
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """All four IK branches (sigma1, sigma2) as (theta1, theta2, d) in rad and length units; [] if unreachable.
+
+        A pose on a reach boundary (within 1e-12 in the arccos argument) is accepted as a double root.
+        """
+        x, y, z = self.check_vector("pose", pose, 3)
+        delta, l1, l2, e = self._chains(design, options)
+        b = z - e
+        roots = []
+        for a in (x - delta, -x - delta):
+            r = math.hypot(a, b)
+            if r == 0.0:
+                return []
+            k = (r * r + y * y + l1 * l1 - l2 * l2) / (2.0 * l1 * r)
+            if abs(k) > 1.0 + 1e-12:
+                return []
+            g = math.acos(min(1.0, max(-1.0, k)))
+            base = math.atan2(-b, a)
+            roots.append({+1: _wrap(base + g), -1: _wrap(base - g)})
+        return [
+            Solution(s1 + s2, np.array([roots[0][1 if s1 == "+" else -1], roots[1][1 if s2 == "+" else -1], y]))
+            for s1 in "+-"
+            for s2 in "+-"
+        ]
+
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        """Both assembly modes (kappa = +1, -1) of inputs (theta1, theta2, d); a double root when the circles are
+        tangent; [] when out of reach or when the circles coincide (infinitely many solutions)."""
+        t1, t2, d = self.check_vector("inputs", inputs, 3)
+        delta, l1, l2, e = self._chains(design, options)
+        if abs(d) > l2:
+            return []
+        rho = math.sqrt(l2 * l2 - d * d)
+        o1 = np.array([delta + l1 * math.cos(t1), e - l1 * math.sin(t1)])
+        o2 = np.array([-(delta + l1 * math.cos(t2)), e - l1 * math.sin(t2)])
+        u = o2 - o1
+        dist = float(np.hypot(*u))
+        scale = max(rho, l1, 1e-300)
+        if dist <= 1e-14 * scale:
+            return []
+        h2 = rho * rho - dist * dist / 4.0
+        if h2 < -1e-12 * scale * scale:
+            return []
+        mid = 0.5 * (o1 + o2)
+        if h2 <= 1e-12 * scale * scale:
+            return [Solution("double", np.array([mid[0], d, mid[1]]))]
+        h = math.sqrt(h2)
+        perp = np.array([-u[1], u[0]]) / dist
+        out = []
+        for label, kappa in (("+", 1.0), ("-", -1.0)):
+            xz = mid + kappa * h * perp
+            out.append(Solution(label, np.array([xz[0], d, xz[1]])))
+        return out
+
+    def jacobians(self, design, options, pose, q) -> dict[str, np.ndarray]:
+        """Jx, Jq and the forward Jacobian J = Jx^-1 Jq (J is None at a forward singularity)."""
+        x, y, z = self.check_vector("pose", pose, 3)
+        t1, t2, _ = self.check_vector("inputs", q, 3)
+        delta, l1, _, e = self._chains(design, options)
+        b = z - e
+        rows, diag = [], []
+        for s, t in ((1.0, t1), (-1.0, t2)):
+            a = s * x - delta
+            rows.append([s * (a - l1 * math.cos(t)), y, b + l1 * math.sin(t)])
+            diag.append(-l1 * (a * math.sin(t) + b * math.cos(t)))
+        jx = np.array([rows[0], rows[1], [0.0, 1.0, 0.0]])
+        jq = np.diag([diag[0], diag[1], 1.0])
+        try:
+            j = np.linalg.solve(jx, jq)
+        except np.linalg.LinAlgError:
+            j = None
+        return {"Jx": jx, "Jq": jq, "J": j}
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'inverse' (det Jq = 0), 'forward' (det Jx = 0), 'both' or 'none', with scale-free tolerances:
+        |sin| of the angle between link l1 and the xz-projection of l2 (inverse), and between the two
+        xz-projections of the l2 links (forward)."""
+        jac = self.jacobians(design, options, pose, q)
+        x, _, z = pose
+        delta, l1, _, e = self._chains(design, options)
+        b = z - e
+        inverse = False
+        for s, qi in ((1.0, jac["Jq"][0, 0]), (-1.0, jac["Jq"][1, 1])):
+            r = math.hypot(s * x - delta, b)
+            # r = 0: D_i's projection on the C-circle centre with l1 = rho, theta_i undetermined (folded leg)
+            if r <= tol * l1 or abs(qi) <= tol * l1 * r:
+                inverse = True
+        w1 = jac["Jx"][0, [0, 2]]
+        w2 = jac["Jx"][1, [0, 2]]
+        n1, n2 = np.hypot(*w1), np.hypot(*w2)
+        cross = w1[0] * w2[1] - w1[1] * w2[0]
+        forward = n1 == 0.0 or n2 == 0.0 or abs(cross) <= tol * n1 * n2
+        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
+            (inverse, forward), "both"
+        )
+
+    def lci(self, design, options, pose, q) -> float:
+        """LCI = 1/kappa_2(J) with NumPy's SVD (0 at any singularity)."""
+        jac = self.jacobians(design, options, pose, q)
+        if jac["J"] is None or self.singularity(design, options, pose, q, tol=0.0) != "none":
+            return 0.0
+        sv = np.linalg.svd(jac["J"], compute_uv=False)
+        return float(sv[-1] / sv[0])
+
+
+def _wrap(t: float) -> float:
+    """Angle in (-pi, pi]."""
+    w = math.atan2(math.sin(t), math.cos(t))
+    return math.pi if w == -math.pi else w
+
+
+MECHANISM = PauuPpap(
+    name="2pauu-ppap",
+    title="2PaUU-PPaP three-translation parallel mechanism (packaging, seed 000)",
+    seed="000",
+    motion="3T",
+    task_axes=("x", "y", "z"),
+    task_units=("length", "length", "length"),
+    joints=("theta1", "theta2", "d"),
+    joint_units=("angle", "angle", "length"),
+    parameters=(
+        Parameter("m", 0.857, "inscribed radius of the base square"),
+        Parameter("n", 0.706, "platform radius"),
+        Parameter("l1", 1.499, "long link of the parallelogram Pa"),
+        Parameter("l2", 1.5, "link between the two U joints"),
+        Parameter("c", 0.1, "short link of the parallelogram Pa"),
+    ),
+    options=(
+        Option("mode", "++", "working mode sigma1 sigma2: '++', '+-', '-+' or '--'"),
+        Option("e", None, "vertical offset of the C-circle centres; null = 2c (reproduces Tables 2-3)"),
+        Option("theta1_limits", None, "[lo, hi] rad for theta1 (convention T), null = none"),
+        Option("theta2_limits", None, "[lo, hi] rad for theta2 (convention T), null = none"),
+        Option("stroke_limits", None, "[lo, hi] for the stroke d = y, null = none"),
+        Option("z_min", None, "keep only z >= z_min, null = none"),
+    ),
+    default_length_unit="m",
+)
