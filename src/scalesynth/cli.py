@@ -125,7 +125,7 @@ def evaluate_cmd(
 ) -> None:
     """Evaluate one design: workspace measure, GCI, FCI, band shares, voxels, seconds."""
     from scalesynth.config import load_config
-    from scalesynth.evaluate import evaluate
+    from scalesynth.evaluate import evaluate_config
 
     overrides = list(sets or [])
     if resolution is not None:
@@ -136,15 +136,7 @@ def evaluate_cmd(
     for key, (lo, hi) in cfg.bounds.items():
         if not lo <= design[key] <= hi:
             _warn(f"design.{key}={design[key]:g} is outside the optimisation bounds [{lo:g}, {hi:g}]")
-    report = evaluate(
-        mech,
-        design,
-        cfg.resolved_options(),
-        resolution=cfg.grid.resolution,
-        region=cfg.grid.region,
-        band_edges=cfg.dexterity.band_edges,
-        length_unit=cfg.units.length,
-    )
+    report = evaluate_config(cfg, design)
     out = report.to_dict()
     if as_json:
         _print_json(out)
@@ -157,6 +149,9 @@ def evaluate_cmd(
     for b in range(len(edges) - 1):
         share = out[f"band{b}_share"] * 100
         typer.echo(f"  band {b} LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]: {share:6.2f} %")
+    for key in ("task_coverage", "task_gci", "task_fci", "task_min_lci", "path_min_lci", "path_mean_lci"):
+        if key in out:
+            typer.echo(f"  {key:<14} {out[key]:.6g}")
     typer.echo(
         f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
     )

@@ -15,7 +15,20 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from scalesynth.errors import ConfigError, ScalesynthError
 
-METRICS = ("volume", "gci", "fci", "min_lci", "max_lci", "band_share", "band_volume")
+METRICS = (
+    "volume",
+    "gci",
+    "fci",
+    "min_lci",
+    "max_lci",
+    "band_share",
+    "band_volume",
+    "task_coverage",
+    "task_gci",
+    "task_fci",
+    "task_min_lci",
+    "path_min_lci",
+)
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
 
@@ -25,8 +38,8 @@ class _Strict(BaseModel):
 
 class GridConfig(_Strict):
     resolution: int = Field(64, ge=4, le=1024, description="cells per axis")
-    region: dict[Literal["x", "y", "z"], tuple[float, float]] | None = Field(
-        None, description="override of the mechanism's bounding box, per axis [lo, hi]"
+    region: dict[str, tuple[float, float]] | None = Field(
+        None, description="override of the mechanism's bounding box, per task axis name: [lo, hi]"
     )
 
     @field_validator("region")
@@ -52,6 +65,37 @@ class DexterityConfig(_Strict):
             raise ValueError("must start at 0 and end at 1")
         if any(not b > a for a, b in zip(v, v[1:], strict=False)):
             raise ValueError("must be strictly increasing")
+        return v
+
+
+class TaskConfig(_Strict):
+    """A task region (box) that must be covered, and an optional path (polyline of task points) to follow."""
+
+    box: dict[str, tuple[float, float]]  # per task axis name
+    resolution: int | None = Field(None, ge=2, le=1024, description="cells per axis; null = grid.resolution")
+    path: list[list[float]] | None = None
+    path_samples: int = Field(200, ge=2, le=100_000, description="points sampled along the whole path")
+
+    @field_validator("box")
+    @classmethod
+    def _box_ok(cls, v):
+        for axis, (lo, hi) in v.items():
+            if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
+                raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+        return v
+
+    @field_validator("path")
+    @classmethod
+    def _path_ok(cls, v):
+        if v is None:
+            return v
+        if len(v) < 2:
+            raise ValueError("need at least two points")
+        dims = {len(p) for p in v}
+        if len(dims) != 1 or dims.pop() not in (2, 3):
+            raise ValueError("every point needs the same 2 or 3 coordinates")
+        if not all(math.isfinite(c) for p in v for c in p):
+            raise ValueError("coordinates must be finite")
         return v
 
 
@@ -105,6 +149,7 @@ class RunConfig(_Strict):
     bounds: dict[str, tuple[float, float]] = Field(default_factory=dict)
     grid: GridConfig = Field(default_factory=GridConfig)
     dexterity: DexterityConfig = Field(default_factory=DexterityConfig)
+    task: TaskConfig | None = None
     objectives: list[ObjectiveConfig] = Field(
         default_factory=lambda: [ObjectiveConfig(metric="volume"), ObjectiveConfig(metric="gci")]
     )
@@ -151,6 +196,24 @@ class RunConfig(_Strict):
                         raise ValueError(f"{where}[{i}].band: required for metric {item.metric}")
                     if item.band >= n_bands:
                         raise ValueError(f"{where}[{i}].band: {item.band} out of range (0..{n_bands - 1})")
+            for i, item in enumerate(items):
+                if item.metric.startswith(("task_", "path_")) and self.task is None:
+                    raise ValueError(f"{where}[{i}].metric: {item.metric} needs a task section")
+                if item.metric.startswith("path_") and (self.task is None or self.task.path is None):
+                    raise ValueError(f"{where}[{i}].metric: {item.metric} needs task.path")
+        axes = ", ".join(mech.task_axes)
+        for axis in self.grid.region or {}:
+            if axis not in mech.task_axes:
+                raise ValueError(f"grid.region.{axis}: not a task axis of {mech.name} ({axes})")
+        if self.task is not None:
+            for axis in self.task.box:
+                if axis not in mech.task_axes:
+                    raise ValueError(f"task.box.{axis}: not a task axis of {mech.name} ({axes})")
+            for axis in mech.task_axes:
+                if axis not in self.task.box:
+                    raise ValueError(f"task.box.{axis}: missing (the box needs every task axis: {axes})")
+            if self.task.path is not None and len(self.task.path[0]) != len(mech.task_axes):
+                raise ValueError(f"task.path: points need {len(mech.task_axes)} coordinates for {mech.name}")
         if len(self.objectives) < 1:
             raise ValueError("objectives: need at least one")
         return self

@@ -51,17 +51,14 @@ def make_grid(
     lo, hi = mech.bounding_box(design, options)
     lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
     if region:
-        for a, name in enumerate(("x", "y", "z")):
+        for a, name in enumerate(mech.task_axes):
             if name in region:
                 lo[a], hi[a] = float(region[name][0]), float(region[name][1])
     ndim = len(mech.task_axes)
     shape = np.array([resolution] * ndim + [1] * (3 - ndim), dtype=np.int64)
-    step = np.where(shape > 1, (hi - lo) / shape, 1.0)
+    step = np.ones(3)
     step[:ndim] = (hi[:ndim] - lo[:ndim]) / resolution
-    if ndim < 3:
-        lo[ndim:] = 0.0
-        step[ndim:] = 1.0
-        step[ndim:] = 1.0
+    lo[ndim:] = 0.0
     return Grid(lo=lo, step=step, shape=shape, ndim=ndim)
 
 
@@ -143,6 +140,7 @@ def evaluate(
     band_edges: Sequence[float] = DEFAULT_BAND_EDGES,
     length_unit: str | None = None,
     keep_grid: bool = False,
+    task: Any = None,
 ) -> WorkspaceReport:
     """Evaluate one design on a ``resolution``-per-axis grid. ``seconds`` excludes JIT compilation."""
     design = mech.resolve_design(design)
@@ -157,6 +155,8 @@ def evaluate(
     seconds = time.perf_counter() - t0
     names = metric_names(mech, unit, band_edges)
     metrics = {k: v[0].item() for k, v in stats_to_metrics(stats, np.array([g.cell_measure]), names).items()}
+    if task is not None:
+        metrics.update({k: v[0].item() for k, v in task_metrics(mech, packed, task, resolution, band_edges).items()})
     lci = _grid.sample_grid(mech.point_kernel, packed[0], g.lo, g.step, g.shape) if keep_grid else None
     return WorkspaceReport(
         mechanism=mech.name,
@@ -186,6 +186,65 @@ def warm_up(mech: Mechanism, packed: np.ndarray, edges: np.ndarray) -> None:
     _WARM.add(key)
 
 
+def sample_path(points: Sequence[Sequence[float]], samples: int) -> np.ndarray:
+    """``samples`` points evenly spaced by arc length along a polyline (ends included), padded to 3 columns."""
+    pts = np.asarray(points, dtype=float)
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    if s[-1] == 0.0:
+        out = np.repeat(pts[:1], samples, axis=0)
+    else:
+        t = np.linspace(0.0, s[-1], samples)
+        out = np.stack([np.interp(t, s, pts[:, a]) for a in range(pts.shape[1])], axis=1)
+    return np.pad(out, ((0, 0), (0, 3 - out.shape[1])))
+
+
+def task_metrics(
+    mech: Mechanism,
+    packed: np.ndarray,
+    task: Any,
+    resolution: int,
+    band_edges: Sequence[float],
+) -> dict[str, np.ndarray]:
+    """Coverage of the task box (share of its cells reachable within all limits), GCI/FCI/min LCI over the
+    reachable part of the box, and the LCI along the task path (0 where the path leaves the workspace)."""
+    n = packed.shape[0]
+    box = task.box
+    ndim = len(mech.task_axes)
+    lo = np.zeros(3)
+    hi = np.zeros(3)
+    shape = np.ones(3, dtype=np.int64)
+    res = task.resolution or resolution
+    for a, name in enumerate(mech.task_axes):  # config validation guarantees every axis is in the box
+        lo[a], hi[a] = box[name]
+        shape[a] = res
+    step = np.ones(3)
+    step[:ndim] = (hi[:ndim] - lo[:ndim]) / shape[:ndim]
+    edges = np.asarray(band_edges, dtype=float)
+    stats = _grid.population_stats(
+        mech.point_kernel, packed, np.tile(lo, (n, 1)), np.tile(step, (n, 1)), shape, edges
+    )
+    count = stats[:, _grid.COL_COUNT]
+    total = float(np.prod(shape))
+    safe = np.where(count > 0, count, 1.0)
+    gci = np.where(count > 0, stats[:, _grid.COL_SUM] / safe, 0.0)
+    var = np.where(count > 0, stats[:, _grid.COL_SUMSQ] / safe - gci * gci, 0.0)
+    out = {
+        "task_coverage": count / total,
+        "task_gci": gci,
+        "task_fci": np.sqrt(np.maximum(var, 0.0)),
+        "task_min_lci": np.where(count > 0, stats[:, _grid.COL_MIN], 0.0),
+    }
+    if task.path is not None:
+        pts = sample_path(task.path, task.path_samples)
+        lci = _grid.population_points_lci(mech.point_kernel, packed, pts)
+        reach = lci >= 0
+        out["path_reachable"] = reach.mean(axis=1)
+        out["path_min_lci"] = np.where(reach.all(axis=1), lci.min(axis=1), 0.0)
+        out["path_mean_lci"] = np.where(reach, lci, 0.0).mean(axis=1)
+    return out
+
+
 def evaluate_population(
     mech: Mechanism,
     designs: Sequence[Mapping[str, float]],
@@ -195,8 +254,10 @@ def evaluate_population(
     region: Mapping[str, Sequence[float]] | None = None,
     band_edges: Sequence[float] = DEFAULT_BAND_EDGES,
     length_unit: str | None = None,
+    task: Any = None,
 ) -> dict[str, np.ndarray]:
-    """Metrics of many designs in one parallel kernel call (no Python work per voxel)."""
+    """Metrics of many designs in one parallel kernel call (no Python work per voxel); with ``task`` (a
+    config TaskConfig) also the task-box and path metrics."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
@@ -211,4 +272,36 @@ def evaluate_population(
     edges = np.asarray(band_edges, dtype=float)
     stats = _grid.population_stats(mech.point_kernel, packed, lo, step, grids[0].shape, edges)
     cell = np.array([g.cell_measure for g in grids])
-    return stats_to_metrics(stats, cell, names)
+    out = stats_to_metrics(stats, cell, names)
+    if task is not None:
+        out.update(task_metrics(mech, packed, task, resolution, band_edges))
+    return out
+
+
+def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid: bool = False) -> WorkspaceReport:
+    """Evaluate ``design`` (default: the config's design) with the config's options, grid, bands and task."""
+    return evaluate(
+        cfg.mech,
+        cfg.resolved_design() if design is None else design,
+        cfg.resolved_options(),
+        resolution=cfg.grid.resolution,
+        region=cfg.grid.region,
+        band_edges=cfg.dexterity.band_edges,
+        length_unit=cfg.units.length,
+        keep_grid=keep_grid,
+        task=cfg.task,
+    )
+
+
+def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> dict[str, np.ndarray]:
+    """All metrics of many designs under one config, in one parallel kernel call per metric family."""
+    return evaluate_population(
+        cfg.mech,
+        designs,
+        cfg.resolved_options(),
+        resolution=cfg.grid.resolution,
+        region=cfg.grid.region,
+        band_edges=cfg.dexterity.band_edges,
+        length_unit=cfg.units.length,
+        task=cfg.task,
+    )

@@ -111,3 +111,16 @@ def points_lci(point_kernel, p, pts):
     for i in range(n):
         out[i] = point_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2])
     return out
+
+
+@njit(cache=True, parallel=True, fastmath=FASTMATH)
+def population_points_lci(point_kernel, params, pts):
+    """LCI (or -1) of every design at the same points: params (n_designs, k), pts (n, 3) -> (n_designs, n)."""
+    n_designs = params.shape[0]
+    n = pts.shape[0]
+    out = np.empty((n_designs, n))
+    for d in prange(n_designs):
+        p = params[d]
+        for i in range(n):
+            out[d, i] = point_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2])
+    return out
