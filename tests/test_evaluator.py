@@ -2,13 +2,14 @@
 
 import numpy as np
 import pytest
-from conftest import EXACT_VOLUME, SPEC_GCI, TABLE4
-from naive import grid_metrics, grid_nodes, pauu_lci
 
 from scalesynth.evaluate import evaluate, evaluate_population, make_grid
 from scalesynth.kernels import grid as kgrid
 from scalesynth.kernels.conditioning import lci_2x2, lci_3x3
 from scalesynth.mechanisms import get
+
+from conftest import EXACT_VOLUME, SPEC_GCI, TABLE4
+from naive import grid_metrics, grid_nodes, pauu_lci
 
 M = get("2pauu-ppap")
 EDGES = (0.0, 0.1, 0.3, 1.0)

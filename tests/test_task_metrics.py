@@ -2,11 +2,12 @@
 
 import numpy as np
 import pytest
-from conftest import TABLE4
-from naive import grid_nodes, pauu_lci
 
 from scalesynth.config import config_from_dict
 from scalesynth.evaluate import evaluate_config, evaluate_config_population, sample_path
+
+from conftest import TABLE4
+from naive import grid_nodes, pauu_lci
 
 BASE = {
     "name": "t",
@@ -14,7 +15,7 @@ BASE = {
     "design": TABLE4[1],
     "grid": {"resolution": 16},
     "task": {
-        "box": {"x": [-0.5, 0.5], "y": [-0.4, 0.4], "z": [1.0, 2.9]},
+        "box": {"x": [-0.5, 0.5], "y": [-0.4, 0.4], "z": [1.0, 3.3]},
         "resolution": 10,
         "path": [[0.0, 0.0, 1.5], [0.5, 0.0, 1.5], [0.5, 0.3, 2.5]],
         "path_samples": 50,
@@ -26,7 +27,7 @@ def test_task_metrics_match_twin():
     cfg = config_from_dict(BASE)
     rep = evaluate_config(cfg)
     lo = np.array([-0.5, -0.4, 1.0])
-    step = (np.array([0.5, 0.4, 2.9]) - lo) / 10
+    step = (np.array([0.5, 0.4, 3.3]) - lo) / 10
     X, Y, Z = grid_nodes(lo, step, (10, 10, 10))
     lci = pauu_lci(cfg.resolved_design(), cfg.resolved_options(), X, Y, Z)
     reach = lci[lci >= 0]
