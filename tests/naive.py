@@ -92,3 +92,61 @@ def grid_metrics(lci, cell_measure, edges):
         shares.append(sel.sum() / v.size)
     out["shares"] = shares
     return out
+
+
+def fivebar_arm_angles(design, options, x, y):
+    """Seed 004, spec §2.2: arm angles (alpha1, alpha2) of the working mode options['mode'] at arrays of points,
+    from alpha(sigma) = atan2(E, D) - sigma arccos(-F / sqrt(D^2 + E^2)); NaN where a chain cannot reach."""
+    x, y = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y)))
+    r, l1, l2 = (design[k] for k in ("r", "l1", "l2"))
+    mode = options.get("mode", "+-")
+    out = []
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for u, ch in ((x - r, mode[0]), (x + r, mode[1])):
+            sigma = 1.0 if ch == "+" else -1.0
+            d = -2 * l1 * u
+            e = -2 * l1 * y
+            f = u**2 + y**2 + l1**2 - l2**2
+            ok = (d**2 + e**2 - f**2 >= 0) & (np.hypot(d, e) > 0)
+            alpha = np.arctan2(e, d) - sigma * np.arccos(np.clip(-f / np.hypot(d, e), -1, 1))
+            out.append(np.where(ok, alpha, np.nan))
+    return out[0], out[1]
+
+
+def fivebar_lci(design, options, x, y):
+    """Seed 004, spec §2.2/§2.4: LCI = sigma_min/sigma_max of J (NumPy SVD) at arrays of points; -1 where
+    unreachable or outside the arm limits (intervals taken modulo 2 pi)."""
+    x, y = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y)))
+    r, l1 = design["r"], design["l1"]
+    a1, a2 = fivebar_arm_angles(design, options, x, y)
+    ok = np.isfinite(a1) & np.isfinite(a2)
+    for alpha, name in ((a1, "alpha1_limits"), (a2, "alpha2_limits")):
+        lims = options.get(name)
+        if lims is not None:
+            with np.errstate(invalid="ignore"):
+                ok &= np.mod(alpha - lims[0], 2 * np.pi) <= lims[1] - lims[0]
+    out = np.full(x.shape, -1.0)
+    idx = np.nonzero(ok)
+    if idx[0].size == 0:
+        return out
+    xs, ys, a1, a2 = x[idx], y[idx], a1[idx], a2[idx]
+    # forearm directions from the elbows Q_i = B_i + l1 (cos alpha_i, sin alpha_i), B_1,2 = (+-r, 0)
+    b1 = np.arctan2(ys - l1 * np.sin(a1), xs - r - l1 * np.cos(a1))
+    b2 = np.arctan2(ys - l1 * np.sin(a2), xs + r - l1 * np.cos(a2))
+    # J in the closed form of spec §2.4
+    k = xs.size
+    j = np.empty((k, 2, 2))
+    j[:, 0, 0] = np.sin(b2) * np.sin(b1 - a1)
+    j[:, 0, 1] = -np.sin(b1) * np.sin(b2 - a2)
+    j[:, 1, 0] = -np.cos(b2) * np.sin(b1 - a1)
+    j[:, 1, 1] = np.cos(b1) * np.sin(b2 - a2)
+    # at a forward singularity (sin(beta2 - beta1) = 0) J is unbounded and its LCI tends to 0
+    det = np.sin(b2 - b1)
+    regular = det != 0
+    j = j[regular] * (l1 / det[regular])[:, None, None]
+    sv = np.linalg.svd(j, compute_uv=False)
+    lci = np.zeros(k)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lci[regular] = np.where(sv[:, 0] > 0, sv[:, -1] / sv[:, 0], 0.0)
+    out[idx] = lci
+    return out

@@ -1,0 +1,296 @@
+"""Planar five-bar packing robot with parallelograms (seed 004), spec mechanisms_000_004.md §2.
+
+The parallelograms only keep the platform's orientation fixed, so the kinematics are those of a symmetric
+five-bar (spec §2.1), all lengths in mm:
+
+* active pivots B1 = (r, 0) (right arm) and B2 = (-r, 0) (left arm);
+* arm angles alpha_i (rad) from +x, counter-clockwise; elbows Q_i = B_i + l1 (cos alpha_i, sin alpha_i);
+* platform P = (x, y) = Q_i + l2 (cos beta_i, sin beta_i); the packing workspace is below the base (y < 0).
+
+Design parameters r (half the pivot distance), l1 (arm), l2 (forearm). The defaults r = 200, l1 = 475,
+l2 = 875 mm are the spec's ILLUSTRATIVE lengths (§2.7): the paper does not give its dimensions (§2.5-2.6).
+Inputs q = (alpha1, alpha2) in rad; the operating (elbows-out) working mode is sigma1 = +1, sigma2 = -1 ("+-").
+Both task axes are lengths, so LCI needs no characteristic length: LCI = sigma_min / sigma_max of the
+forward Jacobian J = Jx^-1 Jq (mm/rad), which the paper states with the spectral norm (§2.4).
+
+Arm limits are [lo, hi] intervals in rad taken modulo 2 pi, so an interval may extend past pi: the spec's
+corrected limits are alpha1 in [-4 pi/9, 7 pi/36] and alpha2 in [29 pi/36, 13 pi/9] (§2.5).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.kernels.conditioning import lci_2x2
+from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+
+MODES = ("++", "+-", "-+", "--")
+TWO_PI = 2.0 * math.pi
+
+# packed-parameter layout (see PlanarFivebar.pack); an arm limit is stored as its lower end and its width
+_R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
+_A1LO, _A1W, _A2LO, _A2W, _HAS1, _HAS2 = 5, 6, 7, 8, 9, 10
+N_PACKED = 11
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _arm(u, y, l1, l2, sigma):
+    """cos(alpha), sin(alpha) of one chain's IK root sigma, without transcendental calls, and the root gap S.
+
+    (u, y) = P - B_i. With rho^2 = u^2 + y^2 and K = rho^2 + l1^2 - l2^2 (law of cosines),
+    alpha = atan2(y, u) + sigma * arccos(K / (2 l1 rho)); expanding cos/sin of that sum gives
+    cos(alpha) = (u K - sigma y S) / (2 l1 rho^2), sin(alpha) = (y K + sigma u S) / (2 l1 rho^2), where
+    S^2 = 4 l1^2 rho^2 - K^2 = ((l1 + l2)^2 - rho^2) (rho^2 - (l1 - l2)^2) is written in factored form so that
+    it keeps its relative accuracy near the reach boundary. S = 2 l1 l2 |sin(beta - alpha)| vanishes exactly at
+    the chain's inverse singularity. Returns (ok, cos, sin, S); ok is False when P is out of the chain's reach.
+    """
+    rho2 = u * u + y * y
+    if rho2 <= 0.0:
+        return False, 0.0, 0.0, 0.0  # P on the pivot: alpha undetermined (measure-zero set)
+    h = ((l1 + l2) * (l1 + l2) - rho2) * (rho2 - (l1 - l2) * (l1 - l2))
+    if h < 0.0:
+        return False, 0.0, 0.0, 0.0
+    s = math.sqrt(h)
+    k = rho2 + l1 * l1 - l2 * l2
+    inv = 1.0 / (2.0 * l1 * rho2)
+    return True, (u * k - sigma * y * s) * inv, (y * k + sigma * u * s) * inv, s
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _angle_in(c, s, lo, width):
+    """True if the angle with cosine c and sine s lies in [lo, lo + width] modulo 2 pi."""
+    d = math.atan2(s, c) - lo
+    d -= TWO_PI * math.floor(d / TWO_PI)
+    return d <= width
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z):
+    """LCI (sigma_min/sigma_max of J) at P = (x, y) in the packed working mode, or -1 if unreachable; z unused."""
+    r = p[_R]
+    l1 = p[_L1]
+    l2 = p[_L2]
+    u1 = x - r
+    u2 = x + r
+    ok1, c1, s1, g1 = _arm(u1, y, l1, l2, p[_S1])
+    if not ok1:
+        return -1.0
+    ok2, c2, s2, g2 = _arm(u2, y, l1, l2, p[_S2])
+    if not ok2:
+        return -1.0
+    if p[_HAS1] > 0.0 and not _angle_in(c1, s1, p[_A1LO], p[_A1W]):
+        return -1.0
+    if p[_HAS2] > 0.0 and not _angle_in(c2, s2, p[_A2LO], p[_A2W]):
+        return -1.0
+    # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
+    w1x = u1 - l1 * c1
+    w1y = y - l1 * s1
+    w2x = u2 - l1 * c2
+    w2y = y - l1 * s2
+    # J = Jx^-1 Jq = adj(Jx) Jq / det(Jx) with Jx rows w_i / l2 and Jq = diag(-sigma_i g_i) / (2 l2) (spec §2.4).
+    # LCI ignores the common scale and the column signs, so adj(Jx) diag(g1, g2) suffices; it stays finite at a
+    # forward singularity (det Jx = 0), where its rank drops to 1 and the LCI is 0, the limit of J's.
+    return lci_2x2(w2y * g1, -w1y * g2, -w2x * g1, w1x * g2)
+
+
+class PlanarFivebar(Mechanism):
+    """Seed-004 mechanism; see module docstring."""
+
+    def check_options(self, options: dict[str, Any]) -> None:
+        if options["mode"] not in MODES:
+            raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
+        for name in ("alpha1_limits", "alpha2_limits"):
+            options[name] = parse_range(name, options[name])
+
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        p = np.zeros(N_PACKED)
+        p[_R] = design["r"]
+        p[_L1] = design["l1"]
+        p[_L2] = design["l2"]
+        mode = options["mode"]
+        p[_S1] = 1.0 if mode[0] == "+" else -1.0
+        p[_S2] = 1.0 if mode[1] == "+" else -1.0
+        for name, lo_i, w_i, has_i in (
+            ("alpha1_limits", _A1LO, _A1W, _HAS1),
+            ("alpha2_limits", _A2LO, _A2W, _HAS2),
+        ):
+            lim = options.get(name)
+            if lim is not None:
+                p[lo_i] = lim[0]
+                p[w_i] = lim[1] - lim[0]
+                p[has_i] = 1.0
+        return p
+
+    @property
+    def point_kernel(self):
+        return point_lci
+
+    def kernel_branch(self, options) -> str:
+        return options["mode"]
+
+    def bounding_box(self, design, options):
+        """Box of the reachable set: P lies in both disks of radius L = l1 + l2 around (+-r, 0), so
+        |x| <= L - r and |y| <= sqrt(L^2 - r^2) (both attained at a fully stretched chain); the third entry is
+        unused (0). An empty lens (L <= r) gives a zero-size box at the origin, which is unreachable."""
+        r, reach = design["r"], design["l1"] + design["l2"]
+        xr = max(reach - r, 0.0)
+        yr = math.sqrt(max(reach * reach - r * r, 0.0))
+        return np.array([-xr, -yr, 0.0]), np.array([xr, yr, 0.0])
+
+    # ----- NumPy kinematics (CLI, tests) ----------------------------------------------------------
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """All four IK branches (sigma1 sigma2) as (alpha1, alpha2) in rad, each in (-pi, pi]; [] if unreachable.
+
+        Spec §2.2: D cos(alpha) + E sin(alpha) + F = 0 with D = -2 l1 u, E = -2 l1 y, F = u^2 + y^2 + l1^2 - l2^2
+        (u = x - r for chain 1, x + r for chain 2), alpha(sigma) = atan2(E, D) - sigma arccos(-F / |(D, E)|).
+        A pose on a reach boundary (within 1e-12 in the arccos argument) is accepted as a double root.
+        """
+        x, y = self.check_vector("pose", pose, 2)
+        r, l1, l2 = design["r"], design["l1"], design["l2"]
+        roots = []
+        for u in (x - r, x + r):
+            dd, ee = -2.0 * l1 * u, -2.0 * l1 * y
+            f = u * u + y * y + l1 * l1 - l2 * l2
+            norm = math.hypot(dd, ee)
+            if norm == 0.0:
+                return []
+            k = -f / norm
+            if abs(k) > 1.0 + 1e-12:
+                return []
+            g = math.acos(min(1.0, max(-1.0, k)))
+            base = math.atan2(ee, dd)
+            roots.append({1: _wrap(base - g), -1: _wrap(base + g)})
+        return [
+            Solution(s1 + s2, np.array([roots[0][1 if s1 == "+" else -1], roots[1][1 if s2 == "+" else -1]]))
+            for s1 in "+-"
+            for s2 in "+-"
+        ]
+
+    def elbows(self, design, q) -> tuple[np.ndarray, np.ndarray]:
+        """Elbow points Q1, Q2 (mm) of arm angles q = (alpha1, alpha2)."""
+        a1, a2 = self.check_vector("inputs", q, 2)
+        r, l1 = design["r"], design["l1"]
+        return (
+            np.array([r + l1 * math.cos(a1), l1 * math.sin(a1)]),
+            np.array([-r + l1 * math.cos(a2), l1 * math.sin(a2)]),
+        )
+
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        """Both assembly modes of arm angles (alpha1, alpha2): the intersections of the circles of radius l2
+        around the two elbows (spec §2.3). Label '+' is P = M + h R90(Q2 - Q1)/|Q2 - Q1| (M the midpoint,
+        R90 a quarter turn counter-clockwise), '-' the mirror image; with the left elbow Q2 to the left of Q1,
+        '+' is the lower solution (the packing side). A double root 'double' when the circles are tangent
+        (forward singularity); [] when they do not meet or coincide (Q1 = Q2: infinitely many solutions)."""
+        q1, q2 = self.elbows(design, inputs)
+        l2 = design["l2"]
+        u = q2 - q1
+        dist = float(np.hypot(*u))
+        scale = max(l2, design["l1"], design["r"])
+        if dist <= 1e-14 * scale:
+            return []
+        h2 = l2 * l2 - dist * dist / 4.0
+        if h2 < -1e-12 * scale * scale:
+            return []
+        mid = 0.5 * (q1 + q2)
+        if h2 <= 1e-12 * scale * scale:
+            return [Solution("double", mid)]
+        h = math.sqrt(h2)
+        perp = np.array([-u[1], u[0]]) / dist
+        return [Solution("+", mid + h * perp), Solution("-", mid - h * perp)]
+
+    def forearm_angles(self, design, pose, q) -> np.ndarray:
+        """(beta1, beta2) in rad, (-pi, pi]: directions of the forearms Q_i -> P. Raises InvalidPose when the
+        arm angles q do not assemble at the pose (a forearm length off l2 by more than 1e-6 relative)."""
+        p = self.check_vector("pose", pose, 2)
+        l2 = design["l2"]
+        betas = []
+        for i, qi in enumerate(self.elbows(design, q), start=1):
+            w = p - qi
+            length = float(np.hypot(*w))
+            if abs(length - l2) > 1e-6 * max(l2, design["l1"], design["r"]):
+                raise InvalidPose(
+                    f"inputs: arm angles do not assemble at the pose (forearm {i} would be {length:g} long, "
+                    f"l2 = {l2:g})"
+                )
+            betas.append(math.atan2(w[1], w[0]))
+        return np.array(betas)
+
+    def jacobians(self, design, options, pose, q) -> dict[str, np.ndarray]:
+        """Jx (rows (cos beta_i, sin beta_i)), Jq = l1 diag(sin(beta_i - alpha_i)) (mm) and the forward Jacobian
+        J = Jx^-1 Jq (mm/rad, dP = J dalpha; None at an exact forward singularity), spec §2.4."""
+        a1, a2 = self.check_vector("inputs", q, 2)
+        b1, b2 = self.forearm_angles(design, pose, q)
+        l1 = design["l1"]
+        jx = np.array([[math.cos(b1), math.sin(b1)], [math.cos(b2), math.sin(b2)]])
+        jq = l1 * np.diag([math.sin(b1 - a1), math.sin(b2 - a2)])
+        try:
+            j = np.linalg.solve(jx, jq)
+        except np.linalg.LinAlgError:
+            j = None
+        return {"Jx": jx, "Jq": jq, "J": j}
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'inverse' (|sin(beta_i - alpha_i)| <= tol: arm and forearm collinear), 'forward'
+        (|sin(beta1 - beta2)| <= tol: forearms collinear), 'both' or 'none'; tol is scale-free."""
+        a1, a2 = self.check_vector("inputs", q, 2)
+        b1, b2 = self.forearm_angles(design, pose, q)
+        inverse = abs(math.sin(b1 - a1)) <= tol or abs(math.sin(b2 - a2)) <= tol
+        forward = abs(math.sin(b1 - b2)) <= tol
+        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
+            (inverse, forward), "both"
+        )
+
+    def lci(self, design, options, pose, q) -> float:
+        """LCI = sigma_min / sigma_max of J with NumPy's SVD (0 at any singularity)."""
+        jac = self.jacobians(design, options, pose, q)
+        if jac["J"] is None or self.singularity(design, options, pose, q, tol=0.0) != "none":
+            return 0.0
+        sv = np.linalg.svd(jac["J"], compute_uv=False)
+        return float(sv[-1] / sv[0])
+
+    def resolution_index(self, design, options, pose, dalpha=(1.0, 1.0)) -> float:
+        """Kinematic resolution |J dalpha| (mm per the arm increments dalpha in rad; spec §2.4, paper eq. 18) in
+        the working mode options['mode']. Infinite at an exact forward singularity (J unbounded); raises
+        InvalidPose when the pose is out of reach."""
+        dq = self.check_vector("dalpha", dalpha, 2)
+        branches = {s.label: s.values for s in self.inverse_kinematics(design, options, pose)}
+        if not branches:
+            raise InvalidPose(f"pose: {tuple(float(v) for v in pose)} is out of reach")
+        j = self.jacobians(design, options, pose, branches[self.kernel_branch(options)])["J"]
+        return math.inf if j is None else float(np.linalg.norm(j @ dq))
+
+
+def _wrap(t: float) -> float:
+    """Angle in (-pi, pi]."""
+    w = math.atan2(math.sin(t), math.cos(t))
+    return math.pi if w == -math.pi else w
+
+
+MECHANISM = PlanarFivebar(
+    name="planar-fivebar",
+    title="2-DOF planar five-bar packing robot with parallelograms (seed 004)",
+    seed="004",
+    motion="2T",
+    task_axes=("x", "y"),
+    task_units=("length", "length"),
+    joints=("alpha1", "alpha2"),
+    joint_units=("angle", "angle"),
+    parameters=(
+        Parameter("r", 200.0, "half the distance between the active pivots (illustrative default, spec §2.7)"),
+        Parameter("l1", 475.0, "active arm length (illustrative default, spec §2.7)"),
+        Parameter("l2", 875.0, "forearm length (illustrative default, spec §2.7)"),
+    ),
+    options=(
+        Option("mode", "+-", "working mode sigma1 sigma2: '+-' = elbows out (operating mode), '++', '-+', '--'"),
+        Option("alpha1_limits", None, "[lo, hi] rad for alpha1 modulo 2 pi, null = none (spec: [-4pi/9, 7pi/36])"),
+        Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
+    ),
+    default_length_unit="mm",
+)
