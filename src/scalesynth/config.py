@@ -150,6 +150,9 @@ class RunConfig(_Strict):
     grid: GridConfig = Field(default_factory=GridConfig)
     dexterity: DexterityConfig = Field(default_factory=DexterityConfig)
     task: TaskConfig | None = None
+    references: dict[str, dict[str, float]] = Field(
+        default_factory=dict, description="labelled designs re-evaluated and drawn beside the front (e.g. a paper's)"
+    )
     objectives: list[ObjectiveConfig] = Field(
         default_factory=lambda: [ObjectiveConfig(metric="volume"), ObjectiveConfig(metric="gci")]
     )
@@ -182,6 +185,11 @@ class RunConfig(_Strict):
         mech = get(self.mechanism)
         mech.resolve_design(self.design)
         mech.resolve_options(self.options)
+        for label, ref in self.references.items():
+            try:
+                mech.resolve_design({**self.design, **ref})
+            except ScalesynthError as err:
+                raise ValueError(f"references.{label}: {err}") from None
         params = {p.name: p for p in mech.parameters}
         for key, (lo, _) in self.bounds.items():
             if key not in params:

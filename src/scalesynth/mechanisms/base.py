@@ -145,6 +145,14 @@ class Mechanism:
         """'none', 'inverse', 'forward' or 'both'."""
         raise NotImplementedError  # abstract
 
+    def derived_columns(self, design: Mapping[str, float]) -> dict[str, float]:
+        """Extra result columns derived from a design (e.g. m_minus_n); none by default."""
+        return {}
+
+    def canonical_vectors(self, names: list[str], X: np.ndarray) -> np.ndarray:
+        """Design vectors in coordinates where two rows are equal iff the models are identical (default: X)."""
+        return np.asarray(X, dtype=float)
+
     # ----- helpers shared by the CLI ------------------------------------------------------------
     def measure_name(self) -> str:
         return "area" if self.planar else "volume"

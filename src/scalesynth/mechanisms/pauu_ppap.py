@@ -139,6 +139,19 @@ class PauuPpap(Mechanism):
     def kernel_branch(self, options) -> str:
         return options["mode"]
 
+    def derived_columns(self, design):
+        """The model depends on m and n only through m - n (spec §1.1)."""
+        return {"m_minus_n": design["m"] - design["n"]}
+
+    def canonical_vectors(self, names, X):
+        """Replace (m, n) by (m - n, 0): designs with equal m - n are the same model (spec §1.1)."""
+        X = np.array(X, dtype=float)
+        if "m" in names and "n" in names:
+            i, j = names.index("m"), names.index("n")
+            X[:, i] = X[:, i] - X[:, j]
+            X[:, j] = 0.0
+        return X
+
     def bounding_box(self, design, options):
         """Tight box of the reachable set: |x| <= l1 + l2 - |m - n| (both annuli), |y| < l2, |z - e| <= l1 + l2,
         clipped by the stroke limits and z_min (spec §1.9/§1.10; the spec's box uses l1 + l2 + |m - n| in x)."""

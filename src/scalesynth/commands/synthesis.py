@@ -1,0 +1,96 @@
+"""Commands of the synthesis workflow: optimize, plot-front, plot-bands, select."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from scalesynth.cli import SetOpt, app, handles_errors
+
+
+@app.command("optimize")
+@handles_errors
+def optimize_cmd(
+    config: Annotated[Path, typer.Argument(help="run config (YAML)")],
+    out: Annotated[Path | None, typer.Option("--out", help="results directory (default results/<name>)")] = None,
+    seed: Annotated[int | None, typer.Option("--seed", min=0, help="random seed (overrides algorithm.seed)")] = None,
+    resume: Annotated[bool, typer.Option("--resume", help="continue from the directory's checkpoint")] = False,
+    sets: SetOpt = None,
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="skip plots and report.md")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no progress output")] = False,
+) -> None:
+    """Run the NSGA-II synthesis and write pareto.csv, history.csv, manifest.json, config.yaml, plots, report.md."""
+    from scalesynth.config import load_config
+    from scalesynth.optimize import run
+    from scalesynth.progress import make_progress
+
+    cfg = load_config(config, sets)
+    progress = make_progress(cfg.algorithm.n_gen, quiet)
+    try:
+        result = run(cfg, out, seed=seed, resume=resume, progress=progress, plots=not no_plots)
+    finally:
+        if progress is not None:
+            progress.close()
+    m = result.manifest
+    typer.echo(
+        f"{m['name']}: {m['pareto_size']} Pareto designs, HV {m['hypervolume']:.6g}, "
+        f"{m['evaluations']} evaluations in {m['wall_seconds']:.1f} s -> {result.out_dir}",
+        err=True,
+    )
+    typer.echo(str(result.out_dir))
+
+
+@app.command("plot-front")
+@handles_errors
+def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")]) -> None:
+    """Pareto front with the config's reference designs re-evaluated, and hypervolume per generation."""
+    from scalesynth.report import plot_front
+
+    info = plot_front(run_dir)
+    for f in info["files"]:
+        typer.echo(str(Path(run_dir) / f))
+
+
+@app.command("plot-bands")
+@handles_errors
+def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")]) -> None:
+    """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs."""
+    from scalesynth.report import plot_bands
+
+    info = plot_bands(run_dir)
+    for f in info["files"]:
+        typer.echo(str(Path(run_dir) / f))
+
+
+@app.command("select")
+@handles_errors
+def select_cmd(
+    run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
+    method: Annotated[str, typer.Option("--method", help="knee | balanced | weights")] = "knee",
+    weights: Annotated[str | None, typer.Option("--weights", help="comma-separated, one per objective")] = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", help="config to write (default RUN_DIR/selected_<method>.yaml)")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
+) -> None:
+    """Choose one design from the front; print it and write it as a config that `scalesynth evaluate` accepts."""
+    from scalesynth.errors import InvalidParameter
+    from scalesynth.selection import select_design
+
+    w = None
+    if weights is not None:
+        try:
+            w = [float(v) for v in weights.split(",")]
+        except ValueError:
+            raise InvalidParameter(f"--weights: expected comma-separated numbers, got {weights!r}") from None
+    chosen = select_design(run_dir, method, w, out)
+    if as_json:
+        from scalesynth.cli import _print_json
+
+        _print_json(chosen)
+        return
+    typer.echo(f"{method} design: " + ", ".join(f"{k}={v:.6g}" for k, v in chosen["design"].items()))
+    typer.echo("  " + ", ".join(f"{k}={v:.6g}" for k, v in chosen["metrics"].items()))
+    typer.echo(f"  config written to {chosen['config']}")

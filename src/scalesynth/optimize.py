@@ -1,0 +1,307 @@
+"""NSGA-II scale synthesis: run(config) -> RunResult, with checkpoints, resume and per-generation history.
+
+The loop is pymoo's ask/tell; the whole algorithm object (population, its Generator state, counters) is pickled
+every ``output.checkpoint_every`` generations, so ``resume`` continues a killed run to the same final front as an
+uninterrupted run with the same seed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from scalesynth import __version__
+from scalesynth import io as rio
+from scalesynth.config import RunConfig, dump_config
+from scalesynth.errors import ConfigError, RunError
+from scalesynth.problem import SynthesisProblem
+
+ProgressFn = Callable[[dict[str, Any]], None]
+
+DEPENDENCIES = ("numpy", "numba", "llvmlite", "pymoo", "moocore", "pandas", "matplotlib", "pydantic", "pyyaml", "typer")
+
+
+@dataclass
+class RunResult:
+    out_dir: Path
+    pareto: pd.DataFrame
+    history: pd.DataFrame
+    manifest: dict[str, Any]
+
+
+class CanonicalX:
+    """Duplicate-elimination key: designs that are the same model (e.g. equal m - n) count as duplicates."""
+
+    def __init__(self, problem: SynthesisProblem):
+        self.problem = problem
+
+    def __call__(self, pop):
+        return self.problem.canonical(pop.get("X"))
+
+
+def config_digest(cfg: RunConfig) -> str:
+    """Hash of everything that determines the result (not the output location)."""
+    data = cfg.model_dump(mode="json")
+    data.pop("output", None)
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
+
+
+def make_algorithm(cfg: RunConfig, problem: SynthesisProblem):
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.core.duplicate import DefaultDuplicateElimination
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.operators.crossover.sbx import SBX
+    from pymoo.operators.mutation.pm import PM
+    from pymoo.operators.sampling.rnd import FloatRandomSampling
+
+    a = cfg.algorithm
+    return NSGA2(
+        pop_size=a.pop_size,
+        sampling=FloatRandomSampling(),
+        crossover=SBX(prob=a.prob_crossover, eta=a.eta_crossover),
+        mutation=PM(prob=1.0, prob_var=a.prob_mutation, eta=a.eta_mutation),
+        eliminate_duplicates=DefaultDuplicateElimination(epsilon=1e-9, func=CanonicalX(problem)),
+        evaluator=Evaluator(evaluate_values_of=["F", "G", "M"]),
+    )
+
+
+def hypervolume(F: np.ndarray, ref: np.ndarray) -> float:
+    """Hypervolume (moocore) of the points of F that strictly dominate ``ref`` (minimisation)."""
+    import moocore
+
+    if F.size == 0:
+        return 0.0
+    F = F[np.all(F < ref, axis=1)]
+    if F.size == 0:
+        return 0.0
+    return float(moocore.hypervolume(F, ref=ref))
+
+
+def _feasible(pop) -> np.ndarray:
+    cv = pop.get("CV")
+    if cv is None or len(cv) == 0:
+        return np.ones(len(pop), dtype=bool)
+    return (np.asarray(cv, dtype=float).reshape(len(pop), -1) <= 0).all(axis=1)
+
+
+def _history_row(algorithm, problem: SynthesisProblem, ref: np.ndarray, elapsed: float) -> dict[str, Any]:
+    pop = algorithm.pop
+    feas = _feasible(pop)
+    F = pop.get("F")[feas]
+    opt = algorithm.opt
+    opt_F = opt.get("F")[_feasible(opt)] if opt is not None and len(opt) else np.zeros((0, problem.n_obj))
+    row = {
+        "generation": int(algorithm.n_gen) - 1,  # pymoo counts the next generation
+        "evaluations": int(algorithm.evaluator.n_eval),
+        "n_nondominated": int(len(opt_F)),
+        "n_feasible": int(feas.sum()),
+        "hypervolume": hypervolume(opt_F, ref),
+    }
+    for key, sign in zip(problem.objective_keys, problem.signs, strict=True):
+        col = problem.objective_keys.index(key)
+        row[f"best_{key}"] = float((F[:, col] * sign).max() if sign < 0 else F[:, col].min()) if len(F) else 0.0
+    row["seconds"] = round(elapsed, 3)
+    return row
+
+
+def _versions() -> dict[str, str]:
+    out = {"scalesynth": __version__, "python": platform.python_version()}
+    for name in DEPENDENCIES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def _pareto_frame(problem: SynthesisProblem, algorithm) -> tuple[pd.DataFrame, pd.DataFrame, int]:
+    """(pareto, population, number of objective-space duplicates dropped from the front)."""
+    from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+    cfg = problem.cfg
+    pop = algorithm.pop
+    X, F, M = pop.get("X"), pop.get("F"), pop.get("M")
+    feas = _feasible(pop)
+    rank = np.full(len(pop), -1, dtype=int)
+    if feas.any():
+        idx = np.nonzero(feas)[0]
+        for r, front in enumerate(NonDominatedSorting().do(F[idx])):
+            rank[idx[front]] = r
+    rows = []
+    for i, design in enumerate(problem.designs(X)):
+        row: dict[str, Any] = {k: design[k] for k in problem.var_names}
+        row.update(cfg.mech.derived_columns(design))
+        row.update({k: M[i, j] for j, k in enumerate(problem.metric_columns)})
+        row["voxels"] = int(round(row["voxels"]))
+        row["feasible"] = bool(feas[i])
+        row["rank"] = int(rank[i])
+        rows.append(row)
+    population = pd.DataFrame(rows)
+    measure = cfg.mech.measure_key(cfg.units.length)
+    sort_cols = [measure, *problem.objective_keys]
+    sort_cols = list(dict.fromkeys(sort_cols))
+    population = population.sort_values(
+        ["rank", *sort_cols], ascending=[True] + [False] * len(sort_cols), kind="mergesort"
+    ).reset_index(drop=True)
+    front = population[(population["rank"] == 0) & population["feasible"]]
+    deduped = front.drop_duplicates(subset=problem.objective_keys, keep="first")
+    pareto = deduped.drop(columns=["feasible"]).reset_index(drop=True)
+    return pareto, population, len(front) - len(deduped)
+
+
+def run(
+    cfg: RunConfig,
+    out_dir: Path | None = None,
+    *,
+    seed: int | None = None,
+    resume: bool = False,
+    progress: ProgressFn | None = None,
+    plots: bool = True,
+    stop_after: int | None = None,
+) -> RunResult:
+    """Run NSGA-II for ``cfg`` and write the results directory.
+
+    ``stop_after`` (generations) ends the loop early without writing final results, leaving a checkpoint: it
+    exists for tests of resume and for chunked runs.
+    """
+    if seed is not None:
+        cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
+    out = Path(out_dir) if out_dir is not None else cfg.output_dir()
+    rio.ensure_dir(out)
+    ckpt_path = out / rio.CHECKPOINT
+    problem = SynthesisProblem(cfg)
+    ref = problem.hv_reference()
+    digest = config_digest(cfg)
+    history: list[dict[str, Any]] = []
+    elapsed_before = 0.0
+    started = datetime.now(UTC).isoformat(timespec="seconds")
+    algorithm = None
+    if resume and ckpt_path.exists():
+        state = rio.read_pickle(ckpt_path)
+        if state.get("digest") != digest:
+            raise ConfigError(
+                f"{out}: cannot resume: the config differs from the checkpoint's (start without --resume)"
+            )
+        algorithm = state["algorithm"]
+        algorithm.problem = problem
+        algorithm.evaluator.evaluate_values_of = ["F", "G", "M"]
+        history = state["history"]
+        elapsed_before = state["elapsed"]
+        started = state["started"]
+    elif resume and _finished(out, digest):
+        return load_result(out)
+    if algorithm is None:
+        # a fresh run: an old checkpoint in this directory belongs to another run
+        if ckpt_path.exists():
+            ckpt_path.unlink()
+        algorithm = make_algorithm(cfg, problem)
+        algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
+    # compile the kernels before the clock starts on the first generation
+    problem.metrics(np.atleast_2d((problem.xl + problem.xu) / 2))
+    t0 = time.perf_counter()
+    gens_this_call = 0
+    while algorithm.has_next():
+        pop = algorithm.ask()
+        algorithm.evaluator.eval(problem, pop)
+        algorithm.tell(infills=pop)
+        gens_this_call += 1
+        elapsed = elapsed_before + time.perf_counter() - t0
+        row = _history_row(algorithm, problem, ref, elapsed)
+        history.append(row)
+        if progress is not None:
+            progress({**row, "n_gen": cfg.algorithm.n_gen})
+        done = not algorithm.has_next()
+        if done or row["generation"] % cfg.output.checkpoint_every == 0 or stop_after == gens_this_call:
+            rio.write_pickle(
+                ckpt_path,
+                {"algorithm": algorithm, "history": history, "elapsed": elapsed, "digest": digest, "started": started},
+            )
+        if stop_after is not None and gens_this_call >= stop_after and not done:
+            raise RunError(f"stopped after {gens_this_call} generations (checkpoint in {ckpt_path})")
+    wall = elapsed_before + time.perf_counter() - t0
+    pareto, population, dropped = _pareto_frame(problem, algorithm)
+    history_df = pd.DataFrame(history)
+    manifest = {
+        "name": cfg.name,
+        "status": "finished",
+        "mechanism": cfg.mechanism,
+        "seed": cfg.algorithm.seed,
+        "config_digest": digest,
+        "started": started,
+        "finished": datetime.now(UTC).isoformat(timespec="seconds"),
+        "wall_seconds": round(wall, 3),
+        "generations": int(algorithm.n_gen) - 1,
+        "evaluations": int(algorithm.evaluator.n_eval),
+        "pop_size": cfg.algorithm.pop_size,
+        "grid_resolution": cfg.grid.resolution,
+        "objectives": [f"{o.sense} {k}" for o, k in zip(cfg.objectives, problem.objective_keys, strict=True)],
+        "hv_reference": [float(v) for v in ref],
+        "hv_reference_note": "in minimisation form: maximised objectives enter negated",
+        "hypervolume": history[-1]["hypervolume"] if history else 0.0,
+        "pareto_size": int(len(pareto)),
+        "objective_duplicates_dropped": int(dropped),
+        "machine": {
+            "cores": os.cpu_count(),
+            "platform": platform.platform(),
+            "processor": platform.processor() or platform.machine(),
+            "numba_threads": _numba_threads(),
+        },
+        "versions": _versions(),
+        "config": cfg.model_dump(mode="json"),
+    }
+    rio.write_csv(out / "pareto.csv", pareto)
+    rio.write_csv(out / "population.csv", population)
+    rio.write_csv(out / "history.csv", history_df)
+    rio.write_text(out / "config.yaml", dump_config(cfg))
+    if plots:
+        from scalesynth.report import write_plots_and_report
+
+        write_plots_and_report(out)
+    rio.write_json(out / "manifest.json", manifest)  # last: its presence marks a finished run
+    if ckpt_path.exists():
+        ckpt_path.unlink()
+    return RunResult(out_dir=out, pareto=pareto, history=history_df, manifest=manifest)
+
+
+def _numba_threads() -> int:
+    import numba
+
+    return int(numba.get_num_threads())
+
+
+def _finished(out: Path, digest: str) -> bool:
+    path = out / "manifest.json"
+    if not path.exists():
+        return False
+    try:
+        manifest = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError):
+        return False
+    return manifest.get("status") == "finished" and manifest.get("config_digest") == digest
+
+
+def load_result(out: Path) -> RunResult:
+    """Read a finished results directory."""
+    out = Path(out)
+    manifest_path = out / "manifest.json"
+    if not manifest_path.exists():
+        raise ConfigError(f"{out}: not a finished scalesynth run (no manifest.json)")
+    manifest = json.loads(manifest_path.read_text())
+    return RunResult(
+        out_dir=out,
+        pareto=pd.read_csv(out / "pareto.csv"),
+        history=pd.read_csv(out / "history.csv"),
+        manifest=manifest,
+    )
