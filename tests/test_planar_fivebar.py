@@ -1,6 +1,7 @@
 """Seed-004 planar five-bar: spec mechanisms_000_004.md §2 (reference cases §2.7, cases/ref000_004.txt), the
 kernel against its NumPy twin (tests/naive.py), and property tests (IK/FK round trips, J vs FK differences)."""
 
+import json
 import math
 
 import numpy as np
@@ -348,8 +349,6 @@ def test_cli_ik_fk_json():
     runner = CliRunner()
     res = runner.invoke(app, ["ik", "planar-fivebar", "--pose", "500,-850", "--json"])
     assert res.exit_code == 0, res.output
-    import json
-
     out = json.loads(res.stdout)
     assert out["names"] == ["alpha1", "alpha2"]
     row = next(r for r in out["solutions"] if r["branch"] == "+-")
@@ -414,3 +413,38 @@ def test_jacobian_matches_central_differences_of_fk(raw, q):
                 vals[step] = min((f.values for f in fk), key=lambda v: np.abs(v - s.values).max())
             num[:, k] = (vals[-2] - 8 * vals[-1] + 8 * vals[1] - vals[2]) / (12 * h)  # fourth-order central
         assert np.abs(num - jac).max() < 1e-6 * np.abs(jac).max()
+
+
+# ----- plot-task command ---------------------------------------------------------------------------------------
+def test_plot_task_writes_png_with_the_task_metrics(tmp_path):
+    from scalesynth.commands.fivebar import task_map
+
+    out = tmp_path / "plots" / "task.png"
+    res = CliRunner().invoke(
+        app, ["plot-task", str(ROOT / "configs" / "fivebar_packing.yaml"), "--out", str(out), "--resolution", "40",
+              "--json"]
+    )
+    assert res.exit_code == 0, res.output
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in out.parent.iterdir()] == ["task.png"]  # no temporary file left behind
+    shown = json.loads(res.stdout)
+    cfg = load_config(ROOT / "configs" / "fivebar_packing.yaml")
+    cfg.grid.resolution = 40
+    rep = evaluate_config(cfg)  # the same cell-centred nodes as the map
+    assert shown["task_coverage"] == rep.metrics["task_coverage"] == 1.0
+    assert shown["task_gci"] == pytest.approx(rep.metrics["task_gci"], rel=1e-12)
+    tm = task_map(cfg)
+    twin = fivebar_lci(DESIGN, cfg.resolved_options(), *np.meshgrid(tm.xs, tm.ys, indexing="ij"))
+    np.testing.assert_allclose(tm.lci, twin, rtol=1e-7)
+    assert tm.path.shape == (7, 2)
+
+
+def test_plot_task_needs_planar_mechanism_and_task(tmp_path):
+    runner = CliRunner()
+    res = runner.invoke(app, ["plot-task", str(ROOT / "configs" / "paper_2pauu_ppap.yaml")])
+    assert res.exit_code == 2 and "mechanism: plot-task needs a planar mechanism" in res.stderr
+    cfg = tmp_path / "no_task.yaml"
+    cfg.write_text("name: t\nmechanism: planar-fivebar\nunits: {length: mm}\n")
+    res = runner.invoke(app, ["plot-task", str(cfg), "--out", str(tmp_path / "x.png")])
+    assert res.exit_code == 2 and res.stderr.startswith("error: task: ")
+    assert not (tmp_path / "x.png").exists()

@@ -1,0 +1,152 @@
+"""`scalesynth plot-task CONFIG`: LCI map over the task box of a planar mechanism, with the task path.
+
+Written for the seed-004 packing robot (configs/fivebar_packing.yaml) but works for any planar mechanism
+whose config has a ``task`` section. The numbers come from the mechanism's point kernel on a cell-centred grid
+over the box (the nodes ``task_coverage`` / ``task_gci`` use); unreachable cells are left blank.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from scalesynth.cli import SetOpt, _print_json, app, handles_errors
+from scalesynth.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class TaskMap:
+    """LCI on the task box: ``lci[i, j]`` at (xs[i], ys[j]), -1 where unreachable within the limits."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    lci: np.ndarray
+    path: np.ndarray | None  # (n, 2) vertices of the task path, or None
+
+    @property
+    def coverage(self) -> float:
+        return float(np.mean(self.lci >= 0))
+
+    @property
+    def gci(self) -> float:
+        v = self.lci[self.lci >= 0]
+        return float(v.mean()) if v.size else 0.0
+
+    @property
+    def fci(self) -> float:
+        v = self.lci[self.lci >= 0]
+        return float(v.std()) if v.size else 0.0
+
+
+def task_map(cfg, resolution: int | None = None) -> TaskMap:
+    """Sample the config design's point kernel on the task box (``resolution`` cells per axis; default the
+    task's, else the grid's). Raises ConfigError for a non-planar mechanism or a config without a task."""
+    from scalesynth.kernels.grid import sample_grid
+
+    mech = cfg.mech
+    if not mech.planar:
+        raise ConfigError(f"mechanism: plot-task needs a planar mechanism, {mech.name} has {len(mech.task_axes)} axes")
+    if cfg.task is None:
+        raise ConfigError("task: plot-task needs a task section (task.box, optional task.path)")
+    res = resolution or cfg.task.resolution or cfg.grid.resolution
+    if res < 2:
+        raise ConfigError(f"--resolution: need at least 2 cells per axis, got {res}")
+    lo, step = np.zeros(3), np.ones(3)
+    for a, name in enumerate(mech.task_axes):  # config validation guarantees both axes are in the box
+        lo[a], hi = cfg.task.box[name]
+        step[a] = (hi - lo[a]) / res
+    shape = np.array([res, res, 1], dtype=np.int64)
+    packed = mech.pack(cfg.resolved_design(), cfg.resolved_options())
+    lci = sample_grid(mech.point_kernel, packed, lo, step, shape)[:, :, 0]
+    xs = lo[0] + (np.arange(res) + 0.5) * step[0]
+    ys = lo[1] + (np.arange(res) + 0.5) * step[1]
+    path = None if cfg.task.path is None else np.asarray(cfg.task.path, dtype=float)
+    return TaskMap(xs=xs, ys=ys, lci=lci, path=path)
+
+
+def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
+    """LCI map (viridis, colour bar, unreachable cells blank) and the task path with its vertices numbered."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    dx = tm.xs[1] - tm.xs[0]
+    dy = tm.ys[1] - tm.ys[0]
+    extent = (tm.xs[0] - dx / 2, tm.xs[-1] + dx / 2, tm.ys[0] - dy / 2, tm.ys[-1] + dy / 2)
+    width, height = extent[1] - extent[0], extent[3] - extent[2]
+    fig, ax = plt.subplots(figsize=(9.0, float(np.clip(7.0 * height / width + 2.0, 3.5, 9.0))))
+    masked = np.ma.masked_less(tm.lci.T, 0.0)
+    img = ax.imshow(masked, origin="lower", extent=extent, cmap="viridis", aspect="equal", interpolation="nearest")
+    # colour bar as tall as the (equal-aspect) map
+    fig.colorbar(img, ax=ax, label="LCI", fraction=0.046 * min(height / width, 1.0), pad=0.02)
+    if tm.path is not None:
+        ax.plot(tm.path[:, 0], tm.path[:, 1], "-", c="C3", lw=1.5, marker="o", ms=5, zorder=4, label="task path")
+        visits: dict[tuple[float, float], list[str]] = {}  # a pick-and-place path revisits its vertices
+        for k, (px, py) in enumerate(tm.path):
+            visits.setdefault((float(px), float(py)), []).append(str(k))
+        for (px, py), ks in visits.items():
+            ax.annotate(",".join(ks), (px, py), textcoords="offset points", xytext=(4, 4), fontsize=7, color="C3")
+        ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.18), fontsize=8, frameon=False)
+    # a margin so that a path along the edges of the box stays visible
+    ax.set_xlim(extent[0] - 0.04 * width, extent[1] + 0.04 * width)
+    ax.set_ylim(extent[2] - 0.04 * height, extent[3] + 0.04 * height)
+    ax.set_xlabel(f"{axes[0]} ({unit})")
+    ax.set_ylabel(f"{axes[1]} ({unit})")
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _save_atomic(fig, out: Path) -> None:
+    """Write the PNG to a temporary file next to ``out`` and rename it, so a reader never sees half a file."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".png", dir=out.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=130)
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+@app.command("plot-task")
+@handles_errors
+def plot_task_cmd(
+    config: Annotated[Path, typer.Argument(help="run config (YAML) of a planar mechanism with a task section")],
+    out: Annotated[Path | None, typer.Option("--out", help="PNG to write (default OUTDIR/plots/task_lci.png)")] = None,
+    sets: SetOpt = None,
+    resolution: Annotated[int | None, typer.Option(help="cells per axis (default task/grid resolution)")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
+) -> None:
+    """LCI over the task box (unreachable cells blank) with the task path, as a PNG."""
+    import matplotlib.pyplot as plt
+
+    from scalesynth.config import load_config
+
+    cfg = load_config(config, list(sets or []))
+    tm = task_map(cfg, resolution)
+    unit = cfg.units.length
+    design = ", ".join(f"{k}={v:g}" for k, v in cfg.resolved_design().items())
+    cells = f"{tm.lci.shape[0]}x{tm.lci.shape[1]} cells"
+    title = (
+        f"{cfg.mech.name} ({design} {unit}), mode {cfg.resolved_options().get('mode', '-')}\n"
+        f"task coverage {tm.coverage:.4f}, GCI {tm.gci:.4f}, FCI {tm.fci:.4f} ({cells})"
+    )
+    fig = task_figure(tm, cfg.mech.task_axes[:2], unit, title)
+    target = out or cfg.output_dir() / "plots" / "task_lci.png"
+    try:
+        _save_atomic(fig, target)
+    finally:
+        plt.close(fig)
+    if as_json:
+        _print_json({"out": str(target), "task_coverage": tm.coverage, "task_gci": tm.gci, "task_fci": tm.fci})
+    else:
+        typer.echo(f"wrote {target} (coverage {tm.coverage:.4f}, GCI {tm.gci:.4f}, FCI {tm.fci:.4f})")
