@@ -150,3 +150,121 @@ def fivebar_lci(design, options, x, y):
         lci[regular] = np.where(sv[:, 0] > 0, sv[:, -1] / sv[:, 0], 0.0)
     out[idx] = lci
     return out
+
+
+def pprs_lci(design, options, x, y, z):
+    """Seed 001, spec §1.3/§1.5/§1.8: LCI = sigma_min/sigma_max (NumPy SVD) of J_t with the beta row times
+    beta_length (default R) and the angular columns over angle_length (default r), at arrays of positions of
+    O1 with the options' orientation; -1 where the IK is not real or an actuator leaves its limits."""
+    x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
+    r, big_r = design["r"], design["R"]
+    links = [design["L1"], design["L2"], design["L3"]]
+    phi, theta, psi = options.get("orientation", (0.0, 0.0, 0.0))
+    sigma = [1.0 if ch == "+" else -1.0 for ch in options.get("sigma", "+++")]
+    conv_r = options.get("w_convention", "O") == "R"
+    beta_len = big_r if options.get("beta_length") is None else options["beta_length"]
+    ang_len = r if options.get("angle_length") is None else options["angle_length"]
+    rz = np.array([[np.cos(phi), -np.sin(phi), 0], [np.sin(phi), np.cos(phi), 0], [0, 0, 1]])
+    ry = np.array([[np.cos(theta), 0, np.sin(theta)], [0, 1, 0], [-np.sin(theta), 0, np.cos(theta)]])
+    rx = np.array([[1, 0, 0], [0, np.cos(psi), -np.sin(psi)], [0, np.sin(psi), np.cos(psi)]])
+    rot = rz @ ry @ rx
+    az = np.radians([0.0, 120.0, options.get("chain3_azimuth_deg", 210.0)])
+    u = np.stack([np.cos(az), np.sin(az), np.zeros(3)], axis=1)
+    e = np.cross([0.0, 0.0, 1.0], u)
+    body = np.array([[r, 0, 0], [-r / 2, np.sqrt(3) * r / 2, 0], [-r / 2, -np.sqrt(3) * r / 2, 0]])
+    rk = body @ rot.T  # r_k = R c_k'
+    pts = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    out = np.full(pts.shape[0], -1.0)
+    zhat = np.array([0.0, 0.0, 1.0])
+    for n, p in enumerate(pts):
+        c = p + rk
+        lam = np.array([e[k] @ c[k] for k in range(3)])
+        if np.any(np.abs(lam) > links):
+            continue
+        kap = np.sqrt(np.array(links) ** 2 - lam**2)
+        w = [big_r - u[k] @ c[k] if conv_r else u[k] @ c[k] for k in range(2)]
+        rho3 = big_r - u[2] @ c[2]
+        h3 = c[2, 2]
+        mu3 = np.hypot(rho3, h3)
+        beta = np.arctan2(h3, rho3)
+        s = [c[0, 2] - sigma[0] * kap[0], c[1, 2] - sigma[1] * kap[1], mu3 - sigma[2] * kap[2]]
+        ok = all(options["w_limits"][0] <= v <= options["w_limits"][1] for v in w)
+        ok &= all(options["s_limits"][0] <= v <= options["s_limits"][1] for v in s)
+        ok &= options["beta_limits"][0] <= beta <= options["beta_limits"][1]
+        if not ok:
+            continue
+        if np.any(kap == 0):
+            out[n] = 0.0
+            continue
+        d3 = -np.cos(beta) * u[2] + np.sin(beta) * zhat
+        g = [
+            -u[0] if conv_r else u[0],
+            -u[1] if conv_r else u[1],
+            (rho3 * zhat + h3 * u[2]) / mu3**2,
+            zhat + sigma[0] * lam[0] / kap[0] * e[0],
+            zhat + sigma[1] * lam[1] / kap[1] * e[1],
+            d3 + sigma[2] * lam[2] / kap[2] * e[2],
+        ]
+        chain = [0, 1, 2, 0, 1, 2]
+        jt = np.array([np.concatenate([g[j], np.cross(rk[chain[j]], g[j])]) for j in range(6)])
+        js = np.diag([1, 1, beta_len, 1, 1, 1]) @ jt @ np.diag([1, 1, 1, 1 / ang_len, 1 / ang_len, 1 / ang_len])
+        sv = np.linalg.svd(js, compute_uv=False)
+        out[n] = sv[-1] / sv[0]
+    return out.reshape(x.shape)
+
+
+def ups_sspr_lci(design, options, alpha, beta, y):
+    """Seed 003, spec §3.1/§3.3/§3.5: LCI = 1/cond_2(J diag(1/L, 1/L, 1)), J = dl/d(alpha, beta, Y), at arrays of
+    task points; -1 outside the workspace box, outside |Y| < c or outside an actuator's limits.
+
+    Built from explicit rotation matrices R = Ry(beta) Rx(alpha), their derivative matrices and l1 = |(2/3)P - M|.
+    """
+    alpha, beta, y = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (alpha, beta, y)))
+    a, b, c = design["a"], design["b"], design["c"]
+    big_l = c if options.get("characteristic_length") is None else options["characteristic_length"]
+    base = {2: np.array([-np.sqrt(3) * a / 2, -a / 2, 0.0]), 3: np.array([np.sqrt(3) * a / 2, -a / 2, 0.0])}
+    plat = {2: np.array([-b / np.sqrt(2), b / np.sqrt(2), 0.0]), 3: np.array([b / np.sqrt(2), b / np.sqrt(2), 0.0])}
+    m_point = np.array([0.0, -a / 2, 0.0])
+    y_range = options.get("Y_range") or (-0.999 * c, 0.999 * c)
+    ok = (alpha >= options["alpha_range"][0]) & (alpha <= options["alpha_range"][1])
+    ok &= (beta >= options["beta_range"][0]) & (beta <= options["beta_range"][1])
+    ok &= (y >= y_range[0]) & (y <= y_range[1]) & (np.abs(y) < c)
+    out = np.full(alpha.shape, -1.0)
+    idx = np.nonzero(ok)
+    al, be, yy = alpha[idx], beta[idx], y[idx]
+    n = al.size
+    if n == 0:
+        return out
+    zero, one = np.zeros(n), np.ones(n)
+    sa, ca, sb, cb = np.sin(al), np.cos(al), np.sin(be), np.cos(be)
+
+    def mat(*rows):  # (n, 3, 3) stack of matrices from 3 rows of 3 arrays each
+        return np.stack([np.stack(r, -1) for r in rows], -2)
+
+    rx = mat((one, zero, zero), (zero, ca, -sa), (zero, sa, ca))
+    drx = mat((zero, zero, zero), (zero, -sa, -ca), (zero, ca, -sa))  # d Rx / d alpha
+    ry = mat((cb, zero, sb), (zero, one, zero), (-sb, zero, cb))
+    dry = mat((-sb, zero, cb), (zero, zero, zero), (-cb, zero, -sb))  # d Ry / d beta
+    rho = np.sqrt(c * c - yy * yy)
+    p = np.stack([sb * rho, yy, cb * rho], -1)
+    dp_db = np.stack([cb * rho, zero, -sb * rho], -1)
+    dp_dy = np.stack([-sb * yy / rho, one, -cb * yy / rho], -1)
+    lengths = {1: np.linalg.norm(2.0 / 3.0 * p - m_point, axis=-1)}
+    jac = np.zeros((n, 3, 3))
+    jac[:, 0, 2] = (2.0 / 3.0) * (a / 2) / lengths[1]
+    for i in (2, 3):
+        leg = p + (ry @ rx @ plat[i]) - base[i]
+        lengths[i] = np.linalg.norm(leg, axis=-1)
+        cols = (ry @ drx @ plat[i], dp_db + dry @ rx @ plat[i], dp_dy)
+        for k, col in enumerate(cols):
+            jac[:, i - 1, k] = np.einsum("nj,nj->n", leg, col) / lengths[i]
+    keep = np.ones(n, dtype=bool)
+    for i in (1, 2, 3):
+        lim = options.get(f"l{i}_limits")
+        if lim is not None:
+            keep &= (lengths[i] >= lim[0]) & (lengths[i] <= lim[1])
+    jac[:, :, :2] /= big_l
+    sv = np.linalg.svd(jac, compute_uv=False)
+    lci = np.where(keep, sv[:, -1] / sv[:, 0], -1.0)
+    out[idx] = lci
+    return out

@@ -1,0 +1,751 @@
+"""6-DOF 2PPRS-RPRS parallel mechanism (seed 001), primary model of spec mechanisms_001_003.md §1.
+
+Three chains carry a moving triangle C1C2C3 (circumradius r). Chains 1 and 2 (P-P-R-S): a carriage slides
+along the horizontal rail u_i (input w_i, measured from O: "conv O", erratum E5), a vertical slider on it
+(input s_i) carries D_i, and a link |D_iC_i| = L_i turns about u_i. Chain 3 (R-P-R-S): an actuated revolute
+at the fixed point B3 = R u3 (input beta) tilts a prismatic (input s3) in the vertical plane of u3; the link
+|D3C3| = L3 turns about the normal of that plane. Pose X = (x, y, z, phi, theta, psi), R = Rz(phi) Ry(theta)
+Rx(psi); lengths in mm, angles in rad. The six joints are (w1, w2, beta, s1, s2, s3).
+
+Task space: the constant-orientation position workspace of O1 (spec §1.8). The orientation is an option;
+task axes are (x, y, z), so the point kernel and the CLI's ``ik --pose x,y,z`` use that orientation, while the
+NumPy kinematics also accept full 6-vector poses. FK solutions are full 6-vector poses.
+
+Dexterity: LCI = 1/kappa_2 of the twist Jacobian J_t (q_dot = J_t [v; omega], spec §1.5), homogenised with
+two characteristic lengths because its columns mix translations and rotations and its beta row is an angle
+rate: the beta row is multiplied by ``beta_length`` (default R) and the three angular-velocity columns are
+divided by ``angle_length`` (default r), which makes every entry dimensionless (spec §1.5: cond = 6.68 at
+home). The twist Jacobian is used rather than the Euler-rate Jacobian J = J_t T because it is independent of
+the Euler parametrisation (no artificial singularity at theta = +-90 deg); at the default zero orientation
+T's angular block is a permutation, so both give the same LCI.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+
+SQRT3_2 = math.sqrt(3.0) / 2.0
+# spec §1.8 search box (mm); bounding_box never extends beyond it
+SPEC_BOX = (np.array([-300.0, -300.0, 0.0]), np.array([300.0, 300.0, 500.0]))
+BRANCHES = tuple(a + b + c for a in "+-" for b in "+-" for c in "+-")
+CONVENTIONS = ("O", "R")
+JOINTS = ("w1", "w2", "beta", "s1", "s2", "s3")
+CHAIN_OF_JOINT = (0, 1, 2, 0, 1, 2)
+
+# packed-parameter layout (see PprsRprs.pack)
+_R1, _R2, _R3 = 0, 3, 6  # rotated sphere-centre offsets r_k = R c_k' (3 each)
+_U3X, _U3Y, _RAIL, _L1, _L2, _L3 = 9, 10, 11, 12, 13, 14
+_SG1, _SG2, _SG3, _CONV = 15, 16, 17, 18
+_WLO, _WHI, _SLO, _SHI, _BLO, _BHI = 19, 20, 21, 22, 23, 24
+_BLEN, _ALEN = 25, 26
+N_PACKED = 27
+
+
+# ----- Numba kernels -----------------------------------------------------------------------------------------
+@njit(cache=True, fastmath=FASTMATH)
+def _lci_6x6(a):
+    """sigma_min / sigma_max of the 6x6 matrix ``a`` (overwritten), by one-sided (Hestenes) Jacobi.
+
+    Plane rotations orthogonalise the columns; the singular values are then the column norms. Working on A
+    itself, not on A^T A, keeps small singular values accurate relative to the large ones.
+    """
+    n = 6
+    for _sweep in range(40):
+        rotated = False
+        for i in range(n - 1):
+            for j in range(i + 1, n):
+                alpha = 0.0
+                beta = 0.0
+                gamma = 0.0
+                for k in range(n):
+                    alpha += a[k, i] * a[k, i]
+                    beta += a[k, j] * a[k, j]
+                    gamma += a[k, i] * a[k, j]
+                if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = 1.0 / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                if zeta < 0.0:
+                    t = -t
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = c * t
+                for k in range(n):
+                    ai = a[k, i]
+                    aj = a[k, j]
+                    a[k, i] = c * ai - s * aj
+                    a[k, j] = s * ai + c * aj
+        if not rotated:
+            break
+    smax = 0.0
+    smin = math.inf
+    for j in range(n):
+        norm = 0.0
+        for k in range(n):
+            norm += a[k, j] * a[k, j]
+        norm = math.sqrt(norm)
+        smax = max(smax, norm)
+        smin = min(smin, norm)
+    if not smax > 0.0:
+        return 0.0
+    return min(smin / smax, 1.0)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_row(a, row, scale, gx, gy, gz, rx, ry, rz, inv_alen):
+    """Row ``row`` of the scaled Jacobian: scale * [g, (r x g) / angle_length]."""
+    a[row, 0] = scale * gx
+    a[row, 1] = scale * gy
+    a[row, 2] = scale * gz
+    k = scale * inv_alen
+    a[row, 3] = k * (ry * gz - rz * gy)
+    a[row, 4] = k * (rz * gx - rx * gz)
+    a[row, 5] = k * (rx * gy - ry * gx)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z):
+    """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
+    IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity."""
+    c1x = x + p[_R1]
+    c1y = y + p[_R1 + 1]
+    c1z = z + p[_R1 + 2]
+    c2x = x + p[_R2]
+    c2y = y + p[_R2 + 1]
+    c2z = z + p[_R2 + 2]
+    c3x = x + p[_R3]
+    c3y = y + p[_R3 + 1]
+    c3z = z + p[_R3 + 2]
+    rail = p[_RAIL]
+    conv_r = p[_CONV] > 0.0
+    wlo = p[_WLO]
+    whi = p[_WHI]
+    slo = p[_SLO]
+    shi = p[_SHI]
+    # rails: u1 = (1, 0, 0), u2 = (-1/2, sqrt3/2, 0)
+    w1 = rail - c1x if conv_r else c1x
+    if w1 < wlo or w1 > whi:
+        return -1.0
+    p2 = -0.5 * c2x + SQRT3_2 * c2y
+    w2 = rail - p2 if conv_r else p2
+    if w2 < wlo or w2 > whi:
+        return -1.0
+    # chains 1, 2: lambda_i = e_i . C_i with e1 = (0, 1, 0), e2 = (-sqrt3/2, -1/2, 0)
+    l1 = p[_L1]
+    lam1 = c1y
+    k1sq = l1 * l1 - lam1 * lam1
+    if k1sq < 0.0:
+        return -1.0
+    k1 = math.sqrt(k1sq)
+    s1 = c1z - p[_SG1] * k1
+    if s1 < slo or s1 > shi:
+        return -1.0
+    l2 = p[_L2]
+    lam2 = -SQRT3_2 * c2x - 0.5 * c2y
+    k2sq = l2 * l2 - lam2 * lam2
+    if k2sq < 0.0:
+        return -1.0
+    k2 = math.sqrt(k2sq)
+    s2 = c2z - p[_SG2] * k2
+    if s2 < slo or s2 > shi:
+        return -1.0
+    # chain 3 in its plane: rho3 = R - u3.C3, h3 = z_C3, beta = atan2(h3, rho3), s3 = mu3 - sigma3 kappa3
+    u3x = p[_U3X]
+    u3y = p[_U3Y]
+    e3x = -u3y
+    e3y = u3x
+    rho3 = rail - (u3x * c3x + u3y * c3y)
+    h3 = c3z
+    mu3sq = rho3 * rho3 + h3 * h3
+    if not mu3sq > 0.0:
+        return -1.0  # C3 on the revolute axis at B3: beta undefined, cannot be checked against its limits
+    beta = math.atan2(h3, rho3)
+    if beta < p[_BLO] or beta > p[_BHI]:
+        return -1.0
+    mu3 = math.sqrt(mu3sq)
+    l3 = p[_L3]
+    lam3 = e3x * c3x + e3y * c3y
+    k3sq = l3 * l3 - lam3 * lam3
+    if k3sq < 0.0:
+        return -1.0
+    k3 = math.sqrt(k3sq)
+    s3 = mu3 - p[_SG3] * k3
+    if s3 < slo or s3 > shi:
+        return -1.0
+    if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
+        return 0.0  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
+    # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
+    inv_alen = 1.0 / p[_ALEN]
+    a = np.empty((6, 6))
+    wsign = -1.0 if conv_r else 1.0
+    r1x, r1y, r1z = p[_R1], p[_R1 + 1], p[_R1 + 2]
+    r2x, r2y, r2z = p[_R2], p[_R2 + 1], p[_R2 + 2]
+    r3x, r3y, r3z = p[_R3], p[_R3 + 1], p[_R3 + 2]
+    _put_row(a, 0, wsign, 1.0, 0.0, 0.0, r1x, r1y, r1z, inv_alen)
+    _put_row(a, 1, wsign, -0.5, SQRT3_2, 0.0, r2x, r2y, r2z, inv_alen)
+    inv_mu2 = 1.0 / mu3sq
+    _put_row(a, 2, p[_BLEN], h3 * u3x * inv_mu2, h3 * u3y * inv_mu2, rho3 * inv_mu2, r3x, r3y, r3z, inv_alen)
+    t1 = p[_SG1] * lam1 / k1
+    _put_row(a, 3, 1.0, 0.0, t1, 1.0, r1x, r1y, r1z, inv_alen)
+    t2 = p[_SG2] * lam2 / k2
+    _put_row(a, 4, 1.0, -SQRT3_2 * t2, -0.5 * t2, 1.0, r2x, r2y, r2z, inv_alen)
+    t3 = p[_SG3] * lam3 / k3
+    inv_mu = 1.0 / mu3
+    # g = d3 + t3 e3 with d3 = (-rho3 u3 + h3 z) / mu3
+    gx = -rho3 * u3x * inv_mu + t3 * e3x
+    gy = -rho3 * u3y * inv_mu + t3 * e3y
+    _put_row(a, 5, 1.0, gx, gy, h3 * inv_mu, r3x, r3y, r3z, inv_alen)
+    return _lci_6x6(a)
+
+
+# ----- NumPy kinematics ----------------------------------------------------------------------------------
+def rotation(phi, theta, psi) -> np.ndarray:
+    """R = Rz(phi) Ry(theta) Rx(psi) for scalars or arrays of angles (rad); shape (..., 3, 3)."""
+    cf, sf = np.cos(phi), np.sin(phi)
+    ct, st = np.cos(theta), np.sin(theta)
+    cp, sp = np.cos(psi), np.sin(psi)
+    return np.stack(
+        [
+            np.stack([cf * ct, cf * st * sp - sf * cp, cf * st * cp + sf * sp], axis=-1),
+            np.stack([sf * ct, sf * st * sp + cf * cp, sf * st * cp - cf * sp], axis=-1),
+            np.stack([-st, ct * sp, ct * cp], axis=-1),
+        ],
+        axis=-2,
+    )
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Resolved geometry (mm, rad): rails u_i and normals e_i = z x u_i (rows), body vectors c_i' (rows)."""
+
+    r: float
+    rail: float
+    links: np.ndarray
+    u: np.ndarray
+    e: np.ndarray
+    body: np.ndarray
+    conv_r: bool
+    beta_length: float
+    angle_length: float
+
+    @classmethod
+    def of(cls, design: Mapping[str, float], options: Mapping[str, Any]) -> Geometry:
+        r = float(design["r"])
+        az = math.radians(options["chain3_azimuth_deg"])
+        u = np.array([[1.0, 0.0, 0.0], [-0.5, SQRT3_2, 0.0], [math.cos(az), math.sin(az), 0.0]])
+        e = np.stack([-u[:, 1], u[:, 0], np.zeros(3)], axis=1)
+        body = np.array([[r, 0.0, 0.0], [-0.5 * r, SQRT3_2 * r, 0.0], [-0.5 * r, -SQRT3_2 * r, 0.0]])
+        bl = options.get("beta_length")
+        al = options.get("angle_length")
+        return cls(
+            r=r,
+            rail=float(design["R"]),
+            links=np.array([design["L1"], design["L2"], design["L3"]], dtype=float),
+            u=u,
+            e=e,
+            body=body,
+            conv_r=options["w_convention"] == "R",
+            beta_length=float(design["R"] if bl is None else bl),
+            angle_length=float(r if al is None else al),
+        )
+
+
+def sigma_vector(label: str) -> np.ndarray:
+    """Branch label such as '+-+' as a vector of +-1."""
+    return np.array([1.0 if ch == "+" else -1.0 for ch in label])
+
+
+@dataclass(frozen=True)
+class ChainState:
+    """IK of one or many poses for one branch: q (..., 6) and the intermediates of spec §1.3.
+
+    ``ok`` is False where a link cannot reach (|lambda_i| > L_i) or beta is undefined (mu3 = 0); q is NaN there.
+    """
+
+    q: np.ndarray
+    ok: np.ndarray
+    rk: np.ndarray  # (..., 3, 3): r_k = R c_k'
+    centres: np.ndarray  # (..., 3, 3): C_k
+    lam: np.ndarray  # (..., 3)
+    kappa: np.ndarray  # (..., 3)
+    rho3: np.ndarray
+    h3: np.ndarray
+    mu3: np.ndarray
+    sigma: np.ndarray
+
+
+def chain_state(geo: Geometry, X: np.ndarray, sigma: np.ndarray, reach_tol: float = 1e-12) -> ChainState:
+    """Closed-form IK (spec §1.3) of poses X (..., 6) for branch signs sigma (3,). A pose within
+    ``reach_tol * L_i`` of a reach boundary is accepted with kappa_i = 0 (double root)."""
+    X = np.asarray(X, dtype=float)
+    rot = rotation(X[..., 3], X[..., 4], X[..., 5])
+    rk = np.einsum("...ij,kj->...ki", rot, geo.body)
+    centres = X[..., None, :3] + rk
+    proj = np.einsum("...kj,kj->...k", centres, geo.u)
+    lam = np.einsum("...kj,kj->...k", centres, geo.e)
+    k2 = geo.links**2 - lam**2
+    rho3 = geo.rail - proj[..., 2]
+    h3 = centres[..., 2, 2]
+    mu3 = np.hypot(rho3, h3)
+    ok = np.all(k2 >= -2.0 * reach_tol * geo.links**2, axis=-1) & (mu3 > 0.0)
+    kappa = np.sqrt(np.maximum(k2, 0.0))
+    w = geo.rail - proj[..., :2] if geo.conv_r else proj[..., :2]
+    s12 = centres[..., :2, 2] - sigma[:2] * kappa[..., :2]
+    s3 = mu3 - sigma[2] * kappa[..., 2]
+    q = np.stack([w[..., 0], w[..., 1], np.arctan2(h3, rho3), s12[..., 0], s12[..., 1], s3], axis=-1)
+    q = np.where(ok[..., None], q, np.nan)
+    return ChainState(q, ok, rk, centres, lam, kappa, rho3, h3, mu3, np.asarray(sigma, dtype=float))
+
+
+def actuator_directions(geo: Geometry, st: ChainState) -> np.ndarray:
+    """g_j of spec §1.5 (q_dot_j = g_j . C_dot_k), shape (..., 6, 3); inf/NaN at a serial singularity."""
+    shape = st.lam.shape[:-1]
+    z = np.zeros(shape + (3,))
+    z[..., 2] = 1.0
+    g = np.empty(shape + (6, 3))
+    wsign = -1.0 if geo.conv_r else 1.0
+    g[..., 0, :] = wsign * geo.u[0]
+    g[..., 1, :] = wsign * geo.u[1]
+    mu2 = st.mu3**2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g[..., 2, :] = (st.rho3[..., None] * z + st.h3[..., None] * geo.u[2]) / mu2[..., None]
+        ratio = st.sigma * st.lam / st.kappa
+        g[..., 3, :] = z + ratio[..., 0, None] * geo.e[0]
+        g[..., 4, :] = z + ratio[..., 1, None] * geo.e[1]
+        d3 = (-st.rho3[..., None] * geo.u[2] + st.h3[..., None] * z) / st.mu3[..., None]
+        g[..., 5, :] = d3 + ratio[..., 2, None] * geo.e[2]
+    return g
+
+
+def twist_jacobian(geo: Geometry, st: ChainState) -> np.ndarray:
+    """J_t (..., 6, 6): q_dot = J_t [v; omega], row j = [g_j, r_k x g_j] (spec §1.5)."""
+    g = actuator_directions(geo, st)
+    r = st.rk[..., CHAIN_OF_JOINT, :]
+    return np.concatenate([g, np.cross(r, g)], axis=-1)
+
+
+def euler_rate_map(X: np.ndarray) -> np.ndarray:
+    """T (..., 6, 6) with [v; omega] = T X_dot: omega = phi' z + theta' Rz(phi) y + psi' Rz(phi) Ry(theta) x."""
+    X = np.asarray(X, dtype=float)
+    phi, theta = X[..., 3], X[..., 4]
+    t = np.zeros(X.shape[:-1] + (6, 6))
+    t[..., 0, 0] = t[..., 1, 1] = t[..., 2, 2] = 1.0
+    t[..., 5, 3] = 1.0
+    t[..., 3, 4] = -np.sin(phi)
+    t[..., 4, 4] = np.cos(phi)
+    t[..., 3, 5] = np.cos(phi) * np.cos(theta)
+    t[..., 4, 5] = np.sin(phi) * np.cos(theta)
+    t[..., 5, 5] = -np.sin(theta)
+    return t
+
+
+def scaled(geo: Geometry, jt: np.ndarray) -> np.ndarray:
+    """The homogenised Jacobian whose LCI is reported: beta row * beta_length, angular columns / angle_length."""
+    row = np.array([1.0, 1.0, geo.beta_length, 1.0, 1.0, 1.0])
+    col = np.array([1.0, 1.0, 1.0, 1.0 / geo.angle_length, 1.0 / geo.angle_length, 1.0 / geo.angle_length])
+    return jt * row[:, None] * col[None, :]
+
+
+def _wrap(a):
+    """Angles into (-pi, pi]."""
+    w = np.mod(np.asarray(a, dtype=float) + np.pi, 2.0 * np.pi) - np.pi
+    return np.where(w == -np.pi, np.pi, w)
+
+
+def normalise_euler(X: np.ndarray) -> np.ndarray:
+    """Pick the representative of the Euler duplicate pair (phi+pi, pi-theta, psi+pi) with theta in
+    [-pi/2, pi/2], all angles in (-pi, pi] (spec §1.4 item 3)."""
+    X = np.array(X, dtype=float)
+    theta = _wrap(X[..., 4])
+    flip = np.abs(theta) > np.pi / 2
+    X[..., 3] = _wrap(np.where(flip, X[..., 3] + np.pi, X[..., 3]))
+    X[..., 4] = np.where(flip, _wrap(np.pi - theta), theta)
+    X[..., 5] = _wrap(np.where(flip, X[..., 5] + np.pi, X[..., 5]))
+    return X
+
+
+def newton_fk(
+    geo: Geometry, sigma: np.ndarray, q: np.ndarray, starts: np.ndarray, max_iter: int = 60
+) -> tuple[np.ndarray, np.ndarray]:
+    """Newton-Raphson on IK(X) - q = 0 from every start (n, 6) at once, with the analytic pose Jacobian
+    J = J_t T, pseudo-inverse steps and step halving (spec §1.4). ``q`` is one input vector (6,) or one per
+    start (n, 6). Returns (X (n, 6), converged (n,)).
+
+    Residuals are compared in mm, the beta residual multiplied by R. Converged means the residual reached
+    1e-12 of max(1, |q|) (round-off level) within ``max_iter`` iterations.
+    """
+    X = np.array(starts, dtype=float, copy=True)
+    q = np.broadcast_to(np.asarray(q, dtype=float), X.shape)
+    weight = np.array([1.0, 1.0, geo.rail, 1.0, 1.0, 1.0])
+    tol = 1e-12 * np.maximum(1.0, np.max(np.abs(q * weight), axis=-1))
+
+    def residual(Xs, rows):
+        st = chain_state(geo, Xs, sigma)
+        res = st.q - q[rows]
+        res[..., 2] = _wrap(res[..., 2])
+        err = np.max(np.abs(res * weight), axis=-1)
+        return res, np.where(st.ok, err, np.inf)
+
+    res, err = residual(X, np.arange(X.shape[0]))
+    alive = np.isfinite(err)
+    done = alive & (err <= tol)
+    for _ in range(max_iter):
+        act = np.nonzero(alive & ~done)[0]
+        if act.size == 0:
+            break
+        sub = chain_state(geo, X[act], sigma)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            jac = twist_jacobian(geo, sub) @ euler_rate_map(X[act])
+        bad = ~np.all(np.isfinite(jac), axis=(-2, -1))  # a serial singularity: no Newton step from there
+        jac[bad] = 0.0
+        step = -np.einsum("nij,nj->ni", np.linalg.pinv(jac), res[act])
+        alpha = np.ones(act.size)
+        pending = ~bad
+        for _half in range(40):
+            idx = np.nonzero(pending)[0]
+            if idx.size == 0:
+                break
+            rows = act[idx]
+            trial = X[rows] + alpha[idx, None] * step[idx]
+            tres, terr = residual(trial, rows)
+            better = terr < err[rows]
+            acc = rows[better]
+            X[acc] = trial[better]
+            res[acc] = tres[better]
+            err[acc] = terr[better]
+            pending[idx[better]] = False
+            alpha[idx[~better]] *= 0.5
+        # no decrease along the Newton direction: a local minimum of |G| (no assembly) or the round-off floor
+        alive[act[pending | bad]] = False
+        done |= alive & (err <= tol)
+    return X, done
+
+
+def dedupe(X: np.ndarray, length: float, tol: float = 1e-6) -> np.ndarray:
+    """Distinct rows of X (first occurrence kept), comparing positions in mm and angles times ``length``."""
+    out: list[np.ndarray] = []
+    for x in X:
+        if all(_pose_distance(x, y, length) > tol for y in out):
+            out.append(x)
+    return np.array(out).reshape(-1, 6)
+
+
+def _pose_distance(a: np.ndarray, b: np.ndarray, length: float) -> float:
+    return max(float(np.max(np.abs(a[:3] - b[:3]))), length * float(np.max(np.abs(_wrap(a[3:] - b[3:])))))
+
+
+# ----- the mechanism ---------------------------------------------------------------------------------------
+class PprsRprs(Mechanism):
+    """Seed-001 mechanism; see module docstring."""
+
+    pose_axes = ("x", "y", "z", "phi", "theta", "psi")
+
+    def check_options(self, options: dict[str, Any]) -> None:
+        orient = options["orientation"]
+        if not isinstance(orient, (list, tuple)) or len(orient) != 3:
+            raise InvalidParameter(f"options.orientation: expected [phi, theta, psi] in rad, got {orient!r}")
+        options["orientation"] = tuple(_finite(f"options.orientation[{i}]", v) for i, v in enumerate(orient))
+        if not isinstance(options["sigma"], str) or options["sigma"] not in BRANCHES:
+            raise InvalidParameter(
+                f"options.sigma: expected three signs from '+-' such as '+++', got {options['sigma']!r}"
+            )
+        for name in ("w_limits", "s_limits", "beta_limits"):
+            value = parse_range(name, options[name])
+            if value is None:
+                raise InvalidParameter(f"options.{name}: actuator limits are required, got null")
+            options[name] = value
+        lo, hi = options["beta_limits"]
+        if lo < -math.pi or hi > math.pi:
+            raise InvalidParameter(f"options.beta_limits: expected radians within [-pi, pi], got [{lo:g}, {hi:g}]")
+        options["chain3_azimuth_deg"] = _finite("options.chain3_azimuth_deg", options["chain3_azimuth_deg"])
+        if options["w_convention"] not in CONVENTIONS:
+            raise InvalidParameter(f"options.w_convention: must be 'O' or 'R', got {options['w_convention']!r}")
+        for name in ("beta_length", "angle_length"):
+            value = options[name]
+            if value is not None:
+                value = _finite(f"options.{name}", value)
+                if value <= 0.0:
+                    raise InvalidParameter(f"options.{name}: must be > 0 (a length in mm) or null, got {value:g}")
+                options[name] = value
+
+    # ----- kernel side -------------------------------------------------------------------------------
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        geo = Geometry.of(design, options)
+        rot = rotation(*options["orientation"])
+        p = np.empty(N_PACKED)
+        p[_R1 : _R3 + 3] = (geo.body @ rot.T).ravel()
+        p[_U3X], p[_U3Y] = geo.u[2, 0], geo.u[2, 1]
+        p[_RAIL] = geo.rail
+        p[_L1], p[_L2], p[_L3] = geo.links
+        p[_SG1:_SG3 + 1] = sigma_vector(options["sigma"])
+        p[_CONV] = 1.0 if geo.conv_r else 0.0
+        p[_WLO], p[_WHI] = options["w_limits"]
+        p[_SLO], p[_SHI] = options["s_limits"]
+        p[_BLO], p[_BHI] = options["beta_limits"]
+        p[_BLEN] = geo.beta_length
+        p[_ALEN] = geo.angle_length
+        return p
+
+    @property
+    def point_kernel(self):
+        return point_lci
+
+    def kernel_branch(self, options) -> str:
+        return options["sigma"]
+
+    def bounding_box(self, design, options):
+        """Box of O1 implied by the actuator limits at the fixed orientation, intersected with the spec §1.8
+        box. x: u1.C1 = x + r1x is w1 (or R - w1); y: from u2.C2 (w2) given x, and |lambda1| = |y + r1y| <= L1;
+        z: z_Ci = s_i + sigma_i kappa_i with 0 <= kappa_i <= L_i, for chains 1 and 2."""
+        geo = Geometry.of(design, options)
+        rk = geo.body @ rotation(*options["orientation"]).T
+        wlo, whi = options["w_limits"]
+        plo, phi_ = (geo.rail - whi, geo.rail - wlo) if geo.conv_r else (wlo, whi)
+        xlo, xhi = plo - rk[0, 0], phi_ - rk[0, 0]
+        u2 = geo.u[1]
+        a_lo, a_hi = plo - u2 @ rk[1], phi_ - u2 @ rk[1]  # u2 . p
+        # y = (u2.p - u2x x) / u2y with u2x < 0 < u2y
+        ylo = max((a_lo - u2[0] * xlo) / u2[1], -geo.links[0] - rk[0, 1])
+        yhi = min((a_hi - u2[0] * xhi) / u2[1], geo.links[0] - rk[0, 1])
+        slo, shi = options["s_limits"]
+        sig = sigma_vector(options["sigma"])
+        zlo, zhi = -math.inf, math.inf
+        for k in (0, 1):
+            lo_k = slo - (geo.links[k] if sig[k] < 0 else 0.0)
+            hi_k = shi + (geo.links[k] if sig[k] > 0 else 0.0)
+            zlo, zhi = max(zlo, lo_k - rk[k, 2]), min(zhi, hi_k - rk[k, 2])
+        lo = np.maximum(np.array([xlo, ylo, zlo]), SPEC_BOX[0])
+        hi = np.minimum(np.array([xhi, yhi, zhi]), SPEC_BOX[1])
+        return lo, np.maximum(hi, lo)
+
+    # ----- NumPy kinematics ----------------------------------------------------------------------------
+    def full_pose(self, options: Mapping[str, Any], pose) -> np.ndarray:
+        """(x, y, z) with the options' orientation, or a full (x, y, z, phi, theta, psi) pose (mm, rad)."""
+        arr = np.asarray(pose, dtype=float) if _is_vector(pose) else None
+        if arr is not None and arr.shape == (3,) and np.all(np.isfinite(arr)):
+            return np.concatenate([arr, options["orientation"]])
+        return self.check_vector("pose", pose, 6)
+
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """All eight sign branches (sigma1 sigma2 sigma3, '+' = D_i below C_i) as (w1, w2, beta, s1, s2, s3) in
+        mm and rad, limits not applied; [] if a link cannot reach its sphere centre."""
+        X = self.full_pose(options, pose)
+        geo = Geometry.of(design, options)
+        out = []
+        for label in BRANCHES:
+            st = chain_state(geo, X, sigma_vector(label))
+            if not st.ok:
+                return []
+            out.append(Solution(label, st.q))
+        return out
+
+    def forward_kinematics(
+        self, design, options, inputs, *, guess=None, starts: int = 400, seed: int = 0
+    ) -> list[Solution]:
+        """Assembly modes of inputs (w1, w2, beta, s1, s2, s3) in the working mode ``options.sigma``, as poses
+        (x, y, z, phi, theta, psi), Euler duplicates normalised to theta in [-pi/2, pi/2].
+
+        Newton (spec §1.4) from X0 = (0, 0, s1 + L1, 0, 0, 0), from ``guess`` if given (continuation), and from
+        ``starts`` seeded pseudo-random poses (|x|, |y| <= R, z in [0, s_max + L], angles within +-60 deg);
+        deterministic for a given ``seed``. Labels: '<sigma>#k'; #1 is the mode reached from ``guess`` (or X0)
+        when that start converges; the others follow in order of distance from it. A multi-start search
+        cannot prove that no other mode exists.
+        """
+        q = self.check_vector("inputs", inputs, 6)
+        geo = Geometry.of(design, options)
+        sigma = sigma_vector(options["sigma"])
+        first = [np.array([0.0, 0.0, q[3] + geo.links[0], 0.0, 0.0, 0.0])]
+        if guess is not None:
+            first.insert(0, self.full_pose(options, guess))
+        rng = np.random.default_rng(seed)
+        zmax = max(float(np.max(q[3:])), 0.0) + float(np.max(geo.links))
+        lo = np.array([-geo.rail, -geo.rail, 0.0, -math.pi / 3, -math.pi / 3, -math.pi / 3])
+        hi = np.array([geo.rail, geo.rail, zmax, math.pi / 3, math.pi / 3, math.pi / 3])
+        rand = lo + (hi - lo) * rng.random((starts, 6))
+        X, ok = newton_fk(geo, sigma, q, np.vstack([np.array(first), rand]))
+        found = dedupe(normalise_euler(X[ok]), geo.r)
+        if found.shape[0] > 1:
+            dist = [_pose_distance(found[0], f, geo.r) for f in found[1:]]
+            found = np.vstack([found[:1], found[1:][np.argsort(dist, kind="stable")]])
+        return [Solution(f"{options['sigma']}#{k + 1}", f) for k, f in enumerate(found)]
+
+    def branch_of(self, design, options, pose, q) -> str:
+        """Sign branch of joint values q at a pose: sigma_i = '+' when D_i is not above C_i."""
+        X = self.full_pose(options, pose)
+        q = self.check_vector("inputs", q, 6)
+        st = chain_state(Geometry.of(design, options), X, np.ones(3))
+        if not st.ok:
+            raise InvalidPose(f"pose: out of reach ({', '.join(f'{v:g}' for v in X)})")
+        # for sigma = +1, q(s) = base - kappa, so base - q_s = sigma * kappa
+        base = np.array([st.centres[0, 2], st.centres[1, 2], st.mu3])
+        return "".join("+" if b - s >= 0.0 else "-" for b, s in zip(base, q[3:], strict=True))
+
+    def jacobians(self, design, options, pose, q) -> dict[str, np.ndarray]:
+        """J_t (twist), T (Euler rates), the pose Jacobian J = J_t T and the homogenised J_t whose LCI is
+        reported ("Js"), for the branch of q at the pose. Rows w1, w2, beta, s1, s2, s3."""
+        X = self.full_pose(options, pose)
+        geo = Geometry.of(design, options)
+        st = chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+        jt = twist_jacobian(geo, st)
+        t = euler_rate_map(X)
+        return {"Jt": jt, "T": t, "J": jt @ t, "Js": scaled(geo, jt)}
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'inverse' (serial: kappa_i <= tol L_i, or mu3 <= tol R), 'forward' (parallel: the row-normalised
+        homogenised J_t with kappa_i and mu3 multiplied out has sigma_min / sigma_max <= tol), 'both', 'none'."""
+        X = self.full_pose(options, pose)
+        geo = Geometry.of(design, options)
+        st = chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+        inverse = bool(np.any(st.kappa <= tol * geo.links) or st.mu3 <= tol * geo.rail)
+        # A t = B q_dot with B = diag(1, 1, mu3^2, kappa1, kappa2, kappa3): A stays finite where J_t does not
+        g = actuator_directions(geo, st)
+        with np.errstate(invalid="ignore"):
+            g[2] *= st.mu3**2
+            # kappa_i g_j -> sigma_i lambda_i e_i as kappa_i -> 0
+            limit = st.sigma[:, None] * st.lam[:, None] * geo.e
+            g[3:] = np.where(st.kappa[:, None] > 0, g[3:] * st.kappa[:, None], limit)
+        a = np.concatenate([g, np.cross(st.rk[list(CHAIN_OF_JOINT)], g) / geo.angle_length], axis=-1)
+        a /= np.linalg.norm(a, axis=1, keepdims=True)
+        sv = np.linalg.svd(a, compute_uv=False)
+        forward = bool(sv[-1] <= tol * sv[0])
+        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
+            (inverse, forward), "both"
+        )
+
+    def lci(self, design, options, pose, q) -> float:
+        """LCI = sigma_min / sigma_max of the homogenised J_t (NumPy SVD); 0 at a serial singularity."""
+        X = self.full_pose(options, pose)
+        geo = Geometry.of(design, options)
+        st = chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+        if np.any(st.kappa == 0.0) or st.mu3 == 0.0:
+            return 0.0
+        sv = np.linalg.svd(scaled(geo, twist_jacobian(geo, st)), compute_uv=False)
+        return float(sv[-1] / sv[0])
+
+    def limit_violations(self, options: Mapping[str, Any], q) -> list[str]:
+        """Names of the actuators of q outside their limits (empty when all are within)."""
+        q = np.asarray(q, dtype=float)
+        lims = [options["w_limits"]] * 2 + [options["beta_limits"]] + [options["s_limits"]] * 3
+        return [n for n, v, (lo, hi) in zip(JOINTS, q, lims, strict=True) if not lo <= v <= hi]
+
+
+def _is_vector(value) -> bool:
+    try:
+        return np.asarray(value, dtype=float).ndim == 1
+    except (TypeError, ValueError):
+        return False
+
+
+def _finite(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise InvalidParameter(f"{name}: expected a finite number, got {value!r}")
+    return float(value)
+
+
+# ----- drive-displacement curves (paper §5, Fig. 7) --------------------------------------------------------
+@dataclass(frozen=True)
+class DriveCurves:
+    """Actuator values along a closed path: t in [0, 1] (constant speed), points (n, 3) mm, q (n, 6) in
+    (w1, w2, beta, s1, s2, s3) mm and rad, the LCI per sample, and the worst continuation-FK error (mm)."""
+
+    t: np.ndarray
+    points: np.ndarray
+    q: np.ndarray
+    lci: np.ndarray
+    fk_error: float
+
+
+def drive_curves(
+    design: Mapping[str, float], options: Mapping[str, Any], path_points: Sequence[Sequence[float]], samples: int
+) -> DriveCurves:
+    """Walk the closed polyline ``path_points`` (x, y, z in mm; closed back to its first point) at the options'
+    orientation and branch, with ``samples`` points evenly spaced by arc length (first and last both at the
+    start). Each sample's actuators come from the closed-form IK; continuation FK (Newton from the previous
+    sample's pose) must land back on the sample, which confirms that the path stays in one assembly mode.
+
+    Raises InvalidPose naming the first sample that is out of reach, outside a limit or where continuation
+    fails (a singularity on the way).
+    """
+    from scalesynth.evaluate import sample_path
+
+    mech = MECHANISM
+    design = mech.resolve_design(design)
+    options = mech.resolve_options(options)
+    pts = np.asarray(path_points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] < 2 or not np.all(np.isfinite(pts)):
+        raise InvalidPose(f"path_points: expected two or more finite (x, y, z) points, got shape {pts.shape}")
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise InvalidPose(f"samples: expected an integer >= 2, got {samples!r}")
+    if np.any(pts[-1] != pts[0]):
+        pts = np.vstack([pts, pts[:1]])
+    if np.all(pts == pts[0]):
+        raise InvalidPose("path_points: all points coincide; the path has no length")
+    path = sample_path(pts, int(samples))
+    n = path.shape[0]
+    poses = np.concatenate([path, np.tile(options["orientation"], (n, 1))], axis=1)
+    geo = Geometry.of(design, options)
+    sigma = sigma_vector(options["sigma"])
+    st = chain_state(geo, poses, sigma)
+    q = st.q
+    packed = mech.pack(design, options)
+    lci = np.array([point_lci(packed, *pt) for pt in path])
+    for k in range(n):
+        where = f"path: sample {k} at ({', '.join(f'{v:.6g}' for v in path[k])})"
+        if not st.ok[k]:
+            raise InvalidPose(f"{where} is out of reach")
+        bad = mech.limit_violations(options, q[k])
+        if bad:
+            raise InvalidPose(f"{where} puts {', '.join(bad)} outside the limits")
+    # continuation: FK of each sample's q by Newton from the previous sample's pose
+    fk, conv = newton_fk(geo, sigma, q[1:], poses[:-1])
+    err = np.max(np.abs(fk - poses[1:]) * np.array([1, 1, 1, geo.r, geo.r, geo.r]), axis=1)
+    failed = np.nonzero(~conv | (err > 1e-6))[0]
+    if failed.size:
+        k = int(failed[0]) + 1
+        raise InvalidPose(
+            f"path: continuation FK leaves the assembly mode at sample {k} "
+            f"({', '.join(f'{v:.6g}' for v in path[k])}); a singularity lies on the path"
+        )
+    t = np.linspace(0.0, 1.0, n)
+    return DriveCurves(t=t, points=path, q=q, lci=lci, fk_error=float(np.max(err, initial=0.0)))
+
+
+MECHANISM = PprsRprs(
+    name="pprs-rprs",
+    title="2PPRS-RPRS six-DOF parallel mechanism (seed 001)",
+    seed="001",
+    motion="3T3R",
+    task_axes=("x", "y", "z"),
+    task_units=("length", "length", "length"),
+    joints=JOINTS,
+    joint_units=("length", "length", "angle", "length", "length", "length"),
+    parameters=(
+        Parameter("r", 160.0, "circumradius of the moving triangle C1C2C3 (mm)"),
+        Parameter("R", 180.0, "|OB3|, distance of chain 3's fixed revolute from O, and rail length (mm)"),
+        Parameter("L1", 100.0, "link |D1C1| of chain 1 (paper's l, mm)"),
+        Parameter("L2", 120.0, "link |D2C2| of chain 2 (paper's n, mm)"),
+        Parameter("L3", 120.0, "link |D3C3| of chain 3 (paper's m, mm)"),
+    ),
+    options=(
+        Option("orientation", (0.0, 0.0, 0.0), "[phi, theta, psi] rad of the constant-orientation workspace"),
+        Option("sigma", "+++", "branch signs sigma1 sigma2 sigma3; '+' = D_i below C_i (spec §1.3)"),
+        Option("w_limits", (80.0, 180.0), "[lo, hi] mm for the rail inputs w1, w2"),
+        Option("s_limits", (37.5, 137.5), "[lo, hi] mm for the slider inputs s1, s2, s3"),
+        Option("beta_limits", (math.pi / 3, 2 * math.pi / 3), "[lo, hi] rad for chain 3's revolute input beta"),
+        Option("chain3_azimuth_deg", 210.0, "azimuth of OB3 in degrees: 210 (spec) or 240 (open question O2)"),
+        Option("w_convention", "O", "'O': B_i = w_i u_i (spec); 'R': B_i = (R - w_i) u_i (eq.10-12, E5)"),
+        Option("beta_length", None, "mm multiplying the beta row of J_t for the LCI; null = R"),
+        Option("angle_length", None, "mm dividing the angular-velocity columns of J_t for the LCI; null = r"),
+    ),
+    default_length_unit="mm",
+)
