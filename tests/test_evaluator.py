@@ -108,3 +108,50 @@ def test_closed_form_conditioning_matches_svd():
         b = a[:2, :2]
         ref2 = np.linalg.svd(b, compute_uv=False)
         assert lci_2x2(b[0, 0], b[0, 1], b[1, 0], b[1, 1]) == pytest.approx(ref2[-1] / ref2[0], rel=1e-9, abs=1e-14)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [{}, {"mode": "+-"}, {"mode": "--", "z_min": 0.3}, {"theta1_limits": [-1.5, 0.2], "theta2_limits": [-1.5, 0.2]},
+     {"theta1_limits": [-1.5, 0.2]}, {"stroke_limits": [-0.3, 0.9]}, {"stroke_limits": [-0.5, 0.5]}],
+)
+@pytest.mark.parametrize("resolution", [17, 24])
+def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
+    """The column-interval/symmetry kernel counts exactly the generic kernel's voxels, with the same sums."""
+    from scalesynth.mechanisms.pauu_ppap import population_stats_fast
+
+    rng = np.random.default_rng(resolution)
+    opts = M.resolve_options(options)
+    designs = [
+        M.resolve_design(dict(m=rng.uniform(0.5, 1.5), n=rng.uniform(0.2, 1), l1=rng.uniform(0.5, 1.5),
+                              l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)))
+        for _ in range(16)
+    ]
+    packed = np.stack([M.pack(d, opts) for d in designs])
+    grids = [make_grid(M, d, opts, resolution) for d in designs]
+    lo = np.stack([g.lo for g in grids])
+    step = np.stack([g.step for g in grids])
+    edges = np.array(EDGES)
+    generic = kgrid.population_stats(M.point_kernel, packed, lo, step, grids[0].shape, edges)
+    fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    assert np.array_equal(generic[:, kgrid.COL_COUNT], fast[:, kgrid.COL_COUNT])
+    np.testing.assert_allclose(fast, generic, rtol=1e-10, atol=1e-12)
+
+
+def test_exact_volume_quadrature_reproduces_spec():
+    from exact_volume import exact_volume
+
+    for group, volume in EXACT_VOLUME.items():
+        assert exact_volume(**TABLE4[group]) == pytest.approx(volume, abs=2e-6)
+    assert exact_volume(m=1, n=0.7, l1=0.65, l2=1.5) == pytest.approx(20.411142, abs=2e-6)  # §1.9, §5.1 example
+
+
+def test_grid_volume_converges_to_exact_on_random_designs():
+    from exact_volume import exact_volume
+
+    rng = np.random.default_rng(7)
+    designs = [dict(m=rng.uniform(0.5, 1.5), n=rng.uniform(0.2, 1), l1=rng.uniform(0.5, 1.5),
+                    l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)) for _ in range(8)]
+    vol = evaluate_population(M, designs, resolution=96)["volume_m3"]
+    exact = np.array([exact_volume(**d) for d in designs])
+    np.testing.assert_allclose(vol, exact, rtol=0.01)

@@ -151,7 +151,7 @@ def evaluate(
     packed = mech.pack(design, options)[None, :]
     warm_up(mech, packed, edges)
     t0 = time.perf_counter()
-    stats = _grid.population_stats(mech.point_kernel, packed, g.lo[None, :], g.step[None, :], g.shape, edges)
+    stats = mech.grid_stats(packed, g.lo[None, :], g.step[None, :], g.shape, edges)
     seconds = time.perf_counter() - t0
     names = metric_names(mech, unit, band_edges)
     metrics = {k: v[0].item() for k, v in stats_to_metrics(stats, np.array([g.cell_measure]), names).items()}
@@ -182,7 +182,7 @@ def warm_up(mech: Mechanism, packed: np.ndarray, edges: np.ndarray) -> None:
         return
     lo = np.zeros((1, 3))
     step = np.ones((1, 3))
-    _grid.population_stats(mech.point_kernel, packed[:1], lo, step, np.array([1, 1, 1], dtype=np.int64), edges)
+    mech.grid_stats(packed[:1], lo, step, np.array([1, 1, 1], dtype=np.int64), edges)
     _WARM.add(key)
 
 
@@ -221,9 +221,7 @@ def task_metrics(
     step = np.ones(3)
     step[:ndim] = (hi[:ndim] - lo[:ndim]) / shape[:ndim]
     edges = np.asarray(band_edges, dtype=float)
-    stats = _grid.population_stats(
-        mech.point_kernel, packed, np.tile(lo, (n, 1)), np.tile(step, (n, 1)), shape, edges
-    )
+    stats = mech.grid_stats(packed, np.tile(lo, (n, 1)), np.tile(step, (n, 1)), shape, edges)
     count = stats[:, _grid.COL_COUNT]
     total = float(np.prod(shape))
     safe = np.where(count > 0, count, 1.0)
@@ -270,7 +268,7 @@ def evaluate_population(
     lo = np.stack([g.lo for g in grids])
     step = np.stack([g.step for g in grids])
     edges = np.asarray(band_edges, dtype=float)
-    stats = _grid.population_stats(mech.point_kernel, packed, lo, step, grids[0].shape, edges)
+    stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
     cell = np.array([g.cell_measure for g in grids])
     out = stats_to_metrics(stats, cell, names)
     if task is not None:

@@ -69,6 +69,13 @@ def population_stats(point_kernel, params, lo, step, shape, edges):
         row[COL_SUMSQ] = s2
         row[COL_MIN] = vmin
         row[COL_MAX] = vmax
+    return reduce_partials(partial, n_designs, nx)
+
+
+@njit(cache=True)
+def reduce_partials(partial, n_designs, nx):
+    """Sum the per-slab rows of each design in slab order (deterministic, whatever the thread schedule)."""
+    ncol = partial.shape[1]
     out = np.zeros((n_designs, ncol))
     for d in range(n_designs):
         acc = out[d]
@@ -83,8 +90,8 @@ def population_stats(point_kernel, params, lo, step, shape, edges):
                 acc[COL_MIN] = row[COL_MIN]
             if row[COL_MAX] > acc[COL_MAX]:
                 acc[COL_MAX] = row[COL_MAX]
-            for b in range(nb):
-                acc[N_FIXED + b] += row[N_FIXED + b]
+            for b in range(N_FIXED, ncol):
+                acc[b] += row[b]
     return out
 
 

@@ -145,6 +145,13 @@ class Mechanism:
         """'none', 'inverse', 'forward' or 'both'."""
         raise NotImplementedError  # abstract
 
+    def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
+        """Workspace statistics of many designs (layout of kernels.grid.population_stats). A mechanism may override
+        this with a faster kernel that must give the same numbers."""
+        from scalesynth.kernels import grid as _grid
+
+        return _grid.population_stats(self.point_kernel, packed, lo, step, shape, edges)
+
     def derived_columns(self, design: Mapping[str, float]) -> dict[str, float]:
         """Extra result columns derived from a design (e.g. m_minus_n); none by default."""
         return {}

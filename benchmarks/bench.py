@@ -1,0 +1,304 @@
+"""scalesynth benchmarks (plain Python; run from the repository root with the project's venv):
+
+    python benchmarks/bench.py all          # everything below, then rewrite benchmarks/RESULTS.md
+    python benchmarks/bench.py evaluator    # Numba vs NumPy twin throughput, same process (issue targets 1)
+    python benchmarks/bench.py accuracy     # volume/GCI error of the paper config's resolution
+    python benchmarks/bench.py paper        # the paper-scale synthesis in a fresh process: wall time, peak memory
+    python benchmarks/bench.py growth       # time against N and against population size
+    python benchmarks/bench.py compile      # JIT: first call (empty cache) vs second process (cache)
+
+Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
+Speed targets are compared as ratios measured in one run; absolute times are stated with the machine.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from scalesynth.config import load_config  # noqa: E402
+from scalesynth.evaluate import evaluate_population, make_grid  # noqa: E402
+from scalesynth.kernels import grid as kgrid  # noqa: E402
+from scalesynth.mechanisms import get  # noqa: E402
+
+from exact_volume import exact_volume  # noqa: E402
+from naive import grid_metrics, grid_nodes, pauu_lci  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results"
+PAPER = ROOT / "configs" / "paper_2pauu_ppap.yaml"
+TABLE4 = [
+    dict(m=0.857, n=0.706, l1=1.499, l2=1.5, c=0.1),
+    dict(m=0.719, n=0.579, l1=1.499, l2=1.5, c=0.1),
+    dict(m=0.516, n=0.342, l1=1.5, l2=1.5, c=0.1),
+    dict(m=0.500, n=0.506, l1=1.5, l2=1.5, c=0.1),
+    dict(m=0.509, n=0.339, l1=1.5, l2=1.5, c=0.1),
+    dict(m=0.506, n=0.330, l1=1.5, l2=1.5, c=0.1),
+]
+EDGES = np.array([0.0, 0.1, 0.3, 1.0])
+M = get("2pauu-ppap")
+
+
+def machine() -> dict:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import numba
+
+    return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
+            "python": platform.python_version(), "numba": numba.__version__, "numpy": np.__version__}
+
+
+def best_of(fn, repeat: int) -> float:
+    fn()  # warm-up (compilation, caches)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def bench_evaluator() -> dict:
+    opts = M.resolve_options({})
+    designs = [M.resolve_design(d) for d in TABLE4]
+    packed = np.stack([M.pack(d, opts) for d in designs])
+    rows = []
+    for n in (64, 128):
+        grids = [make_grid(M, d, opts, n) for d in designs]
+        lo = np.stack([g.lo for g in grids])
+        step = np.stack([g.step for g in grids])
+        shape = grids[0].shape
+        voxels = len(designs) * n**3
+        t_fast = best_of(lambda: M.grid_stats(packed, lo, step, shape, EDGES), 5)  # noqa: B023
+        t_generic = best_of(lambda: kgrid.population_stats(M.point_kernel, packed, lo, step, shape, EDGES), 3)  # noqa: B023
+
+        def numpy_twin():
+            for d, g in zip(designs, grids, strict=True):  # noqa: B023
+                X, Y, Z = grid_nodes(g.lo, g.step, g.shape)
+                grid_metrics(pauu_lci(d, opts, X, Y, Z), g.cell_measure, EDGES)
+
+        t_numpy = best_of(numpy_twin, 1)
+        rows.append({
+            "N": n, "designs": len(designs), "voxels": voxels,
+            "numba_fast_s": t_fast, "numba_generic_s": t_generic, "numpy_s": t_numpy,
+            "numba_fast_Mvox_s": voxels / t_fast / 1e6, "numba_generic_Mvox_s": voxels / t_generic / 1e6,
+            "numpy_Mvox_s": voxels / t_numpy / 1e6, "ratio_fast_vs_numpy": t_numpy / t_fast,
+            "ratio_generic_vs_numpy": t_numpy / t_generic,
+        })
+        print(f"N={n}: fast {voxels / t_fast / 1e6:.1f} Mvox/s, generic {voxels / t_generic / 1e6:.1f}, "
+              f"numpy {voxels / t_numpy / 1e6:.3f}; fast/numpy = {t_numpy / t_fast:.0f}x", flush=True)
+    return {"rows": rows}
+
+
+def bench_accuracy(n_random: int = 40) -> dict:
+    cfg = load_config(PAPER)
+    res = cfg.grid.resolution
+    rng = np.random.default_rng(0)
+    designs = [dict(d) for d in TABLE4]
+    b = cfg.bounds
+    for _ in range(n_random):
+        designs.append({k: float(rng.uniform(*b[k])) for k in ("m", "n", "l1", "l2", "c")})
+    coarse = evaluate_population(M, designs, resolution=res)
+    fine = evaluate_population(M, designs, resolution=2 * res)
+    exact = np.array([exact_volume(**d) for d in designs])
+    vol_err = np.abs(coarse["volume_m3"] / exact - 1)
+    gci_err = np.abs(coarse["gci"] - fine["gci"])
+    out = {"resolution": res, "designs": len(designs), "max_volume_rel_error": float(vol_err.max()),
+           "max_gci_abs_error_vs_2x": float(gci_err.max()),
+           "table4_max_volume_rel_error": float(vol_err[:6].max()),
+           "table4_max_gci_abs_error_vs_2x": float(gci_err[:6].max())}
+    print(out, flush=True)
+    return out
+
+
+def _run_subprocess(cmd: list[str], env: dict) -> tuple[float, float, subprocess.CompletedProcess]:
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    peak_kib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr)
+    return wall, max(peak_kib, before) / 1024.0, proc
+
+
+def bench_paper() -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, MPLBACKEND="Agg", NUMBA_CACHE_DIR=str(Path(tmp) / "numba-cache"))
+        out = Path(tmp) / "run"
+        cmd = [sys.executable, "-m", "scalesynth", "optimize", str(PAPER), "--out", str(out), "--no-plots", "-q"]
+        wall_cold, peak_cold, _ = _run_subprocess(cmd, env)
+        manifest = json.loads((out / "manifest.json").read_text())
+        result = {"command": "scalesynth optimize configs/paper_2pauu_ppap.yaml --no-plots -q",
+                  "wall_s_cold_cache": wall_cold, "peak_rss_mib": peak_cold,
+                  "loop_wall_s": manifest["wall_seconds"], "evaluations": manifest["evaluations"],
+                  "resolution": manifest["grid_resolution"], "hypervolume": manifest["hypervolume"],
+                  "pareto_size": manifest["pareto_size"]}
+        out2 = Path(tmp) / "run2"
+        cmd[cmd.index(str(out))] = str(out2)
+        wall_warm, _, _ = _run_subprocess(cmd, env)
+        result["wall_s_warm_cache"] = wall_warm
+        result["byte_identical_rerun"] = (out / "pareto.csv").read_bytes() == (out2 / "pareto.csv").read_bytes()
+    print(result, flush=True)
+    return result
+
+
+def bench_growth() -> dict:
+    opts = M.resolve_options({})
+    rng = np.random.default_rng(1)
+    pool = [M.resolve_design({k: float(rng.uniform(*r)) for k, r in
+                              dict(m=(0.5, 1.5), n=(0.2, 1), l1=(0.5, 1.5), l2=(0.5, 1.5), c=(0.1, 0.5)).items()})
+            for _ in range(400)]
+
+    def timed(designs, n):
+        packed = np.stack([M.pack(d, opts) for d in designs])
+        grids = [make_grid(M, d, opts, n) for d in designs]
+        lo = np.stack([g.lo for g in grids])
+        step = np.stack([g.step for g in grids])
+        return best_of(lambda: M.grid_stats(packed, lo, step, grids[0].shape, EDGES), 3)
+
+    by_n = [{"N": n, "seconds": timed(pool[:50], n)} for n in (32, 48, 64, 96, 128, 192)]
+    by_pop = [{"designs": k, "seconds": timed(pool[:k], 64)} for k in (25, 50, 100, 200, 400)]
+    slope_n = float(np.polyfit(np.log([r["N"] for r in by_n]), np.log([r["seconds"] for r in by_n]), 1)[0])
+    slope_pop = float(np.polyfit(np.log([r["designs"] for r in by_pop]), np.log([r["seconds"] for r in by_pop]), 1)[0])
+    out = {"by_N": by_n, "by_population": by_pop, "exponent_N": slope_n, "exponent_population": slope_pop}
+    print(out, flush=True)
+    return out
+
+
+COMPILE_SNIPPET = """
+import time
+t0 = time.perf_counter()
+from scalesynth.mechanisms import get
+from scalesynth.evaluate import evaluate
+t1 = time.perf_counter()
+evaluate(get("2pauu-ppap"), {}, resolution=8)
+t2 = time.perf_counter()
+print(t1 - t0, t2 - t1)
+"""
+
+
+def bench_compile() -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        runs = []
+        for _ in range(2):
+            proc = subprocess.run([sys.executable, "-c", COMPILE_SNIPPET], env=env, capture_output=True, text=True)
+            imp, first = (float(v) for v in proc.stdout.split())
+            runs.append({"import_s": imp, "first_evaluate_s": first})
+    out = {"empty_cache": runs[0], "cached": runs[1]}
+    print(out, flush=True)
+    return out
+
+
+PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": bench_paper, "growth": bench_growth,
+         "compile": bench_compile}
+
+
+def write_results_md() -> None:
+    data = {}
+    for name in PARTS:
+        path = RESULTS / f"{name}.json"
+        if path.exists():
+            data[name] = json.loads(path.read_text())
+    lines = ["# Benchmark results", "",
+             "Rebuilt by `python benchmarks/bench.py all` (or one part: `evaluator`, `accuracy`, `paper`, `growth`,",
+             "`compile`). Each section states the machine and date it was measured on.", ""]
+    if "evaluator" in data:
+        d = data["evaluator"]
+        lines += _header("Evaluator throughput: Numba vs NumPy twin (same process, Table-4 designs)", d)
+        lines += ["Grid-equivalent voxels per second (designs x N^3 / seconds). `numba fast` is the evaluator the",
+                  "optimiser uses (column intervals + symmetry), `numba generic` the registry-wide point-kernel grid",
+                  "evaluator, `numpy` the obvious vectorised NumPy code of `tests/naive.py` (np.linalg.svd per voxel).",
+                  "", "| N | numba fast (Mvox/s) | numba generic (Mvox/s) | numpy (Mvox/s) | fast / numpy | generic / numpy |",
+                  "|---|---|---|---|---|---|"]
+        for r in d["result"]["rows"]:
+            lines.append(f"| {r['N']} | {r['numba_fast_Mvox_s']:.1f} | {r['numba_generic_Mvox_s']:.1f} | "
+                         f"{r['numpy_Mvox_s']:.3f} | {r['ratio_fast_vs_numpy']:.0f}x | {r['ratio_generic_vs_numpy']:.0f}x |")
+        lines.append("")
+    if "accuracy" in data:
+        r = data["accuracy"]["result"]
+        lines += _header("Accuracy of the paper config's resolution", data["accuracy"])
+        lines += [f"Resolution {r['resolution']} on the six Table-4 designs and {r['designs'] - 6} random designs in the",
+                  "paper's bounds: volume against the exact quadrature of spec §1.9, GCI against a 2x finer grid.", "",
+                  "| | max volume error | max GCI error |", "|---|---|---|",
+                  f"| Table-4 designs | {100 * r['table4_max_volume_rel_error']:.3f} % | {r['table4_max_gci_abs_error_vs_2x']:.5f} |",
+                  f"| all {r['designs']} designs | {100 * r['max_volume_rel_error']:.3f} % | {r['max_gci_abs_error_vs_2x']:.5f} |",
+                  ""]
+    if "paper" in data:
+        r = data["paper"]["result"]
+        lines += _header("Paper-scale synthesis (population 200, 200 generations)", data["paper"])
+        lines += [f"`{r['command']}` in a fresh process, resolution {r['resolution']}, {r['evaluations']} evaluations.", "",
+                  "| | value |", "|---|---|",
+                  f"| wall time, empty Numba cache (includes JIT compilation) | {r['wall_s_cold_cache']:.1f} s |",
+                  f"| wall time, warm cache | {r['wall_s_warm_cache']:.1f} s |",
+                  f"| NSGA-II loop alone (manifest wall_seconds) | {r['loop_wall_s']:.1f} s |",
+                  f"| peak memory (max RSS) | {r['peak_rss_mib']:.0f} MiB |",
+                  f"| final hypervolume | {r['hypervolume']:.6g} |",
+                  f"| Pareto designs | {r['pareto_size']} |",
+                  f"| re-run byte-identical pareto.csv | {r['byte_identical_rerun']} |", ""]
+    if "growth" in data:
+        r = data["growth"]["result"]
+        lines += _header("Cost growth", data["growth"])
+        lines += ["Fast evaluator, best of 3. Against N (50 random designs):", "", "| N | seconds | s / N^3 (ns) |",
+                  "|---|---|---|"]
+        for row in r["by_N"]:
+            lines.append(f"| {row['N']} | {row['seconds']:.4f} | {1e9 * row['seconds'] / row['N'] ** 3:.2f} |")
+        lines += ["", f"Fitted exponent in N: **{r['exponent_N']:.2f}** (N^3 would be 3).", "",
+                  "Against population size (N = 64):", "", "| designs | seconds | ms / design |", "|---|---|---|"]
+        for row in r["by_population"]:
+            lines.append(f"| {row['designs']} | {row['seconds']:.4f} | {1e3 * row['seconds'] / row['designs']:.2f} |")
+        lines += ["", f"Fitted exponent in designs: **{r['exponent_population']:.2f}** (linear would be 1).", ""]
+    if "compile" in data:
+        r = data["compile"]["result"]
+        lines += _header("JIT compilation", data["compile"])
+        lines += ["Two fresh processes sharing one empty NUMBA_CACHE_DIR: the first compiles, the second loads the cache.",
+                  "", "| process | import (s) | first evaluate, incl. compile or cache load (s) |", "|---|---|---|",
+                  f"| first (empty cache) | {r['empty_cache']['import_s']:.2f} | {r['empty_cache']['first_evaluate_s']:.2f} |",
+                  f"| second (cached) | {r['cached']['import_s']:.2f} | {r['cached']['first_evaluate_s']:.2f} |", ""]
+    (ROOT / "benchmarks" / "RESULTS.md").write_text("\n".join(lines) + "\n")
+
+
+def _header(title: str, entry: dict) -> list[str]:
+    m = entry["machine"]
+    return [f"## {title}", "",
+            f"Measured {entry['date']} on {m['cpu']}, {m['cores']} cores, {m['numba_threads']} Numba threads, Python "
+            f"{m['python']}, numba {m['numba']}, numpy {m['numpy']}. Command: `python benchmarks/bench.py "
+            f"{entry['part']}`.", ""]
+
+
+def main(argv: list[str]) -> None:
+    parts = list(PARTS) if not argv or argv[0] == "all" else argv
+    for name in parts:
+        if name not in PARTS:
+            raise SystemExit(f"unknown part {name!r}; choose from all, {', '.join(PARTS)}")
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    for name in parts:
+        print(f"== {name}", flush=True)
+        result = PARTS[name]()
+        entry = {"part": name, "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), "machine": machine(),
+                 "result": result}
+        (RESULTS / f"{name}.json").write_text(json.dumps(entry, indent=2) + "\n")
+    write_results_md()
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
