@@ -2,6 +2,11 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# reproducible property tests: the same examples on every run (CI included)
+settings.register_profile("repro", derandomize=True, deadline=None, print_blob=True)
+settings.load_profile("repro")
 
 sys.path.insert(0, str(Path(__file__).parent))
 

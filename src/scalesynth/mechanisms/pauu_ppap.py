@@ -30,23 +30,21 @@ N_PACKED = 14
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _chain_angle(a, b, yy, l1, l2, sigma):
-    """cos(theta), sin(theta) of one chain's IK root sigma, without transcendental calls.
+def _chain(a, b, yy, l1, l2, sigma):
+    """One chain's IK root sigma in algebraic form: (ok, cos theta, sin theta, Jq entry), no transcendental calls.
 
-    theta = atan2(-b, a) + sigma * arccos(k), k = T3 / (2 l1 r), r = |(a, b)|.
-    Returns (ok, cos, sin); ok is False when the pose is out of the chain's reach.
+    With r^2 = a^2 + b^2 and K = (r^2 + y^2 + l1^2 - l2^2) / (2 l1) (= r cos of the arccos term of spec §1.2),
+    S = sqrt(r^2 - K^2) (= r sin of it): cos theta = (a K + sigma b S) / r^2, sin theta = (-b K + sigma a S) / r^2
+    and Jq_ii = -l1 (a sin theta + b cos theta) = -sigma l1 S. ok is False when the pose is out of reach (K^2 > r^2).
     """
     r2 = a * a + b * b
-    if r2 <= 1e-300:
-        return False, 0.0, 0.0
-    r = math.sqrt(r2)
-    k = (r2 + yy + l1 * l1 - l2 * l2) / (2.0 * l1 * r)
-    if k > 1.0 or k < -1.0:
-        return False, 0.0, 0.0
-    sg = math.sqrt(1.0 - k * k)
-    c0 = a / r
-    s0 = -b / r
-    return True, c0 * k - sigma * s0 * sg, s0 * k + sigma * c0 * sg
+    kk = (r2 + yy + l1 * l1 - l2 * l2) / (2.0 * l1)
+    s2 = r2 - kk * kk
+    if s2 < 0.0 or r2 <= 1e-300:
+        return False, 0.0, 0.0, 0.0
+    sq = math.sqrt(s2)
+    inv = 1.0 / r2
+    return True, (a * kk + sigma * b * sq) * inv, (-b * kk + sigma * a * sq) * inv, -sigma * l1 * sq
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -70,10 +68,10 @@ def point_lci(p, x, y, z):
         return -1.0
     a1 = x - delta
     a2 = -x - delta
-    ok1, c1, s1 = _chain_angle(a1, b, yy, l1, l2, p[_S1])
+    ok1, c1, s1, q1 = _chain(a1, b, yy, l1, l2, p[_S1])
     if not ok1:
         return -1.0
-    ok2, c2, s2 = _chain_angle(a2, b, yy, l1, l2, p[_S2])
+    ok2, c2, s2, q2 = _chain(a2, b, yy, l1, l2, p[_S2])
     if not ok2:
         return -1.0
     if p[_HAS_THETA] > 0.0:
@@ -84,8 +82,6 @@ def point_lci(p, x, y, z):
     w1z = b + l1 * s1
     w2x = -(a2 - l1 * c2)
     w2z = b + l1 * s2
-    q1 = -l1 * (a1 * s1 + b * c1)
-    q2 = -l1 * (a2 * s2 + b * c2)
     if q1 == 0.0 or q2 == 0.0:
         return 0.0  # inverse (type-1) singularity
     # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J)
