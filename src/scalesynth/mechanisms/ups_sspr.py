@@ -1,0 +1,408 @@
+"""2-UPS/(S+SPR)R parallel mechanism with a closed-loop unit, 2R1T (seed 003), following spec §3.
+
+Geometry (spec §3.1; lengths in mm, angles in rad). Base: A0 at the centroid of the equilateral triangle
+A1 = (0, a, 0), A2 = (-sqrt(3) a/2, -a/2, 0), A3 = (sqrt(3) a/2, -a/2, 0); the SPR chain's S joint sits at
+M = (0, -a_m, 0), the midpoint of A2A3 (a_m = a/2). Platform (isosceles right triangle, right angle at B1):
+B2' = (-b/sqrt2, b/sqrt2, 0), B3' = (b/sqrt2, b/sqrt2, 0). The rigid SR link A0B1 has length c = l0 and the SPR
+revolute sits at B0 = k0 * B1 on it, k0 = 2/3.
+
+Task coordinates (alpha, beta, Y): R = Ry(beta) Rx(alpha) (this order is mandatory, erratum G3) and
+B1 = P = (sin(beta) rho, Y, cos(beta) rho), rho = sqrt(c^2 - Y^2) > 0 (the Z > 0 assembly of the SR link).
+Actuators: l1 (SPR leg, depends on Y only), l2, l3 (UPS legs from A2, A3 to B2, B3).
+
+Dimensions: c = 120 mm is the paper's; a = 100 mm and b = 80 mm and all actuator ranges are PLACEHOLDERS (the
+paper's values were lost in extraction, spec §3.7-3.9).
+
+Dexterity: the Jacobian Jx = dl/d(alpha, beta, Y) mixes mm/rad (angle columns) and mm/mm (Y column); the LCI is
+1/kappa_2 of Jx diag(1/L, 1/L, 1), i.e. of the Jacobian with respect to (L alpha, L beta, Y), where L is the
+option ``characteristic_length`` (default c, the SR link length).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from scalesynth.errors import InvalidParameter
+from scalesynth.kernels.conditioning import lci_3x3
+from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+
+K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
+SQRT3_2 = math.sqrt(3.0) / 2.0
+INV_SQRT2 = 1.0 / math.sqrt(2.0)
+Y_OPEN = 0.999  # default Y box = +-0.999 c: Y = +-c (rho = 0) is singular (spec §3.5)
+IK_LABEL = "Z+"  # the only IK branch: leg lengths are positive square roots, the SR link above the base
+
+# packed-parameter layout (see UpsSspr.pack)
+_C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
+_L1LO, _L1HI, _L2LO, _L2HI, _L3LO, _L3HI = 6, 7, 8, 9, 10, 11
+_ALO, _AHI, _BLO, _BHI, _YLO, _YHI = 12, 13, 14, 15, 16, 17
+N_PACKED = 18
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
+    """Length and (d l/d alpha, d l/d beta, d l/d Y) of the UPS leg from A = (ax, ay, 0) to B = P + R (bx, by, 0).
+
+    The beta-derivative of a point r is y_hat x r = (r_z, 0, -r_x) (R = Ry(beta) ...); returns length 0 and a
+    zero row when the leg has zero length (its direction is undefined there).
+    """
+    rbx = cb * bx + sb * sa * by  # R B'
+    rby = ca * by
+    rbz = -sb * bx + cb * sa * by
+    dx = px + rbx - ax
+    dy = py + rby - ay
+    dz = pz + rbz
+    ln = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if ln <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    inv = 1.0 / ln
+    # d(R B')/d alpha = Ry(beta) Rx'(alpha) B' = (sb ca by, -sa by, cb ca by)
+    ja = (dx * sb * ca * by - dy * sa * by + dz * cb * ca * by) * inv
+    # d(P + R B')/d beta = y_hat x (P + R B')
+    jb = (dx * (pz + rbz) - dz * (px + rbx)) * inv
+    # dP/dY = (-sb Y / rho, 1, -cb Y / rho)
+    jy = (dy - (dx * sb + dz * cb) * yy / rho) * inv
+    return ln, ja, jb, jy
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, alpha, beta, yy):
+    """LCI at task point (alpha [rad], beta [rad], Y [mm]) if it lies in the workspace box with every actuator
+    length within its limits, else -1. LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the angle columns divided by
+    the characteristic length."""
+    if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
+        return -1.0
+    if yy < p[_YLO] or yy > p[_YHI]:
+        return -1.0
+    c = p[_C]
+    rho2 = c * c - yy * yy
+    if not rho2 > 0.0:
+        return -1.0  # |Y| >= c: no Z > 0 assembly
+    am = p[_AM]
+    # spec §3.3: l1 = |(2/3) P - M| depends on Y only; > 0 whenever |Y| < c
+    l1 = math.sqrt(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy)
+    if l1 < p[_L1LO] or l1 > p[_L1HI]:
+        return -1.0
+    rho = math.sqrt(rho2)
+    sa = math.sin(alpha)
+    ca = math.cos(alpha)
+    sb = math.sin(beta)
+    cb = math.cos(beta)
+    px = sb * rho
+    pz = cb * rho
+    ax = p[_AX]
+    ay = -am
+    bx = p[_BX]
+    by = p[_BY]
+    l2, j2a, j2b, j2y = _ups_row(-ax, ay, -bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
+    if l2 < p[_L2LO] or l2 > p[_L2HI]:
+        return -1.0
+    l3, j3a, j3b, j3y = _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
+    if l3 < p[_L3LO] or l3 > p[_L3HI]:
+        return -1.0
+    if l2 <= 0.0 or l3 <= 0.0:
+        return 0.0  # zero-length leg: inverse singularity
+    s = p[_INV_L]
+    return lci_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
+
+
+def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
+    """Leg lengths (l1, l2, l3) and rows of Jx = dl/d(alpha, beta, Y) (spec §3.3, §3.5) at a pose with |Y| < c.
+
+    Plain-Python twin of the kernel's arithmetic for the NumPy kinematics (IK, Jacobians, FK Newton steps).
+    """
+    am = a / 2.0
+    rho = math.sqrt(max(c * c - yy * yy, 0.0))
+    sa, ca, sb, cb = math.sin(alpha), math.cos(alpha), math.sin(beta), math.cos(beta)
+    px, pz = sb * rho, cb * rho
+    l1 = math.sqrt(max(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy, 0.0))
+    rows = [[0.0, 0.0, K0 * am / l1 if l1 > 0.0 else math.inf]]
+    lengths = [l1]
+    ax, bxy = SQRT3_2 * a, b * INV_SQRT2
+    for sx in (-1.0, 1.0):  # leg 2 (A2, B2: x < 0), leg 3 (A3, B3: x > 0)
+        rbx = cb * sx * bxy + sb * sa * bxy
+        rby = ca * bxy
+        rbz = -sb * sx * bxy + cb * sa * bxy
+        d = (px + rbx - sx * ax, yy + rby + am, pz + rbz)
+        ln = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        lengths.append(ln)
+        if ln <= 0.0 or rho <= 0.0:
+            rows.append([math.nan, math.nan, math.nan])  # undefined: zero-length leg or |Y| = c
+            continue
+        ja = (d[0] * sb * ca * bxy - d[1] * sa * bxy + d[2] * cb * ca * bxy) / ln
+        jb = (d[0] * (pz + rbz) - d[2] * (px + rbx)) / ln
+        jy = (d[1] - (d[0] * sb + d[2] * cb) * yy / rho) / ln
+        rows.append([ja, jb, jy])
+    return lengths, rows
+
+
+def _wrap(t: float) -> float:
+    """Angle in (-pi, pi]."""
+    w = math.atan2(math.sin(t), math.cos(t))
+    return math.pi if w == -math.pi else w
+
+
+class UpsSspr(Mechanism):
+    """Seed-003 mechanism; see module docstring."""
+
+    # ----- options --------------------------------------------------------------------------------
+    def check_options(self, options: dict[str, Any]) -> None:
+        for name in ("l1_limits", "l2_limits", "l3_limits"):
+            options[name] = parse_range(name, options[name])
+            if options[name] is not None and options[name][0] < 0.0:
+                raise InvalidParameter(f"options.{name}: actuator lengths must be >= 0, got {options[name][0]:g}")
+        for name, bound in (("alpha_range", math.pi), ("beta_range", math.pi / 2)):
+            rng = parse_range(name, options[name])
+            if rng is None:
+                raise InvalidParameter(f"options.{name}: required [lo, hi] in rad")
+            if rng[0] < -bound or rng[1] > bound:
+                raise InvalidParameter(f"options.{name}: must lie within [-{bound:.6g}, {bound:.6g}] rad, got {rng}")
+            options[name] = rng
+        options["Y_range"] = parse_range("Y_range", options["Y_range"])
+        value = options["characteristic_length"]
+        if value is not None:
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not number or not (math.isfinite(value) and value > 0):
+                raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {value!r}")
+            options["characteristic_length"] = float(value)
+
+    def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
+        """L in mm (default c): the angle columns of Jx are divided by L before conditioning."""
+        value = options.get("characteristic_length")
+        return float(design["c"]) if value is None else float(value)
+
+    def y_box(self, design: Mapping[str, float], options: Mapping[str, Any]) -> tuple[float, float]:
+        """Y interval [mm] of the workspace box: Y_range (default +-0.999 c) clipped to [-c, c]."""
+        c = design["c"]
+        rng = options.get("Y_range")
+        lo, hi = (-Y_OPEN * c, Y_OPEN * c) if rng is None else rng
+        return max(lo, -c), min(hi, c)
+
+    def y_of_l1(self, design: Mapping[str, float], l1: float) -> float:
+        """Closed-form Y [mm] of an SPR length l1 [mm] (spec §3.4); l1 is increasing in Y."""
+        am, c = design["a"] / 2.0, design["c"]
+        return (l1 * l1 - 4.0 / 9.0 * c * c - am * am) / (4.0 / 3.0 * am)
+
+    # ----- kernel ---------------------------------------------------------------------------------
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        p = np.empty(N_PACKED)
+        a, b, c = design["a"], design["b"], design["c"]
+        p[_C] = c
+        p[_AM] = a / 2.0
+        p[_AX] = SQRT3_2 * a
+        p[_BX] = b * INV_SQRT2
+        p[_BY] = b * INV_SQRT2
+        p[_INV_L] = 1.0 / self.characteristic_length(design, options)
+        for lo, name in ((_L1LO, "l1_limits"), (_L2LO, "l2_limits"), (_L3LO, "l3_limits")):
+            rng = options.get(name)
+            p[lo], p[lo + 1] = rng if rng is not None else (-math.inf, math.inf)
+        p[_ALO], p[_AHI] = options["alpha_range"]
+        p[_BLO], p[_BHI] = options["beta_range"]
+        p[_YLO], p[_YHI] = self.y_box(design, options)
+        return p
+
+    @property
+    def point_kernel(self):
+        return point_lci
+
+    def kernel_branch(self, options) -> str:
+        return IK_LABEL
+
+    def bounding_box(self, design, options):
+        """The workspace box (alpha_range, beta_range, Y box), with Y also clipped to the slab the l1 limits allow:
+        l1 is monotone in Y, so that slab is exact (spec §3.8: l1 in [80, 110] gives Y in [-37.5, 48] for the
+        placeholder dimensions)."""
+        ylo, yhi = self.y_box(design, options)
+        l1 = options.get("l1_limits")
+        if l1 is not None:
+            ylo = max(ylo, self.y_of_l1(design, l1[0]))
+            yhi = min(yhi, self.y_of_l1(design, l1[1]))
+        lo = np.array([options["alpha_range"][0], options["beta_range"][0], ylo])
+        hi = np.array([options["alpha_range"][1], options["beta_range"][1], yhi])
+        hi = np.maximum(hi, lo)
+        return lo, hi
+
+    # ----- NumPy kinematics (CLI, tests) ----------------------------------------------------------
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """The single IK branch (label 'Z+') as (l1, l2, l3) in mm; [] when |Y| > c. Ignores actuator limits."""
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        if abs(yy) > design["c"]:
+            return []
+        lengths, _ = _legs(design["a"], design["b"], design["c"], alpha, beta, yy)
+        return [Solution(IK_LABEL, np.array(lengths))]
+
+    def passive_joints(self, design, pose) -> dict[str, float]:
+        """Passive angles [rad] of the closed loop (spec §3.1): link angle alpha_L = -asin(Y/c), platform
+        revolute gamma = alpha - alpha_L."""
+        alpha, _, yy = self.check_vector("pose", pose, 3)
+        alpha_l = -math.asin(max(-1.0, min(1.0, yy / design["c"])))
+        return {"alpha_L": alpha_l, "gamma": float(alpha) - alpha_l}
+
+    def jacobians(self, design, options, pose, q=None) -> dict[str, np.ndarray | None]:
+        """Jx = dl/d(alpha, beta, Y) (spec §3.5's J; mm/rad, mm/rad, mm/mm), Jq = I (prismatic actuators, so
+        Jx xdot = Jq ldot) and the forward Jacobian J = Jx^-1 = d(alpha, beta, Y)/dl (None where Jx is singular
+        or undefined, i.e. |Y| = c or a zero-length leg). ``q`` is not needed: the legs follow from the pose."""
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        _, rows = _legs(design["a"], design["b"], design["c"], alpha, beta, yy)
+        jx = np.array(rows)
+        j = None
+        if np.all(np.isfinite(jx)):
+            try:
+                j = np.linalg.inv(jx)
+            except np.linalg.LinAlgError:
+                j = None
+        return {"Jx": jx, "Jq": np.eye(3), "J": j}
+
+    def singularity(self, design, options, pose, q=None, tol: float = 1e-7) -> str:
+        """'inverse', 'forward', 'both' or 'none' (scale-free tolerances).
+
+        * inverse: a leg of (near) zero length, l_i <= tol c (its direction, hence its constraint, is undefined).
+        * forward: with the actuators locked the platform keeps a first-order mobility. Two cases (spec §3.5):
+          rho <= tol c (|Y| -> c: the spheres |P| = c and |(2/3)P - M| = l1 touch, so B1 can slide in their
+          common tangent plane; Jx's Y column blows up there), or the (alpha, beta) block of rows l2, l3 is
+          singular (|sin| of the angle between its rows <= tol). The block test needs both UPS leg directions,
+          so it is skipped at a zero-length leg.
+        """
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        c = design["c"]
+        lengths, rows = _legs(design["a"], design["b"], c, alpha, beta, yy)
+        inverse = min(lengths) <= tol * c
+        rho = math.sqrt(max(c * c - yy * yy, 0.0))
+        forward = rho <= tol * c
+        if not inverse and not forward:
+            r2, r3 = rows[1][:2], rows[2][:2]
+            det = r2[0] * r3[1] - r2[1] * r3[0]
+            forward = abs(det) <= tol * math.hypot(*r2) * math.hypot(*r3)
+        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
+            (inverse, forward), "both"
+        )
+
+    def lci(self, design, options, pose, q=None) -> float:
+        """LCI = 1/kappa_2 of Jx diag(1/L, 1/L, 1) with NumPy's SVD (L = characteristic length); 0 at any
+        singularity. Ignores the actuator limits and the workspace box (the kernel applies them)."""
+        if self.singularity(design, options, pose, q, tol=0.0) != "none":
+            return 0.0
+        jx = self.jacobians(design, options, pose)["Jx"]
+        inv_l = 1.0 / self.characteristic_length(design, options)
+        sv = np.linalg.svd(jx * np.array([inv_l, inv_l, 1.0]), compute_uv=False)
+        return float(sv[-1] / sv[0])
+
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        """All Z > 0 assembly modes (alpha, beta, Y) of actuator lengths (l1, l2, l3) in mm. Ignores limits.
+
+        Y is closed form (spec §3.4); (alpha, beta) come from damped Newton iterations on (l2, l3) from a grid of
+        starts covering alpha in (-pi, pi], |beta| < pi/2 (the first start is (0, 0), as in the spec). Solutions are
+        labelled by the sign of det d(l2, l3)/d(alpha, beta): the home pose (0, 0, 0) lies in mode '-' for every
+        design, the spec's flipped-platform branch in mode '+'; a repeated sign gets an index ('-1', '-2'), a
+        (near) singular root is labelled '0'. [] when |Y| >= c or nothing converges.
+        """
+        l1, l2, l3 = self.check_vector("inputs", inputs, 3)
+        a, b, c = design["a"], design["b"], design["c"]
+        if l1 < 0.0 or l2 < 0.0 or l3 < 0.0:
+            return []
+        yy = self.y_of_l1(design, l1)
+        if not abs(yy) < c:
+            return []
+        scale = max(l2, l3, c)
+        found: list[tuple[float, float, float]] = []
+        for a0, b0 in _starts():
+            sol = _newton(a, b, c, yy, l2, l3, a0, b0, scale)
+            if sol is None:
+                continue
+            alpha, beta = _wrap(sol[0]), _wrap(sol[1])
+            if not math.cos(beta) > 0.0:
+                continue  # Z < 0 assembly
+            if any(abs(_wrap(alpha - f[0])) < 1e-7 and abs(beta - f[1]) < 1e-7 for f in found):
+                continue
+            _, rows = _legs(a, b, c, alpha, beta, yy)
+            r2, r3 = rows[1][:2], rows[2][:2]
+            det = r2[0] * r3[1] - r2[1] * r3[0]
+            sin_angle = det / (math.hypot(*r2) * math.hypot(*r3))
+            found.append((alpha, beta, 0.0 if abs(sin_angle) <= 1e-9 else math.copysign(1.0, det)))
+        found.sort(key=lambda f: (f[2], f[0], f[1]))
+        out = []
+        for alpha, beta, sign in found:
+            base = "0" if sign == 0.0 else ("-" if sign < 0 else "+")
+            same = [f for f in found if f[2] == sign]
+            label = base if len(same) == 1 else f"{base}{same.index((alpha, beta, sign)) + 1}"
+            out.append(Solution(label, np.array([alpha, beta, yy])))
+        return out
+
+
+def _starts():
+    """Newton starting points (alpha, beta) [rad]: (0, 0) first, then a 12 x 5 grid."""
+    yield 0.0, 0.0
+    for i in range(12):
+        for beta in (-1.2, -0.6, 0.0, 0.6, 1.2):
+            yield -math.pi + (i + 0.5) * (2.0 * math.pi / 12), beta
+
+
+def _newton(a, b, c, yy, t2, t3, alpha, beta, scale):
+    """Damped Newton for l2(alpha, beta) = t2, l3(alpha, beta) = t3 at fixed Y. Returns (alpha, beta) when the
+    residual reaches 1e-9 scale (it runs on until the residual stops decreasing), else None."""
+
+    def residual(al, be):
+        lengths, rows = _legs(a, b, c, al, be, yy)
+        return lengths[1] - t2, lengths[2] - t3, rows
+
+    g2, g3, rows = residual(alpha, beta)
+    norm = max(abs(g2), abs(g3))
+    for _ in range(60):
+        if norm <= 1e-13 * scale:
+            break
+        j11, j12 = rows[1][0], rows[1][1]
+        j21, j22 = rows[2][0], rows[2][1]
+        det = j11 * j22 - j12 * j21
+        if not abs(det) > 1e-14 * (abs(j11) + abs(j12)) * (abs(j21) + abs(j22)):
+            break  # (near) singular step: give up this start
+        da = (j22 * g2 - j12 * g3) / det
+        db = (j11 * g3 - j21 * g2) / det
+        step = 1.0
+        while True:
+            n2, n3, nrows = residual(alpha - step * da, beta - step * db)
+            new = max(abs(n2), abs(n3))
+            if new < norm or step < 1e-3:
+                break
+            step *= 0.5
+        if not new < norm:
+            break  # no progress: at the round-off floor or stuck
+        alpha, beta = alpha - step * da, beta - step * db
+        g2, g3, rows, norm = n2, n3, nrows, new
+    return (alpha, beta) if norm <= 1e-9 * scale else None
+
+
+MECHANISM = UpsSspr(
+    name="ups-sspr",
+    title="2-UPS/(S+SPR)R 2R1T parallel mechanism with a closed-loop unit (sorting, seed 003)",
+    seed="003",
+    motion="2R1T",
+    task_axes=("alpha", "beta", "Y"),
+    task_units=("angle", "angle", "length"),
+    joints=("l1", "l2", "l3"),
+    joint_units=("length", "length", "length"),
+    parameters=(
+        Parameter("a", 100.0, "base circumradius |A0A2| (mm); PLACEHOLDER, not in the paper"),
+        Parameter("b", 80.0, "platform leg |B1B2| = |B1B3| (mm); PLACEHOLDER, not in the paper"),
+        Parameter("c", 120.0, "SR link length l0 = |A0B1| (mm), from the paper"),
+    ),
+    options=(
+        Option("l1_limits", [80.0, 110.0], "[lo, hi] mm for the SPR actuator l1 (PLACEHOLDER), null = none"),
+        Option("l2_limits", [120.0, 220.0], "[lo, hi] mm for the UPS actuator l2 (PLACEHOLDER), null = none"),
+        Option("l3_limits", [120.0, 220.0], "[lo, hi] mm for the UPS actuator l3 (PLACEHOLDER), null = none"),
+        Option("alpha_range", [-0.5, 0.5], "[lo, hi] rad of the workspace box in alpha (within [-pi, pi])"),
+        Option("beta_range", [-0.5, 0.5], "[lo, hi] rad of the workspace box in beta (within [-pi/2, pi/2])"),
+        Option("Y_range", None, "[lo, hi] mm of the workspace box in Y, null = +-0.999 c (clipped to [-c, c])"),
+        Option(
+            "characteristic_length",
+            None,
+            "L in mm homogenising the Jacobian (angle columns / L) for the LCI, null = c",
+        ),
+    ),
+    default_length_unit="mm",
+)
