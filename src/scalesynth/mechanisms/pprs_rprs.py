@@ -428,6 +428,19 @@ def newton_fk(
         # no decrease along the Newton direction: a local minimum of |G| (no assembly) or the round-off floor
         alive[act[pending | bad]] = False
         done |= alive & (err <= tol)
+    # polish: converged rows take full Newton steps while the residual does not grow (down to round-off)
+    for _ in range(3):
+        rows = np.nonzero(done)[0]
+        if rows.size == 0:
+            break
+        with np.errstate(invalid="ignore", divide="ignore"):
+            jac = twist_jacobian(geo, chain_state(geo, X[rows], sigma)) @ euler_rate_map(X[rows])
+        fine = np.all(np.isfinite(jac), axis=(-2, -1))
+        rows, jac = rows[fine], jac[fine]
+        trial = X[rows] - np.einsum("nij,nj->ni", np.linalg.pinv(jac), res[rows])
+        tres, terr = residual(trial, rows)
+        keep = terr <= err[rows]
+        X[rows[keep]], res[rows[keep]], err[rows[keep]] = trial[keep], tres[keep], terr[keep]
     return X, done
 
 
@@ -550,7 +563,7 @@ class PprsRprs(Mechanism):
         return out
 
     def forward_kinematics(
-        self, design, options, inputs, *, guess=None, starts: int = 400, seed: int = 0
+        self, design, options, inputs, *, guess=None, starts: int = 200, seed: int = 0
     ) -> list[Solution]:
         """Assembly modes of inputs (w1, w2, beta, s1, s2, s3) in the working mode ``options.sigma``, as poses
         (x, y, z, phi, theta, psi), Euler duplicates normalised to theta in [-pi/2, pi/2].
