@@ -1,0 +1,146 @@
+"""``scalesynth drives``: actuator curves of the 2PPRS-RPRS (seed 001) along a closed square path E-F-G-H-E.
+
+The paper (§5, Figs. 6-7) moves O1 around a closed path at constant orientation and plots the six drive
+displacements over time; this command does the same from the closed-form IK, with continuation FK checking
+that the path stays in one assembly mode (``pprs_rprs.drive_curves``). Outputs, each written atomically:
+``drives.csv`` (t, x, y, z, w1, w2, beta, s1, s2, s3; mm, beta in rad, t = fraction of the loop at constant
+speed) and ``drives.png`` (one subplot per actuator).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import secrets
+from collections.abc import Callable
+from pathlib import Path
+from typing import IO, Annotated
+
+import numpy as np
+import typer
+
+from scalesynth.cli import _print_json, app, handles_errors
+from scalesynth.errors import ConfigError, InvalidPose
+
+CSV_COLUMNS = ("t", "x", "y", "z", "w1", "w2", "beta", "s1", "s2", "s3")
+# At z = 200 mm the cross-section of the primary workspace is a diagonal band: the largest axis-parallel square
+# that fits is about 30.9 mm, centred near (-41, -25); a 20 mm square there keeps about 5 mm of margin.
+DEFAULT_CENTER = "-40,-25"
+
+
+def square_path(center: tuple[float, float], side: float, z: float) -> np.ndarray:
+    """Corners E, F, G, H (counter-clockwise from the lower left) of an axis-parallel square at height z (mm)."""
+    cx, cy = center
+    a = 0.5 * side
+    return np.array([[cx - a, cy - a, z], [cx + a, cy - a, z], [cx + a, cy + a, z], [cx - a, cy + a, z]])
+
+
+def _atomic_write(path: Path, write: Callable[[IO[bytes]], None]) -> None:
+    """Write through a temporary file in the same directory, then rename it over ``path``."""
+    # open(..., "xb") rather than mkstemp: the result gets the usual umask permissions, not 0600
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    try:
+        with open(tmp, "xb") as fh:
+            write(fh)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def write_csv(path: Path, curves) -> None:
+    table = np.column_stack([curves.t, curves.points, curves.q])
+    lines = [",".join(CSV_COLUMNS)]
+    lines += [",".join(f"{v:.12g}" for v in row) for row in table]
+    _atomic_write(path, lambda fh: fh.write(("\n".join(lines) + "\n").encode()))
+
+
+def write_plot(path: Path, curves, corners: list[tuple[str, float]]) -> None:
+    """Six subplots (w1, w2, beta in deg, s1, s2, s3) over t, the path's corners marked."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 8), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(3, 2, sharex=True)
+    labels = ("w1 (mm)", "w2 (mm)", "beta (deg)", "s1 (mm)", "s2 (mm)", "s3 (mm)")
+    for k, ax in enumerate(axes.T.ravel()):
+        values = np.degrees(curves.q[:, k]) if k == 2 else curves.q[:, k]
+        ax.plot(curves.t, values, lw=1.5)
+        ax.set_ylabel(labels[k])
+        for name, t in corners:
+            ax.axvline(t, color="0.8", lw=0.8, zorder=0)
+            ax.annotate(name, (t, 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom", fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("t (fraction of the loop)")
+    fig.suptitle("2PPRS-RPRS drive displacements along E-F-G-H-E")
+    _atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=120))
+
+
+def _parse_center(text: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InvalidPose(f"--center: expected x,y in mm, got {text!r}") from None
+    if not (np.isfinite(x) and np.isfinite(y)):
+        raise InvalidPose(f"--center: expected finite x,y, got {text!r}")
+    return x, y
+
+
+@app.command("drives")
+@handles_errors
+def drives_cmd(
+    config: Annotated[Path, typer.Argument(help="run config (YAML) of a pprs-rprs design")],
+    z: Annotated[float, typer.Option("--z", help="height of the square path (mm)")] = 200.0,
+    side: Annotated[float, typer.Option("--side", help="side of the square (mm)")] = 20.0,
+    center: Annotated[str, typer.Option("--center", help="centre x,y of the square (mm)")] = DEFAULT_CENTER,
+    samples: Annotated[int, typer.Option("--samples", help="samples along the closed path")] = 400,
+    out: Annotated[Path | None, typer.Option("--out", help="output directory (default: <run dir>/drives)")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
+) -> None:
+    """Drive-displacement curves of a pprs-rprs design along a closed square E-F-G-H-E: drives.csv, drives.png."""
+    from scalesynth.config import load_config
+    from scalesynth.mechanisms.pprs_rprs import MECHANISM, drive_curves
+
+    cfg = load_config(config)
+    if cfg.mechanism != MECHANISM.name:
+        raise ConfigError(f"mechanism: drives needs {MECHANISM.name}, got {cfg.mechanism!r}")
+    if not (np.isfinite(side) and side > 0):
+        raise InvalidPose(f"--side: must be a positive length in mm, got {side:g}")
+    if not np.isfinite(z):
+        raise InvalidPose(f"--z: must be finite, got {z:g}")
+    if samples < 2:
+        raise InvalidPose(f"--samples: need at least 2, got {samples}")
+    corners = square_path(_parse_center(center), side, z)
+    curves = drive_curves(cfg.resolved_design(), cfg.resolved_options(), corners, samples)
+    out_dir = out if out is not None else cfg.output_dir() / "drives"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    csv_path, png_path = out_dir / "drives.csv", out_dir / "drives.png"
+    write_csv(csv_path, curves)
+    marks = [(name, k / 4) for k, name in enumerate("EFGHE")]
+    write_plot(png_path, curves, marks)
+    summary = {
+        "csv": str(csv_path),
+        "png": str(png_path),
+        "corners": {name: [float(v) for v in c] for name, c in zip("EFGH", corners, strict=True)},
+        "samples": int(curves.t.size),
+        "ranges": {
+            name: [float(curves.q[:, k].min()), float(curves.q[:, k].max())]
+            for k, name in enumerate(MECHANISM.joints)
+        },
+        "min_lci": float(curves.lci.min()),
+        "fk_error": curves.fk_error,
+    }
+    if as_json:
+        _print_json(summary)
+        return
+    typer.echo(
+        "square " + " -> ".join(f"{n}({c[0]:g}, {c[1]:g}, {c[2]:g})" for n, c in summary["corners"].items())
+        + f" -> E, {summary['samples']} samples"
+    )
+    for name, (lo, hi) in summary["ranges"].items():
+        unit = "rad" if name == "beta" else "mm"
+        typer.echo(f"  {name:<5} {lo:10.4f} .. {hi:10.4f} {unit}")
+    typer.echo(f"  min LCI on the path {summary['min_lci']:.4f}; continuation FK error {curves.fk_error:.2e} mm")
+    typer.echo(f"wrote {csv_path} and {png_path}")
