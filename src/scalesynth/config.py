@@ -7,6 +7,7 @@ Every validation problem becomes a one-line ConfigError that names the field pat
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any, Literal
 
@@ -250,6 +251,8 @@ def _format_validation_error(err: ValidationError) -> str:
     msg = msg.removeprefix("Value error, ")
     if first["type"] == "extra_forbidden":
         msg = "unknown key"
+    if loc and re.match(r"^[\w.\[\]-]+: ", msg):
+        return f"{loc}.{msg}"  # a validator that names the entry inside the field, e.g. design + "l1: ..."
     return f"{loc}: {msg}" if loc else msg
 
 
