@@ -16,8 +16,8 @@ import numpy as np
 from numba import njit, prange
 
 from scalesynth.errors import InvalidParameter
-from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
 
