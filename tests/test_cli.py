@@ -1,4 +1,4 @@
-"""CLI contract (DESIGN.md): --json prints one JSON object and nothing else on stdout; exit 0 / 2 with one-line errors."""
+"""CLI contract (DESIGN.md): --json prints one JSON object, nothing else; exit 0 or 2 with one-line errors."""
 
 import json
 import os
