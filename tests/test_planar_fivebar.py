@@ -223,6 +223,7 @@ TWIN_CASES = [
     (ILLUSTRATIVE, {"mode": "--"}),
     (ILLUSTRATIVE, LIMITS),
     (ILLUSTRATIVE, {"alpha2_limits": [-3.5, -1.0], "mode": "++"}),
+    (ILLUSTRATIVE, {"alpha1_limits": [-1.0, 3.0], "alpha2_limits": [2.0, 8.0], "mode": "--"}),  # wider than pi
     (dict(r=100.0, l1=900.0, l2=500.0), {"alpha1_limits": [-2.0, 0.5]}),  # l1 > l2: a hole around each pivot
     (dict(r=380.0, l1=260.0, l2=520.0), {"mode": "-+"}),
 ]
@@ -245,6 +246,25 @@ def test_kernel_matches_numpy_twin(design, options):
     assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
     assert rep.gci == pytest.approx(ref["gci"], rel=1e-9)
     assert rep.metrics["fci"] == pytest.approx(ref["fci"], rel=1e-7)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-2 * math.pi, 2 * math.pi), st.floats(0.05, 7.0), st.sampled_from(["alpha1_limits", "alpha2_limits"]))
+def test_arm_limits_modulo_two_pi_match_twin(lo, width, name):
+    """The kernel's atan2-free arc test agrees with the twin's (alpha - lo) mod 2 pi <= hi - lo, for intervals
+    anywhere, narrower or wider than pi, or a full turn and more (no restriction)."""
+    opts = M.resolve_options({name: [lo, lo + width]})
+    rng = np.random.default_rng(7)
+    xy = rng.uniform(-1150, 1150, size=(400, 2))
+    lci = kgrid.points_lci(M.point_kernel, M.pack(DESIGN, opts), np.c_[xy, np.zeros(400)])
+    twin = fivebar_lci(DESIGN, opts, xy[:, 0], xy[:, 1])
+    alpha = fivebar_arm_angles(DESIGN, opts, xy[:, 0], xy[:, 1])[0 if name == "alpha1_limits" else 1]
+    with np.errstate(invalid="ignore"):
+        gap = np.minimum(np.abs(np.sin(alpha - lo)), np.abs(np.sin(alpha - lo - width)))
+    clear = ~(gap < 1e-9)  # a point on a limit may fall either way by round-off
+    assert np.array_equal((lci >= 0)[clear], (twin >= 0)[clear])
+    if width >= 2 * math.pi:
+        assert np.array_equal(lci >= 0, kgrid.points_lci(M.point_kernel, PACKED, np.c_[xy, np.zeros(400)]) >= 0)
 
 
 def test_bounding_box_is_tight_and_contains_fk_samples():

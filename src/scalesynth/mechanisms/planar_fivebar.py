@@ -15,6 +15,9 @@ forward Jacobian J = Jx^-1 Jq (mm/rad), which the paper states with the spectral
 
 Arm limits are [lo, hi] intervals in rad taken modulo 2 pi, so an interval may extend past pi: the spec's
 corrected limits are alpha1 in [-4 pi/9, 7 pi/36] and alpha2 in [29 pi/36, 13 pi/9] (§2.5).
+
+The point kernel calls no trigonometric function, limits included (cross products against the limit
+directions): cos/sin of the arm angles come from the law of cosines in algebraic form.
 """
 
 from __future__ import annotations
@@ -34,15 +37,17 @@ from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, p
 MODES = ("++", "+-", "-+", "--")
 TWO_PI = 2.0 * math.pi
 
-# packed-parameter layout (see PlanarFivebar.pack); an arm limit is stored as its lower end and its width
+# packed-parameter layout (see PlanarFivebar.pack); arm limit i occupies 6 slots from _LIM[i]:
+# has, cos lo, sin lo, cos hi, sin hi, wide (1 if hi - lo > pi)
 _R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
-_A1LO, _A1W, _A2LO, _A2W, _HAS1, _HAS2 = 5, 6, 7, 8, 9, 10
-N_PACKED = 11
+_LIM1, _LIM2 = 5, 11
+N_PACKED = 17
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
 def _arm(u, y, l1, l2, sigma):
-    """cos(alpha), sin(alpha) of one chain's IK root sigma, without transcendental calls, and the root gap S.
+    """cos(alpha), sin(alpha) of one chain's IK root sigma, without transcendental calls, and
+    S = sqrt(D^2 + E^2 - F^2), the discriminant of spec §2.2.
 
     (u, y) = P - B_i. With rho^2 = u^2 + y^2 and K = rho^2 + l1^2 - l2^2 (law of cosines),
     alpha = atan2(y, u) + sigma * arccos(K / (2 l1 rho)); expanding cos/sin of that sum gives
@@ -64,11 +69,19 @@ def _arm(u, y, l1, l2, sigma):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _angle_in(c, s, lo, width):
-    """True if the angle with cosine c and sine s lies in [lo, lo + width] modulo 2 pi."""
-    d = math.atan2(s, c) - lo
-    d -= TWO_PI * math.floor(d / TWO_PI)
-    return d <= width
+def _arc_ok(p, k, c, s):
+    """True if the angle with cosine c and sine s lies in arm limit k (slots p[k:k+6]), modulo 2 pi.
+
+    No atan2: with a = the angle, sin(a - lo) >= 0 and sin(hi - a) >= 0 (two cross products) select [lo, hi] when
+    hi - lo <= pi; a wider interval is the complement of an arc narrower than pi, so either test suffices.
+    """
+    if p[k] <= 0.0:
+        return True
+    after_lo = p[k + 1] * s - p[k + 2] * c >= 0.0
+    before_hi = c * p[k + 4] - s * p[k + 3] >= 0.0
+    if p[k + 5] > 0.0:
+        return after_lo or before_hi
+    return after_lo and before_hi
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -85,9 +98,7 @@ def point_lci(p, x, y, z):
     ok2, c2, s2, g2 = _arm(u2, y, l1, l2, p[_S2])
     if not ok2:
         return -1.0
-    if p[_HAS1] > 0.0 and not _angle_in(c1, s1, p[_A1LO], p[_A1W]):
-        return -1.0
-    if p[_HAS2] > 0.0 and not _angle_in(c2, s2, p[_A2LO], p[_A2W]):
+    if not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
         return -1.0
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
@@ -117,15 +128,11 @@ class PlanarFivebar(Mechanism):
         mode = options["mode"]
         p[_S1] = 1.0 if mode[0] == "+" else -1.0
         p[_S2] = 1.0 if mode[1] == "+" else -1.0
-        for name, lo_i, w_i, has_i in (
-            ("alpha1_limits", _A1LO, _A1W, _HAS1),
-            ("alpha2_limits", _A2LO, _A2W, _HAS2),
-        ):
+        for name, k in (("alpha1_limits", _LIM1), ("alpha2_limits", _LIM2)):
             lim = options.get(name)
-            if lim is not None:
-                p[lo_i] = lim[0]
-                p[w_i] = lim[1] - lim[0]
-                p[has_i] = 1.0
+            if lim is not None and lim[1] - lim[0] < TWO_PI:  # a full turn or more restricts nothing
+                lo, hi = lim
+                p[k : k + 6] = (1.0, math.cos(lo), math.sin(lo), math.cos(hi), math.sin(hi), hi - lo > math.pi)
         return p
 
     @property
