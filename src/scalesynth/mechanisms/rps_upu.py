@@ -1,0 +1,718 @@
+"""2-RPS-UPU parallel mechanism with two rotations and one translation (2R1T, seed 002), spec
+``mechanisms_001_003.md`` §2.
+
+Geometry (mm, rad): base joints A1 = (0, -g, 0), A2 = (0, g, 0), A3 = (e, 0, 0) with O the midpoint of A1A2
+(erratum F1); platform points B1' = (0, -h, 0), B2' = (0, h, 0), B3' = (c, 0, 0). Inputs are the three leg
+lengths q_i = |A_i B_i| (mm); the task coordinates are (z, theta, psi): the height of the platform origin O' and
+the Euler angles about y and x.
+
+Two models (spec §2.3):
+
+* ``P`` (default) reproduces the paper's numbers: p = (0, 0, z), R = Ry(theta) Rx(psi). It violates the RPS
+  joint constraints (B1 and B2 leave the plane x = 0), but it is what the paper computed with.
+* ``C`` is constraint-consistent: x0 = 0 and R[0, 1] = 0, which adds a parasitic yaw
+  phi = atan2(sin theta sin psi, cos psi), R = Rz(phi) Ry(theta) Rx(psi), and a parasitic y0 that depends on the
+  chain-3 variant: ``plane`` keeps B3 in y = 0 (y0 = -c R[1, 0]); ``upu`` has the fixed U axis parallel to x
+  through A3 and the platform U axis parallel to w (y0 = R[1, 2] (z + c R[2, 0]) / R[2, 2] - c R[1, 0]).
+
+The LCI is 1/kappa_2 of the homogenised Jacobian dq/d(z, L theta, L psi): the angle columns of dq/d(z, theta, psi)
+(mm/rad) are divided by the characteristic length L (option ``characteristic_length``, default h), which is the
+same as measuring angular rates by the tangential speed L omega; the homogenised matrix is dimensionless.
+
+Singularities: ``inverse`` when a leg length vanishes (q_i = 0: the leg direction is undefined), ``forward``
+when the rows of the constraint Jacobian become dependent (det dq/dx = 0: assembly modes merge).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.kernels.conditioning import lci_3x3
+from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+
+MODELS = ("P", "C")
+C3_VARIANTS = ("plane", "upu")
+BRANCH = "+++"  # the only IK branch: every leg length is the positive root q_i = |A_i B_i|
+
+# packed-parameter layout (see RpsUpu.pack)
+_G, _H, _C, _E, _MODEL_C, _UPU, _QLO, _QHI, _INV_L = range(9)
+N_PACKED = 9
+
+# a parametrisation is degenerate below these (dimensionless) values: yaw undefined (cos psi = 0 with
+# sin theta sin psi = 0), or, for the upu variant, R[2, 2] = cos theta cos psi = 0 (y0 unbounded)
+_YAW_EPS2 = 1e-24
+_R22_EPS = 1e-12
+
+
+# ----- point kernel ---------------------------------------------------------------------------------------
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _p_model_rows(g, h, c, e, z, st, ct, sp, cp):
+    """Squared leg lengths and the rows of q_i dq_i/d(z, theta, psi) of the P-model, spec §2.3 and §2.5."""
+    a = g * g + h * h + z * z - 2.0 * g * h * cp
+    b = 2.0 * h * z * ct * sp
+    q1s = a - b
+    q2s = a + b
+    q3s = c * c + e * e + z * z - 2.0 * c * e * ct - 2.0 * c * z * st
+    hz = h * z
+    r11 = z - h * ct * sp
+    r12 = hz * st * sp
+    r13 = g * h * sp - hz * ct * cp
+    r21 = z + h * ct * sp
+    r23 = g * h * sp + hz * ct * cp
+    r31 = z - c * st
+    r32 = c * e * st - c * z * ct
+    return True, q1s, q2s, q3s, r11, r12, r13, r21, -r12, r23, r31, r32, 0.0
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
+    """Squared leg lengths and the rows of q_i dq_i/d(z, theta, psi) of the C-model (spec §2.3).
+
+    Every leg vector d_i = B_i - A_i is differentiated by the chain rule through the parasitic yaw (its sine
+    and cosine sf = N/n, cf = M/n with N = sin theta sin psi, M = cos psi, n = |(N, M)| = R[1, 1]) and y0; the
+    row is d_i . dB_i/dx. Returns ok = False where the parametrisation is degenerate.
+    """
+    nn = st * sp
+    mm = cp
+    n2 = nn * nn + mm * mm
+    if n2 < _YAW_EPS2:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    n = math.sqrt(n2)
+    sf = nn / n
+    cf = mm / n
+    # derivatives of n, sf, cf with respect to theta (_t) and psi (_p)
+    n_t = nn * ct * sp / n
+    n_p = -sp * cp * ct * ct / n
+    sf_t = (ct * sp * n - nn * n_t) / n2
+    sf_p = (st * cp * n - nn * n_p) / n2
+    cf_t = -mm * n_t / n2
+    cf_p = (-sp * n - mm * n_p) / n2
+    r10 = sf * ct
+    r10_t = sf_t * ct - sf * st
+    r10_p = sf_p * ct
+    if upu:
+        r22 = ct * cp
+        if abs(r22) < _R22_EPS:
+            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        r12 = sf * st * cp - cf * sp
+        r12_t = sf_t * st * cp + sf * ct * cp - cf_t * sp
+        r12_p = sf_p * st * cp - sf * st * sp - cf_p * sp - cf * cp
+        r22_t = -st * cp
+        r22_p = -ct * sp
+        w = z - c * st  # z + c R[2, 0]
+        w_t = -c * ct
+        y0 = r12 * w / r22 - c * r10
+        y0_z = r12 / r22
+        y0_t = (r12_t * w + r12 * w_t) / r22 - r12 * w * r22_t / (r22 * r22) - c * r10_t
+        y0_p = r12_p * w / r22 - r12 * w * r22_p / (r22 * r22) - c * r10_p
+    else:
+        y0 = -c * r10
+        y0_z = 0.0
+        y0_t = -c * r10_t
+        y0_p = -c * r10_p
+    # chains 1 and 2: B_i stays in x = 0, d = (0, y0 -+ h n +- g, z -+ h cos theta sin psi)
+    d1y = y0 - h * n + g
+    d1z = z - h * ct * sp
+    d2y = y0 + h * n - g
+    d2z = z + h * ct * sp
+    # chain 3: d3 = (c cf cos theta - e, y0 + c R[1, 0], z - c sin theta)
+    d3x = c * cf * ct - e
+    d3y = y0 + c * r10
+    d3z = z - c * st
+    q1s = d1y * d1y + d1z * d1z
+    q2s = d2y * d2y + d2z * d2z
+    q3s = d3x * d3x + d3y * d3y + d3z * d3z
+    r11 = d1y * y0_z + d1z
+    r12_ = d1y * (y0_t - h * n_t) + d1z * (h * st * sp)
+    r13 = d1y * (y0_p - h * n_p) + d1z * (-h * ct * cp)
+    r21 = d2y * y0_z + d2z
+    r22_ = d2y * (y0_t + h * n_t) + d2z * (-h * st * sp)
+    r23 = d2y * (y0_p + h * n_p) + d2z * (h * ct * cp)
+    r31 = d3y * y0_z + d3z
+    r32 = d3x * c * (cf_t * ct - cf * st) + d3y * (y0_t + c * r10_t) + d3z * (-c * ct)
+    r33 = d3x * c * cf_p * ct + d3y * (y0_p + c * r10_p)
+    return True, q1s, q2s, q3s, r11, r12_, r13, r21, r22_, r23, r31, r32, r33
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_ok(qs, lo, hi):
+    """(within limits, q) for a squared leg length; tiny negative round-off of a squared norm is clamped."""
+    q = math.sqrt(qs) if qs > 0.0 else 0.0
+    return lo <= q <= hi, q
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z):
+    """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
+    length leaves the stroke limits or the parametrisation is degenerate (C-model)."""
+    g = p[_G]
+    h = p[_H]
+    c = p[_C]
+    e = p[_E]
+    st = math.sin(y)
+    ct = math.cos(y)
+    sp = math.sin(z)
+    cp = math.cos(z)
+    if p[_MODEL_C] > 0.0:
+        ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _c_model_rows(
+            g, h, c, e, p[_UPU] > 0.0, x, st, ct, sp, cp
+        )
+        if not ok:
+            return -1.0
+    else:
+        ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _p_model_rows(g, h, c, e, x, st, ct, sp, cp)
+    lo = p[_QLO]
+    hi = p[_QHI]
+    ok1, q1 = _leg_ok(q1s, lo, hi)
+    ok2, q2 = _leg_ok(q2s, lo, hi)
+    ok3, q3 = _leg_ok(q3s, lo, hi)
+    if not (ok1 and ok2 and ok3):
+        return -1.0
+    if q1 == 0.0 or q2 == 0.0 or q3 == 0.0:
+        return 0.0  # inverse singularity: a leg of zero length has no direction
+    # row i of dq/dx is (q_i dq_i/dx) / q_i; the angle columns are divided by L (homogenisation)
+    i1 = 1.0 / q1
+    i2 = 1.0 / q2
+    i3 = 1.0 / q3
+    il = p[_INV_L]
+    return lci_3x3(
+        a11 * i1, a12 * i1 * il, a13 * i1 * il,
+        a21 * i2, a22 * i2 * il, a23 * i2 * il,
+        a31 * i3, a32 * i3 * il, a33 * i3 * il,
+    )  # fmt: skip
+
+
+# ----- NumPy kinematics (vectorised over poses; CLI, FK and tests) ----------------------------------------
+def _rot(axis: str, a: np.ndarray) -> np.ndarray:
+    """Stack of active rotation matrices about a fixed axis, shape (n, 3, 3)."""
+    c, s = np.cos(a), np.sin(a)
+    o, z = np.ones_like(a), np.zeros_like(a)
+    if axis == "x":
+        rows = ((o, z, z), (z, c, -s), (z, s, c))
+    elif axis == "y":
+        rows = ((c, z, s), (z, o, z), (-s, z, c))
+    else:
+        rows = ((c, -s, z), (s, c, z), (z, z, o))
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def _skew(w: np.ndarray) -> np.ndarray:
+    """[w]x for a stack of vectors (n, 3) -> (n, 3, 3)."""
+    z = np.zeros(w.shape[0])
+    rows = ([z, -w[:, 2], w[:, 1]], [w[:, 2], z, -w[:, 0]], [-w[:, 1], w[:, 0], z])
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def _platform(geom: tuple, model: str, variant: str, x: np.ndarray):
+    """Platform pose of task points x (n, 3) = (z, theta, psi).
+
+    Returns (valid (n,), p (n, 3), R (n, 3, 3), phi (n,), T (n, 6, 3)) where T = d(v, omega)/d(z, theta, psi)
+    maps task rates to the platform twist (v: velocity of O', omega: angular velocity, fixed frame). It carries the
+    parasitic yaw rate and y0 rate of the C-model (spec §2.5): omega = phi' z + theta' Rz y + psi' Rz Ry x.
+    """
+    _, _, c, _ = geom
+    z, th, ps = x[:, 0], x[:, 1], x[:, 2]
+    n = x.shape[0]
+    st, ct, sp, cp = np.sin(th), np.cos(th), np.sin(ps), np.cos(ps)
+    valid = np.ones(n, dtype=bool)
+    if model == "P":
+        phi = np.zeros(n)
+        phi_t = phi_p = np.zeros(n)
+    else:
+        n2 = (st * sp) ** 2 + cp**2
+        valid &= n2 >= _YAW_EPS2
+        n2 = np.where(valid, n2, 1.0)
+        phi = np.arctan2(st * sp, cp)
+        phi_t = cp * ct * sp / n2
+        phi_p = st / n2
+    rz, ry, rx = _rot("z", phi), _rot("y", th), _rot("x", ps)
+    rzy = rz @ ry
+    R = rzy @ rx
+    ez = np.array([0.0, 0.0, 1.0])
+    w_t = phi_t[:, None] * ez + rz[:, :, 1]
+    w_p = phi_p[:, None] * ez + rzy[:, :, 0]
+    dR_t = _skew(w_t) @ R
+    dR_p = _skew(w_p) @ R
+    y0 = np.zeros(n)
+    dy = np.zeros((n, 3))  # d y0 / d(z, theta, psi)
+    if model == "C" and variant == "plane":
+        y0 = -c * R[:, 1, 0]
+        dy[:, 1] = -c * dR_t[:, 1, 0]
+        dy[:, 2] = -c * dR_p[:, 1, 0]
+    elif model == "C":
+        r22 = R[:, 2, 2]
+        valid &= np.abs(r22) >= _R22_EPS
+        r22 = np.where(valid, r22, 1.0)
+        w = z + c * R[:, 2, 0]
+        y0 = R[:, 1, 2] * w / r22 - c * R[:, 1, 0]
+        dy[:, 0] = R[:, 1, 2] / r22
+        for k, dR in ((1, dR_t), (2, dR_p)):
+            dw = c * dR[:, 2, 0]  # d(z + c R[2, 0]) for the angles
+            quotient = (dR[:, 1, 2] * w + R[:, 1, 2] * dw) / r22 - R[:, 1, 2] * w * dR[:, 2, 2] / r22**2
+            dy[:, k] = quotient - c * dR[:, 1, 0]
+    p = np.stack([np.zeros(n), y0, z], axis=-1)
+    T = np.zeros((n, 6, 3))
+    T[:, 1, :] = dy
+    T[:, 2, 0] = 1.0
+    T[:, 3:, 1] = w_t
+    T[:, 3:, 2] = w_p
+    return valid, p, R, phi, T
+
+
+def _legs(geom: tuple, model: str, variant: str, x: np.ndarray):
+    """Leg vectors and Jacobians at task points x (n, 3).
+
+    Returns (valid, q (n, 3), jx (n, 3, 3)) with jx[:, i] = q_i dq_i/d(z, theta, psi) from the twist form
+    q_i q_i' = d_i . v + (r_i x d_i) . omega (spec §0, §2.5) composed with T; d_i = B_i - A_i, r_i = R b_i'.
+    """
+    g, h, c, e = geom
+    valid, p, R, _, T = _platform(geom, model, variant, x)
+    a = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+    b = np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]])
+    r = np.einsum("nij,kj->nki", R, b)  # (n, leg, xyz)
+    d = p[:, None, :] + r - a[None]
+    q = np.sqrt(np.einsum("nki,nki->nk", d, d))
+    screw = np.concatenate([d, np.cross(r, d)], axis=-1)  # (n, leg, 6)
+    jx = screw @ T
+    return valid, q, jx
+
+
+def _wrap(a):
+    """Angles in (-pi, pi]."""
+    w = np.arctan2(np.sin(a), np.cos(a))
+    return np.where(w == -np.pi, np.pi, w)
+
+
+# ----- forward kinematics -----------------------------------------------------------------------------------
+def _p_angles(geom: tuple, q: np.ndarray, z: np.ndarray, cos_theta: np.ndarray, sin_theta: np.ndarray) -> np.ndarray:
+    """Complete P-model candidates (z, theta, psi) from z and theta (spec §2.4): cos psi from q1^2 + q2^2,
+    sin psi = D / (h z cos theta). Where h z cos theta vanishes (then D = 0 too) both signs of sin psi are
+    returned. Candidates with |cos psi| > 1 are dropped; the caller polishes the rest by Newton."""
+    g, h, _, _ = geom
+    s = 0.5 * (q[0] ** 2 + q[1] ** 2)
+    d = 0.25 * (q[1] ** 2 - q[0] ** 2)
+    out = []
+    for zi, ct, st in zip(z, cos_theta, sin_theta, strict=True):
+        cp = (g * g + h * h + zi * zi - s) / (2.0 * g * h)
+        if abs(cp) > 1.0 + 1e-7:
+            continue
+        cp = min(1.0, max(-1.0, cp))
+        den = h * zi * ct
+        if abs(den) > 1e-9 * h * max(zi, 1.0):
+            sps = [d / den]
+        else:
+            sps = [math.sqrt(1.0 - cp * cp), -math.sqrt(1.0 - cp * cp)]
+        th = math.atan2(st, ct)
+        out.extend((zi, th, math.atan2(sp, cp)) for sp in sps)
+    return np.array(out, dtype=float).reshape(-1, 3)
+
+
+def fk_p_quartic(geom: tuple, q) -> np.ndarray:
+    """Unpolished P-model FK candidates for e = 0 from the quartic in t = z^2 (spec §2.4):
+
+    (t - S + (g - h)^2)(t - S + (g + h)^2)(t - (c + q3)^2)(t - (c - q3)^2) = 16 g^2 c^2 D^2,
+    S = (q1^2 + q2^2)/2, D = (q2^2 - q1^2)/4; then sin theta = (c^2 + t - q3^2)/(2 c z) with both signs of
+    cos theta (the theta <-> pi - theta mirror). Only z > 0 is returned: every solution (z, theta, psi) has the
+    mirror image (-z, -theta, -psi) through the base plane. Shape (k, 3).
+    """
+    g, h, c, e = geom
+    if e != 0.0:
+        raise ValueError("fk_p_quartic: the quartic holds for e = 0 only; use fk_p_bracket")
+    q = np.asarray(q, dtype=float)
+    s = 0.5 * (q[0] ** 2 + q[1] ** 2)
+    d = 0.25 * (q[1] ** 2 - q[0] ** 2)
+    factors = np.array([s - (g - h) ** 2, s - (g + h) ** 2, (c + q[2]) ** 2, (c - q[2]) ** 2])
+    # scale t so that the coefficients are O(1): t^4 ~ 1e16 mm^8 otherwise
+    scale = max(float(np.abs(factors).max()), 1e-300)
+    coef = np.poly(factors / scale)
+    coef[-1] -= (4.0 * g * c * d) ** 2 / scale**4
+    roots = np.roots(coef)
+    real = roots[np.abs(roots.imag) <= 1e-6 * np.maximum(1.0, np.abs(roots))].real
+    dcoef = np.polyder(coef)
+    for _ in range(3):  # Newton on the polynomial: restores full precision after the eigenvalue solver
+        dp = np.polyval(dcoef, real)
+        real = real - np.where(dp != 0.0, np.polyval(coef, real) / np.where(dp != 0.0, dp, 1.0), 0.0)
+    t = real[real > 0.0] * scale
+    z, st, ct = [], [], []
+    for ti in t:
+        zi = math.sqrt(ti)
+        sth = (c * c + ti - q[2] ** 2) / (2.0 * c * zi)
+        if abs(sth) > 1.0 + 1e-7:
+            continue
+        sth = min(1.0, max(-1.0, sth))
+        cth = math.sqrt(1.0 - sth * sth)
+        for sign in (1.0, -1.0):
+            z.append(zi)
+            st.append(sth)
+            ct.append(sign * cth)
+    return _p_angles(geom, q, np.array(z), np.array(ct), np.array(st))
+
+
+def _p_branch_residual(geom: tuple, q: np.ndarray, z: np.ndarray, branch: float):
+    """F(z) = D^2 - (h z cos theta)^2 (1 - cos^2 psi) on one theta branch of the q3 equation (any e):
+    theta = atan2(z, e) + branch * arccos(K / (c r)), K = (c^2 + e^2 + z^2 - q3^2)/2, r = |(e, z)|.
+    F = 0 is cos^2 psi + sin^2 psi = 1 with sin psi = D / (h z cos theta), free of poles. Returns (F, theta)."""
+    g, h, c, e = geom
+    s = 0.5 * (q[0] ** 2 + q[1] ** 2)
+    d = 0.25 * (q[1] ** 2 - q[0] ** 2)
+    r = np.hypot(e, z)
+    k = 0.5 * (c * c + e * e + z * z - q[2] ** 2)
+    arg = np.clip(k / (c * np.maximum(r, 1e-300)), -1.0, 1.0)
+    theta = np.arctan2(z, e) + branch * np.arccos(arg)
+    cp = np.clip((g * g + h * h + z * z - s) / (2.0 * g * h), -1.0, 1.0)
+    return d * d - (h * z * np.cos(theta)) ** 2 * (1.0 - cp * cp), theta
+
+
+def fk_p_bracket(geom: tuple, q, samples: int = 2048) -> np.ndarray:
+    """Unpolished P-model FK candidates for any e by root bracketing in z (spec §2.4, ``P_fk_all``).
+
+    On z^2 in [max((c - q3)^2 - e^2, S - (g + h)^2), min((c + q3)^2 - e^2, S - (g - h)^2)] both theta branches of
+    the q3 equation and cos psi are real; the ends are where the branches join or |cos psi| = 1. Each branch's
+    F(z) (see ``_p_branch_residual``) is sampled at ``samples`` points and every sign change bisected; the
+    samples around each local minimum of |F| below 1 % of max |F| are added as candidates, so that a pair of roots
+    closer than the sample step (next to a forward singularity) still gets a start for the Newton polish.
+    z > 0 only.
+    """
+    g, h, c, e = geom
+    q = np.asarray(q, dtype=float)
+    s = 0.5 * (q[0] ** 2 + q[1] ** 2)
+    t_lo = max((c - q[2]) ** 2 - e * e, s - (g + h) ** 2, 0.0)
+    t_hi = min((c + q[2]) ** 2 - e * e, s - (g - h) ** 2)
+    if not t_hi > t_lo:
+        return np.zeros((0, 3))
+    zs = np.linspace(math.sqrt(t_lo), math.sqrt(t_hi), samples)
+    z_out, th_out = [], []
+    for branch in (1.0, -1.0):
+        f, _ = _p_branch_residual(geom, q, zs, branch)
+        # a pair of roots closer than the sample step shows as a local minimum of |F| without a sign change:
+        # its neighbourhood goes to the Newton polish as extra candidates
+        af = np.abs(f)
+        small = af[1:-1] <= 1e-2 * af.max()
+        dip = np.nonzero(small & (af[1:-1] < af[:-2]) & (af[1:-1] < af[2:]))[0] + 1
+        for k in dip:
+            near = zs[max(k - 1, 0) : k + 2]
+            _, theta = _p_branch_residual(geom, q, near, branch)
+            z_out.extend(near)
+            th_out.extend(theta)
+        idx = np.nonzero(np.sign(f[:-1]) * np.sign(f[1:]) <= 0.0)[0]
+        if idx.size == 0:
+            continue
+        lo, hi = zs[idx], zs[idx + 1]
+        f_lo = f[idx]
+        for _ in range(80):  # bisection to round-off, all brackets at once
+            mid = 0.5 * (lo + hi)
+            f_mid, _ = _p_branch_residual(geom, q, mid, branch)
+            left = np.sign(f_mid) * np.sign(f_lo) <= 0.0
+            hi = np.where(left, mid, hi)
+            lo = np.where(left, lo, mid)
+            f_lo = np.where(left, f_lo, f_mid)
+        root = 0.5 * (lo + hi)
+        _, theta = _p_branch_residual(geom, q, root, branch)
+        z_out.extend(root)
+        th_out.extend(theta)
+    z_arr, th_arr = np.array(z_out), np.array(th_out)
+    keep = z_arr > 0.0
+    return _p_angles(geom, q, z_arr[keep], np.cos(th_arr[keep]), np.sin(th_arr[keep]))
+
+
+def fk_p_candidates(geom: tuple, q) -> np.ndarray:
+    """Unpolished P-model FK candidates: the quartic for e = 0, root bracketing otherwise."""
+    return fk_p_quartic(geom, q) if geom[3] == 0.0 else fk_p_bracket(geom, q)
+
+
+def _newton(geom: tuple, model: str, variant: str, q: np.ndarray, x0: np.ndarray, iters: int = 60):
+    """Newton with step halving, x <- x - alpha (dq/dx)^+ (q(x) - q), on all starts at once (spec §0).
+
+    The Newton step is a descent direction of |q(x) - q|_2^2, so a halved step is taken as soon as it lowers that
+    sum. A start stops when max|q(x) - q| <= 1e-13 max(1, q), or when no step down to 2^-12 lowers the sum (a root
+    to round-off, or a local minimum that is no root). Returns (x (n, 3), max|q(x) - q| (n,) in mm); degenerate
+    poses get inf.
+    """
+    x = np.array(x0, dtype=float).reshape(-1, 3)
+    tight = 1e-13 * max(1.0, float(np.max(q)))
+
+    def evaluate(xx):
+        valid, qq, jx = _legs(geom, model, variant, xx)
+        with np.errstate(invalid="ignore", over="ignore"):
+            err = qq - q
+            merit = np.where(valid, np.einsum("ni,ni->n", err, err), np.inf)
+        return np.where(np.isfinite(merit), merit, np.inf), qq, jx
+
+    merit, qq, jx = evaluate(x)
+    alive = np.isfinite(merit)
+    for _ in range(iters):
+        idx = np.nonzero(alive & (np.abs(qq - q).max(axis=1) > tight))[0]
+        if idx.size == 0:
+            break
+        xa, qa = x[idx], qq[idx]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            jac = jx[idx] / qa[:, :, None]
+        jac = np.where(np.isfinite(jac), jac, 0.0)
+        step = np.einsum("nij,nj->ni", np.linalg.pinv(jac), qa - q)
+        alpha = np.ones(idx.size)
+        pending = np.ones(idx.size, dtype=bool)
+        for _ in range(13):  # step halving until the sum of squares drops
+            sub = np.nonzero(pending)[0]
+            trial = xa[sub] - alpha[sub, None] * step[sub]
+            m_trial, q_trial, j_trial = evaluate(trial)
+            better = m_trial < merit[idx[sub]]
+            took = idx[sub[better]]
+            x[took], merit[took], qq[took], jx[took] = trial[better], m_trial[better], q_trial[better], j_trial[better]
+            pending[sub[better]] = False
+            if not np.any(pending):
+                break
+            alpha[pending] *= 0.5
+        alive[idx[pending]] = False
+    with np.errstate(invalid="ignore"):
+        res = np.where(np.isfinite(merit), np.abs(qq - q).max(axis=1), np.inf)
+    return x, res
+
+
+def _distinct(x: np.ndarray, res: np.ndarray) -> list[np.ndarray]:
+    """Distinct poses (angles wrapped to (-pi, pi]), the smallest residual kept for each."""
+    out: list[np.ndarray] = []
+    for i in np.argsort(res, kind="stable"):
+        xi = np.array([x[i, 0], *_wrap(x[i, 1:])])
+        if all(
+            abs(xi[0] - o[0]) > 1e-7 * max(1.0, abs(o[0])) or np.abs(_wrap(xi[1:] - o[1:])).max() > 1e-7 for o in out
+        ):
+            out.append(xi)
+    return out
+
+
+def _label(sols: list[np.ndarray]) -> list[Solution]:
+    """Labels '<k><a><b>': k ranks the distinct z values (1 = highest platform), a and b are the signs of cos theta
+    and cos psi ('++': the platform faces up; '-+': the theta <-> pi - theta mirror of the P-model; the C-model
+    also has psi <-> pi - psi branches)."""
+    groups: list[list[np.ndarray]] = []
+    for v in sorted(sols, key=lambda v: -v[0]):
+        if groups and abs(v[0] - groups[-1][0][0]) <= 1e-7 * max(1.0, abs(groups[-1][0][0])):
+            groups[-1].append(v)
+        else:
+            groups.append([v])
+    out, used = [], set()
+    for rank, group in enumerate(groups, start=1):
+        for v in sorted(group, key=lambda v: (-math.cos(v[1]), -math.cos(v[2]))):
+            label = f"{rank}{'+' if math.cos(v[1]) >= 0.0 else '-'}{'+' if math.cos(v[2]) >= 0.0 else '-'}"
+            base, k = label, 2
+            while label in used:
+                label = f"{base}{k}"
+                k += 1
+            used.add(label)
+            out.append(Solution(label, v))
+    return out
+
+
+# starts of the C-model multi-start Newton besides the P-model solutions: z as a fraction of the largest
+# possible height, theta and psi spread over both mirror families (cos theta > 0 and < 0)
+_C_START_Z = (0.05, 0.2, 0.4, 0.65, 0.9)
+_C_START_THETA = (-1.0, 0.0, 1.0, math.pi - 1.0, math.pi, 1.0 - math.pi)
+_C_START_PSI = (-0.8, 0.0, 0.8)
+
+
+class RpsUpu(Mechanism):
+    """Seed-002 mechanism; see module docstring."""
+
+    # ----- options, packing -------------------------------------------------------------------------------
+    def check_options(self, options: dict[str, Any]) -> None:
+        if options["model"] not in MODELS:
+            raise InvalidParameter(f"options.model: must be 'P' or 'C', got {options['model']!r}")
+        if options["c3_variant"] not in C3_VARIANTS:
+            raise InvalidParameter(f"options.c3_variant: must be 'plane' or 'upu', got {options['c3_variant']!r}")
+        stroke = parse_range("stroke_limits", options["stroke_limits"])
+        if stroke is not None and stroke[0] < 0.0:
+            raise InvalidParameter(f"options.stroke_limits: leg lengths are >= 0, got lower bound {stroke[0]:g}")
+        options["stroke_limits"] = stroke
+        for name in ("z_range", "theta_range", "psi_range"):
+            if options[name] is None:
+                raise InvalidParameter(f"options.{name}: required [lo, hi] (the workspace box), got null")
+            options[name] = parse_range(name, options[name])
+        length = options["characteristic_length"]
+        if length is not None:
+            if isinstance(length, bool) or not isinstance(length, (int, float)) or not math.isfinite(length):
+                raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {length!r}")
+            if length <= 0:
+                raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
+            options["characteristic_length"] = float(length)
+
+    def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
+        """L (mm) dividing the angle columns of dq/d(z, theta, psi); default h, the platform half-width."""
+        length = options.get("characteristic_length")
+        return float(design["h"]) if length is None else float(length)
+
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        p = np.empty(N_PACKED)
+        p[_G], p[_H], p[_C], p[_E] = design["g"], design["h"], design["c"], design["e"]
+        p[_MODEL_C] = 1.0 if options["model"] == "C" else 0.0
+        p[_UPU] = 1.0 if options["c3_variant"] == "upu" else 0.0
+        stroke = options.get("stroke_limits")
+        p[_QLO], p[_QHI] = stroke if stroke is not None else (-math.inf, math.inf)
+        p[_INV_L] = 1.0 / self.characteristic_length(design, options)
+        return p
+
+    @property
+    def point_kernel(self):
+        return point_lci
+
+    def kernel_branch(self, options) -> str:
+        return BRANCH
+
+    def bounding_box(self, design, options):
+        """The configured workspace box (z_range, theta_range, psi_range), in mm and rad (spec §2.8)."""
+        lo = np.array([options["z_range"][0], options["theta_range"][0], options["psi_range"][0]], dtype=float)
+        hi = np.array([options["z_range"][1], options["theta_range"][1], options["psi_range"][1]], dtype=float)
+        return lo, hi
+
+    # ----- helpers ------------------------------------------------------------------------------------------
+    @staticmethod
+    def _geom(design) -> tuple[float, float, float, float]:
+        return float(design["g"]), float(design["h"]), float(design["c"]), float(design["e"])
+
+    def platform_pose(self, design, options, pose) -> dict[str, Any]:
+        """Platform origin p (mm), rotation R, parasitic yaw phi (rad) and y0 (mm) of a task pose (z, theta, psi).
+
+        In the P-model phi = y0 = 0. Raises InvalidPose where the C-model parametrisation is degenerate.
+        """
+        x = self.check_vector("pose", pose, 3)
+        valid, p, R, phi, _ = _platform(self._geom(design), options["model"], options["c3_variant"], x[None])
+        if not valid[0]:
+            raise InvalidPose(f"pose: the C-model yaw or y0 is undefined at {list(map(float, x))}")
+        return {"p": p[0], "R": R[0], "phi": float(phi[0]), "y0": float(p[0, 1])}
+
+    # ----- IK ---------------------------------------------------------------------------------------------
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """The single IK branch '+++' (q1, q2, q3) in mm, q_i = |A_i B_i| (spec §2.3), for the configured model;
+        [] where the C-model parametrisation is degenerate. Stroke limits are not applied here (see the kernel)."""
+        x = self.check_vector("pose", pose, 3)
+        valid, q, _ = _legs(self._geom(design), options["model"], options["c3_variant"], x[None])
+        if not valid[0]:
+            return []
+        return [Solution(BRANCH, q[0])]
+
+    # ----- FK ---------------------------------------------------------------------------------------------
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        """All assembly modes (z, theta, psi) with z > 0 of leg lengths q (mm), polished by Newton to
+        max|q(x) - q| ~ 1e-13 q (spec §2.4). Each solution (z, theta, psi) of the P-model has a mirror image
+        (-z, -theta, -psi) through the base plane, not listed.
+
+        P-model: closed form (quartic in z^2) for e = 0, root bracketing in z otherwise; all real branches,
+        including the theta <-> pi - theta mirror. C-model: Newton from the P-model solutions and a fixed grid of
+        starts; distinct converged branches are reported (a multi-start search, so branches far from every
+        start can be missed). Labels: see ``_label``.
+        """
+        q = self.check_vector("inputs", inputs, 3)
+        if np.any(q < 0.0):
+            raise InvalidPose(f"inputs: leg lengths must be >= 0 mm, got {list(map(float, q))}")
+        geom = self._geom(design)
+        model, variant = options["model"], options["c3_variant"]
+        starts = fk_p_candidates(geom, q)
+        if model == "C":
+            z_top = float(q.max()) + max(geom[:3]) + abs(geom[3])
+            grid = np.array(
+                [(f * z_top, t, p) for f in _C_START_Z for t in _C_START_THETA for p in _C_START_PSI], dtype=float
+            )
+            starts = np.vstack([starts, grid])
+        if starts.shape[0] == 0:
+            return []
+        tol = 1e-9 * max(1.0, float(q.max()))
+        x, res = _newton(geom, model, variant, q, starts)
+        accept = np.isfinite(res) & (res <= tol) & (x[:, 0] > 0.0)
+        if model == "C" and np.any(accept):
+            # second pass from the mirror images of the branches found (theta -> pi - theta, psi -> pi - psi):
+            # exact symmetries for e = 0, good starts for the nearby branches otherwise
+            found = x[accept]
+            z, th, ps = found[:, 0], found[:, 1], found[:, 2]
+            images = np.vstack([np.stack([z, np.pi - th, -ps], -1), np.stack([z, th, np.pi - ps], -1),
+                                np.stack([z, np.pi - th, ps - np.pi], -1)])
+            x2, res2 = _newton(geom, model, variant, q, images)
+            x, res = np.vstack([x, x2]), np.concatenate([res, res2])
+            accept = np.isfinite(res) & (res <= tol) & (x[:, 0] > 0.0)
+        return _label(_distinct(x[accept], res[accept]))
+
+    # ----- Jacobians, LCI, singularities -----------------------------------------------------------------
+    def jacobians(self, design, options, pose, q) -> dict[str, np.ndarray | None]:
+        """Jacobians at a pose with leg lengths q (mm), from the twist form composed with T (spec §2.5):
+
+        Jx (rows q_i dq_i/d(z, theta, psi), mm^2 and mm^2/rad), Jq = diag(q) (mm), dq_dx = Jq^-1 Jx (the spec's
+        dq/d(z, theta, psi)), dq_dx_h (dq_dx with its angle columns divided by L, dimensionless) and the forward
+        Jacobian J = Jx^-1 Jq = d(z, theta, psi)/dq (None at a forward or inverse singularity).
+        """
+        x = self.check_vector("pose", pose, 3)
+        qv = self.check_vector("inputs", q, 3)
+        valid, _, jx = _legs(self._geom(design), options["model"], options["c3_variant"], x[None])
+        if not valid[0]:
+            raise InvalidPose(f"pose: the C-model yaw or y0 is undefined at {list(map(float, x))}")
+        jx = jx[0]
+        jq = np.diag(qv)
+        dq_dx = dq_dx_h = j = None
+        if np.all(qv > 0.0):
+            dq_dx = jx / qv[:, None]
+            length = self.characteristic_length(design, options)
+            dq_dx_h = dq_dx / np.array([1.0, length, length])
+            try:
+                j = np.linalg.solve(jx, jq)
+            except np.linalg.LinAlgError:
+                j = None
+        return {"Jx": jx, "Jq": jq, "dq_dx": dq_dx, "dq_dx_h": dq_dx_h, "J": j}
+
+    def lci(self, design, options, pose, q) -> float:
+        """LCI = sigma_min / sigma_max of dq/d(z, L theta, L psi) with NumPy's SVD (0 at any singularity)."""
+        jac = self.jacobians(design, options, pose, q)
+        if jac["dq_dx_h"] is None:
+            return 0.0
+        sv = np.linalg.svd(jac["dq_dx_h"], compute_uv=False)
+        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'inverse' when a leg length q_i <= tol (g + h + c), 'forward' when the rows of Jx, each normalised and
+        with the angle columns divided by L, have sigma_min / sigma_max <= tol; 'both' or 'none'."""
+        jac = self.jacobians(design, options, pose, q)
+        g, h, c, _ = self._geom(design)
+        inverse = bool(np.any(jac["Jq"].diagonal() <= tol * (g + h + c)))
+        length = self.characteristic_length(design, options)
+        rows = jac["Jx"] / np.array([1.0, length, length])
+        norms = np.linalg.norm(rows, axis=1)
+        if np.any(norms == 0.0):
+            forward = True
+        else:
+            sv = np.linalg.svd(rows / norms[:, None], compute_uv=False)
+            forward = bool(sv[-1] <= tol * sv[0])
+        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
+            (inverse, forward), "both"
+        )
+
+
+MECHANISM = RpsUpu(
+    name="rps-upu",
+    title="2-RPS-UPU 2R1T parallel mechanism (seed 002)",
+    seed="002",
+    motion="2R1T",
+    task_axes=("z", "theta", "psi"),
+    task_units=("length", "angle", "angle"),
+    joints=("q1", "q2", "q3"),
+    joint_units=("length", "length", "length"),
+    parameters=(
+        Parameter("g", 80.0, "half distance A1A2 of the base (mm)"),
+        Parameter("h", 50.0, "half distance B1B2 of the platform (mm)"),
+        Parameter("c", 50.0, "platform offset of B3 along u (mm)"),
+        Parameter("e", 0.0, "base offset of A3 along x (mm); 0 reproduces the paper's Table 2", positive=False),
+    ),
+    options=(
+        Option("model", "P", "'P' = paper-reproducing (R = Ry Rx, O' on the z axis), 'C' = constraint-consistent"),
+        Option("c3_variant", "plane", "C-model chain 3: 'plane' (B3 stays in y = 0) or 'upu' (U axes x and w)"),
+        Option("stroke_limits", [40.0, 90.0], "[lo, hi] mm for all three legs, null = none (ASSUMED default: "
+               "the paper gives none; [40, 90] is the Table-2 span used by spec §2.8)"),
+        Option("z_range", [-10.0, 90.0], "workspace box in z (mm), the paper's"),
+        Option("theta_range", [-0.314, 0.314], "workspace box in theta (rad), the paper's"),
+        Option("psi_range", [-0.314, 0.314], "workspace box in psi (rad), the paper's"),
+        Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
+    ),
+    default_length_unit="mm",
+)
