@@ -268,3 +268,67 @@ def ups_sspr_lci(design, options, alpha, beta, y):
     lci = np.where(keep, sv[:, -1] / sv[:, 0], -1.0)
     out[idx] = lci
     return out
+
+
+def rps_upu_lci(design, options, z, theta, psi):
+    """Seed 002, spec §2.3/§2.5: LCI = 1/cond_2 of dq/d(z, L theta, L psi) (NumPy SVD) at arrays of points; -1 where
+    a leg leaves the stroke limits or the C-model parametrisation is degenerate.
+
+    q: P-model from the closed-form q_i^2 of §2.3; C-model as |p + R b_i' - a_i| with R = Rz(phi) Ry(theta) Rx(psi)
+    multiplied out as matrices, cos/sin phi = (cos psi, sin theta sin psi)/norm. dq/dx by complex-step
+    differentiation, Im q(x + i s e_k)/s (exact to round-off; no derivative formula shared with the kernel).
+    """
+    z, theta, psi = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (z, theta, psi)))
+    g, h, c, e = (float(design[k]) for k in ("g", "h", "c", "e"))
+    model, variant = options.get("model", "P"), options.get("c3_variant", "plane")
+    big_l = h if options.get("characteristic_length") is None else float(options["characteristic_length"])
+    x = np.stack([z.ravel(), theta.ravel(), psi.ravel()], axis=-1)
+    n = x.shape[0]
+
+    def legs(xc):
+        zz, th, ps = xc[:, 0], xc[:, 1], xc[:, 2]
+        st, ct, sp, cp = np.sin(th), np.cos(th), np.sin(ps), np.cos(ps)
+        if model == "P":
+            q1s = g**2 + h**2 + zz**2 - 2 * g * h * cp - 2 * h * zz * ct * sp
+            q2s = g**2 + h**2 + zz**2 - 2 * g * h * cp + 2 * h * zz * ct * sp
+            q3s = c**2 + e**2 + zz**2 - 2 * c * e * ct - 2 * c * zz * st
+            return np.sqrt(np.stack([q1s, q2s, q3s], axis=-1)), np.ones(xc.shape[0], dtype=bool)
+        nrm = np.sqrt((st * sp) ** 2 + cp**2)
+        ok = np.abs(nrm) ** 2 >= 1e-24
+        nrm = np.where(ok, nrm, 1.0)
+        cf, sf = cp / nrm, st * sp / nrm
+        zero, one = np.zeros_like(th), np.ones_like(th)
+        rz = np.array([[cf, -sf, zero], [sf, cf, zero], [zero, zero, one]])
+        ry = np.array([[ct, zero, st], [zero, one, zero], [-st, zero, ct]])
+        rx = np.array([[one, zero, zero], [zero, cp, -sp], [zero, sp, cp]])
+        rot = np.einsum("ijn,jkn,kln->nil", rz, ry, rx)
+        if variant == "plane":
+            y0 = -c * rot[:, 1, 0]  # B3 in the plane y = 0
+        else:
+            ok &= np.abs(rot[:, 2, 2]) >= 1e-12
+            r22 = np.where(ok, rot[:, 2, 2], 1.0)
+            y0 = rot[:, 1, 2] * (zz + c * rot[:, 2, 0]) / r22 - c * rot[:, 1, 0]
+        p = np.stack([zero, y0, zz], axis=-1)
+        a = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        b = np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]])
+        d = p[:, None, :] + np.einsum("nij,kj->nki", rot, b) - a[None]
+        return np.sqrt(np.sum(d * d, axis=-1)), ok
+
+    q, ok = legs(x.astype(complex))
+    q = q.real
+    stroke = options.get("stroke_limits")
+    if stroke is not None:
+        ok &= np.all((q >= stroke[0]) & (q <= stroke[1]), axis=1)
+    step = 1e-20
+    jac = np.zeros((n, 3, 3))
+    for k in range(3):
+        xc = x.astype(complex)
+        xc[:, k] += 1j * step
+        jac[:, :, k] = legs(xc)[0].imag / step
+    jac[:, :, 1:] /= big_l
+    out = np.full(n, -1.0)
+    good = ok & np.all(q > 0, axis=1)
+    sv = np.linalg.svd(jac[good], compute_uv=False)
+    out[good] = sv[:, -1] / sv[:, 0]
+    out[ok & ~np.all(q > 0, axis=1)] = 0.0
+    return out.reshape(z.shape)

@@ -499,7 +499,7 @@ def _label(sols: list[np.ndarray]) -> list[Solution]:
             groups.append([v])
     out, used = [], set()
     for rank, group in enumerate(groups, start=1):
-        for v in sorted(group, key=lambda v: (-math.cos(v[1]), -math.cos(v[2]))):
+        for v in sorted(group, key=lambda v: (math.cos(v[1]) < 0.0, math.cos(v[2]) < 0.0)):
             label = f"{rank}{'+' if math.cos(v[1]) >= 0.0 else '-'}{'+' if math.cos(v[2]) >= 0.0 else '-'}"
             base, k = label, 2
             while label in used:
