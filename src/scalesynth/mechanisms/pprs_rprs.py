@@ -23,6 +23,7 @@ T's angular block is a permutation, so both give the same LCI.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -459,13 +460,13 @@ def _pose_distance(a: np.ndarray, b: np.ndarray, length: float) -> float:
 
 # ----- the mechanism ---------------------------------------------------------------------------------------
 class PprsRprs(Mechanism):
-    """Seed-001 mechanism; see module docstring."""
+    """Seed-001 mechanism; see module docstring. FK solutions are full poses named by ``pose_axes``."""
 
     pose_axes = ("x", "y", "z", "phi", "theta", "psi")
 
     def check_options(self, options: dict[str, Any]) -> None:
         orient = options["orientation"]
-        if not isinstance(orient, (list, tuple)) or len(orient) != 3:
+        if not isinstance(orient, (list, tuple, np.ndarray)) or len(orient) != 3:
             raise InvalidParameter(f"options.orientation: expected [phi, theta, psi] in rad, got {orient!r}")
         options["orientation"] = tuple(_finite(f"options.orientation[{i}]", v) for i, v in enumerate(orient))
         if not isinstance(options["sigma"], str) or options["sigma"] not in BRANCHES:
@@ -545,9 +546,9 @@ class PprsRprs(Mechanism):
     def full_pose(self, options: Mapping[str, Any], pose) -> np.ndarray:
         """(x, y, z) with the options' orientation, or a full (x, y, z, phi, theta, psi) pose (mm, rad)."""
         arr = np.asarray(pose, dtype=float) if _is_vector(pose) else None
-        if arr is not None and arr.shape == (3,) and np.all(np.isfinite(arr)):
-            return np.concatenate([arr, options["orientation"]])
-        return self.check_vector("pose", pose, 6)
+        if arr is None or arr.shape not in ((3,), (6,)) or not np.all(np.isfinite(arr)):
+            raise InvalidPose(f"pose: expected 3 (x, y, z) or 6 (x, y, z, phi, theta, psi) numbers, got {pose!r}")
+        return np.concatenate([arr, options["orientation"]]) if arr.shape == (3,) else arr
 
     def inverse_kinematics(self, design, options, pose) -> list[Solution]:
         """All eight sign branches (sigma1 sigma2 sigma3, '+' = D_i below C_i) as (w1, w2, beta, s1, s2, s3) in
@@ -660,7 +661,7 @@ def _is_vector(value) -> bool:
 
 
 def _finite(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
         raise InvalidParameter(f"{name}: expected a finite number, got {value!r}")
     return float(value)
 
