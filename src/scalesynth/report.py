@@ -208,7 +208,8 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
     if "m_minus_n" in pareto.columns:
         lines.append("- note: the model depends on m and n only through m - n (spec §1.1); see column m_minus_n")
     lines += ["", "## Featured designs", ""]
-    cols = [*problem.var_names, mkey, "gci", "fci", "min_lci"] + [c for c in pareto.columns if c.endswith("_share")]
+    cols = [*problem.var_names, *problem.objective_keys, *problem.constraint_keys, mkey, "gci", "fci", "min_lci"]
+    cols += [c for c in pareto.columns if c.endswith("_share")]
     cols = [c for c in dict.fromkeys(cols) if c in pareto.columns]
     lines.append("| design | " + " | ".join(cols) + " |")
     lines.append("|---" * (len(cols) + 1) + "|")
