@@ -166,7 +166,7 @@ def test_newton_from_x0_round_trip_statistics():
          np.radians(rng.uniform(-10, 10, (3000, 3)))]
     )
     q = chain_state(geo, cand, sig).q
-    lims = np.array([OPT["w_limits"]] * 2 + [OPT["beta_limits"]] + [OPT["s_limits"]] * 3)
+    lims = M.joint_limits(OPT)
     feasible = np.all((q >= lims[:, 0]) & (q <= lims[:, 1]), axis=1)
     X, q = cand[feasible][:300], q[feasible][:300]
     assert X.shape[0] == 300
@@ -492,7 +492,7 @@ def test_drive_curves_closed_square():
     np.testing.assert_allclose(curves.q[-1], curves.q[0], atol=1e-12)  # back at E, back to the start values
     np.testing.assert_allclose(curves.t[[0, 25, 50, 100]], (0.0, 0.25, 0.5, 1.0))
     np.testing.assert_allclose(curves.points[25], SQUARE[1], atol=1e-12)  # F after a quarter of the loop
-    lims = np.array([OPT["w_limits"]] * 2 + [OPT["beta_limits"]] + [OPT["s_limits"]] * 3)
+    lims = M.joint_limits(OPT)
     assert np.all((curves.q >= lims[:, 0]) & (curves.q <= lims[:, 1]))
     # E -> F moves along x only: w1 = x + r rises by the side length, s1 (depends on y, z only) stays
     np.testing.assert_allclose(curves.q[25, 0] - curves.q[0, 0], 20.0, atol=1e-12)

@@ -9,18 +9,15 @@ speed) and ``drives.png`` (one subplot per actuator).
 
 from __future__ import annotations
 
-import contextlib
-import os
-import secrets
-from collections.abc import Callable
 from pathlib import Path
-from typing import IO, Annotated
+from typing import Annotated
 
 import numpy as np
 import typer
 
 from scalesynth.cli import _print_json, app, handles_errors
 from scalesynth.errors import ConfigError, InvalidPose
+from scalesynth.io import ensure_dir, save_figure, write_text
 
 CSV_COLUMNS = ("t", "x", "y", "z", "w1", "w2", "beta", "s1", "s2", "s3")
 # At z = 200 mm the cross-section of the primary workspace is a diagonal band: the largest axis-parallel square
@@ -35,29 +32,15 @@ def square_path(center: tuple[float, float], side: float, z: float) -> np.ndarra
     return np.array([[cx - a, cy - a, z], [cx + a, cy - a, z], [cx + a, cy + a, z], [cx - a, cy + a, z]])
 
 
-def _atomic_write(path: Path, write: Callable[[IO[bytes]], None]) -> None:
-    """Write through a temporary file in the same directory, then rename it over ``path``."""
-    # open(..., "xb") rather than mkstemp: the result gets the usual umask permissions, not 0600
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
-    try:
-        with open(tmp, "xb") as fh:
-            write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
 def write_csv(path: Path, curves) -> None:
+    """drives.csv, atomically: CSV_COLUMNS, one row per sample, 12 significant digits."""
     table = np.column_stack([curves.t, curves.points, curves.q])
-    lines = [",".join(CSV_COLUMNS)]
-    lines += [",".join(f"{v:.12g}" for v in row) for row in table]
-    _atomic_write(path, lambda fh: fh.write(("\n".join(lines) + "\n").encode()))
+    lines = [",".join(CSV_COLUMNS)] + [",".join(f"{v:.12g}" for v in row) for row in table]
+    write_text(path, "\n".join(lines) + "\n")
 
 
 def write_plot(path: Path, curves, corners: list[tuple[str, float]]) -> None:
-    """Six subplots (w1, w2, beta in deg, s1, s2, s3) over t, the path's corners marked."""
+    """drives.png, atomically: six subplots (w1, w2, beta in deg, s1, s2, s3) over t, the path's corners marked."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -75,7 +58,7 @@ def write_plot(path: Path, curves, corners: list[tuple[str, float]]) -> None:
     for ax in axes[-1]:
         ax.set_xlabel("t (fraction of the loop)")
     fig.suptitle("2PPRS-RPRS drive displacements along E-F-G-H-E")
-    _atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=120))
+    save_figure(fig, path, dpi=120)
 
 
 def _parse_center(text: str) -> tuple[float, float]:
@@ -114,8 +97,7 @@ def drives_cmd(
         raise InvalidPose(f"--samples: need at least 2, got {samples}")
     corners = square_path(_parse_center(center), side, z)
     curves = drive_curves(cfg.resolved_design(), cfg.resolved_options(), corners, samples)
-    out_dir = out if out is not None else cfg.output_dir() / "drives"
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = ensure_dir(out if out is not None else cfg.output_dir() / "drives")
     csv_path, png_path = out_dir / "drives.csv", out_dir / "drives.png"
     write_csv(csv_path, curves)
     marks = [(name, k / 4) for k, name in enumerate("EFGHE")]

@@ -646,11 +646,14 @@ class PprsRprs(Mechanism):
         sv = np.linalg.svd(scaled(geo, twist_jacobian(geo, st)), compute_uv=False)
         return float(sv[-1] / sv[0])
 
+    def joint_limits(self, options: Mapping[str, Any]) -> np.ndarray:
+        """Limits (6, 2) of (w1, w2, beta, s1, s2, s3), mm and rad."""
+        return np.array([options["w_limits"]] * 2 + [options["beta_limits"]] + [options["s_limits"]] * 3)
+
     def limit_violations(self, options: Mapping[str, Any], q) -> list[str]:
         """Names of the actuators of q outside their limits (empty when all are within)."""
         q = np.asarray(q, dtype=float)
-        lims = [options["w_limits"]] * 2 + [options["beta_limits"]] + [options["s_limits"]] * 3
-        return [n for n, v, (lo, hi) in zip(JOINTS, q, lims, strict=True) if not lo <= v <= hi]
+        return [n for n, v, (lo, hi) in zip(JOINTS, q, self.joint_limits(options), strict=True) if not lo <= v <= hi]
 
 
 def _is_vector(value) -> bool:
@@ -691,6 +694,7 @@ def drive_curves(
     fails (a singularity on the way).
     """
     from scalesynth.evaluate import sample_path
+    from scalesynth.kernels.grid import points_lci
 
     mech = MECHANISM
     design = mech.resolve_design(design)
@@ -711,15 +715,15 @@ def drive_curves(
     sigma = sigma_vector(options["sigma"])
     st = chain_state(geo, poses, sigma)
     q = st.q
-    packed = mech.pack(design, options)
-    lci = np.array([point_lci(packed, *pt) for pt in path])
-    for k in range(n):
+    lims = mech.joint_limits(options)
+    outside = ~st.ok | np.any((q < lims[:, 0]) | (q > lims[:, 1]), axis=1)
+    if np.any(outside):
+        k = int(np.argmax(outside))
         where = f"path: sample {k} at ({', '.join(f'{v:.6g}' for v in path[k])})"
         if not st.ok[k]:
             raise InvalidPose(f"{where} is out of reach")
-        bad = mech.limit_violations(options, q[k])
-        if bad:
-            raise InvalidPose(f"{where} puts {', '.join(bad)} outside the limits")
+        raise InvalidPose(f"{where} puts {', '.join(mech.limit_violations(options, q[k]))} outside the limits")
+    lci = points_lci(point_lci, mech.pack(design, options), path)
     # continuation: FK of each sample's q by Newton from the previous sample's pose
     fk, conv = newton_fk(geo, sigma, q[1:], poses[:-1])
     err = np.max(np.abs(fk - poses[1:]) * np.array([1, 1, 1, geo.r, geo.r, geo.r]), axis=1)
