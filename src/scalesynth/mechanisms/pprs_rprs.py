@@ -604,12 +604,16 @@ class PprsRprs(Mechanism):
         base = np.array([st.centres[0, 2], st.centres[1, 2], st.mu3])
         return "".join("+" if b - s >= 0.0 else "-" for b, s in zip(base, q[3:], strict=True))
 
+    def _state_at(self, design, options, pose, q) -> tuple[np.ndarray, Geometry, ChainState]:
+        """Full pose, geometry and chain state of the branch that q takes at the pose."""
+        X = self.full_pose(options, pose)
+        geo = Geometry.of(design, options)
+        return X, geo, chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+
     def jacobians(self, design, options, pose, q) -> dict[str, np.ndarray]:
         """J_t (twist), T (Euler rates), the pose Jacobian J = J_t T and the homogenised J_t whose LCI is
         reported ("Js"), for the branch of q at the pose. Rows w1, w2, beta, s1, s2, s3."""
-        X = self.full_pose(options, pose)
-        geo = Geometry.of(design, options)
-        st = chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+        X, geo, st = self._state_at(design, options, pose, q)
         jt = twist_jacobian(geo, st)
         t = euler_rate_map(X)
         return {"Jt": jt, "T": t, "J": jt @ t, "Js": scaled(geo, jt)}
@@ -617,9 +621,7 @@ class PprsRprs(Mechanism):
     def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
         """'inverse' (serial: kappa_i <= tol L_i, or mu3 <= tol R), 'forward' (parallel: the row-normalised
         homogenised J_t with kappa_i and mu3 multiplied out has sigma_min / sigma_max <= tol), 'both', 'none'."""
-        X = self.full_pose(options, pose)
-        geo = Geometry.of(design, options)
-        st = chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+        X, geo, st = self._state_at(design, options, pose, q)
         inverse = bool(np.any(st.kappa <= tol * geo.links) or st.mu3 <= tol * geo.rail)
         # A t = B q_dot with B = diag(1, 1, mu3^2, kappa1, kappa2, kappa3): A stays finite where J_t does not
         g = actuator_directions(geo, st)
@@ -638,9 +640,7 @@ class PprsRprs(Mechanism):
 
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of the homogenised J_t (NumPy SVD); 0 at a serial singularity."""
-        X = self.full_pose(options, pose)
-        geo = Geometry.of(design, options)
-        st = chain_state(geo, X, sigma_vector(self.branch_of(design, options, X, q)))
+        X, geo, st = self._state_at(design, options, pose, q)
         if np.any(st.kappa == 0.0) or st.mu3 == 0.0:
             return 0.0
         sv = np.linalg.svd(scaled(geo, twist_jacobian(geo, st)), compute_uv=False)
