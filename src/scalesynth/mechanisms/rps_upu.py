@@ -328,8 +328,9 @@ def fk_p_quartic(geom: tuple, q) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     s = 0.5 * (q[0] ** 2 + q[1] ** 2)
     d = 0.25 * (q[1] ** 2 - q[0] ** 2)
-    factors = np.array([s - (g - h) ** 2, s - (g + h) ** 2, (c + q[2]) ** 2, (c - q[2]) ** 2])
-    # scale t so that the coefficients are O(1): t^4 ~ 1e16 mm^8 otherwise
+    # roots of the four factors in u = (t - S) / scale: centring on S keeps long legs (all four roots close to
+    # S) from cancelling, scaling makes the coefficients O(1) (t^4 ~ 1e16 mm^8 otherwise)
+    factors = np.array([-((g - h) ** 2), -((g + h) ** 2), (c + q[2]) ** 2 - s, (c - q[2]) ** 2 - s])
     scale = max(float(np.abs(factors).max()), 1e-300)
     coef = np.poly(factors / scale)
     coef[-1] -= (4.0 * g * c * d) ** 2 / scale**4
@@ -339,7 +340,8 @@ def fk_p_quartic(geom: tuple, q) -> np.ndarray:
     for _ in range(3):  # Newton on the polynomial: restores full precision after the eigenvalue solver
         dp = np.polyval(dcoef, real)
         real = real - np.where(dp != 0.0, np.polyval(coef, real) / np.where(dp != 0.0, dp, 1.0), 0.0)
-    t = real[real > 0.0] * scale
+    t = s + real * scale
+    t = t[t > 0.0]
     z, st, ct = [], [], []
     for ti in t:
         zi = math.sqrt(ti)
