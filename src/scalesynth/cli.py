@@ -193,7 +193,7 @@ def fk_cmd(
     mech, design, options = _mech_inputs(mechanism, sets)
     q = _parse_vector("--inputs", inputs, len(mech.joints))
     rows = [s.as_dict() for s in mech.forward_kinematics(design, options, q)]
-    _print_solutions(mech.task_axes, rows, as_json, "no isolated assembly: inputs out of reach or degenerate")
+    _print_solutions(mech.pose_axes, rows, as_json, "no isolated assembly: inputs out of reach or degenerate")
 
 
 def _print_solutions(names, rows, as_json: bool, empty_msg: str) -> None:

@@ -4,6 +4,10 @@ Each x-slab of each design writes its partial sums into its own row; the rows ar
 order, so results do not depend on thread scheduling. Grids are cell-centred: node i of an axis sits at
 ``lo + (i + 0.5) * step``.
 
+The functions that take a point kernel as an argument are compiled per mechanism and NOT cached on disk: Numba
+keys such cache entries by the dispatcher object, so they never hit in a new process and a stale entry can break
+later saves. Mechanisms that need a fast start provide their own cached ``grid_stats`` (seed 000 does).
+
 Statistics row layout (``N_FIXED`` leading columns, then one count per dexterity band):
 ``[count, sum_lci, sum_lci2, min_lci, max_lci, band_0, ..., band_{k-1}]``.
 """
@@ -27,7 +31,7 @@ def _band_index(lci, edges):
     return nb - 1
 
 
-@njit(cache=True, parallel=True, fastmath=FASTMATH)
+@njit(parallel=True, fastmath=FASTMATH)
 def population_stats(point_kernel, params, lo, step, shape, edges):
     """Workspace statistics for every design on its own grid.
 
@@ -95,7 +99,7 @@ def reduce_partials(partial, n_designs, nx):
     return out
 
 
-@njit(cache=True, parallel=True, fastmath=FASTMATH)
+@njit(parallel=True, fastmath=FASTMATH)
 def sample_grid(point_kernel, p, lo, step, shape):
     """LCI at every node of one design's grid, shape (nx, ny, nz); -1 marks unreachable nodes."""
     nx, ny, nz = shape[0], shape[1], shape[2]
@@ -110,7 +114,7 @@ def sample_grid(point_kernel, p, lo, step, shape):
     return out
 
 
-@njit(cache=True, fastmath=FASTMATH)
+@njit(fastmath=FASTMATH)
 def points_lci(point_kernel, p, pts):
     """LCI (or -1) at arbitrary points, pts shape (n, 3)."""
     n = pts.shape[0]
@@ -120,7 +124,7 @@ def points_lci(point_kernel, p, pts):
     return out
 
 
-@njit(cache=True, parallel=True, fastmath=FASTMATH)
+@njit(parallel=True, fastmath=FASTMATH)
 def population_points_lci(point_kernel, params, pts):
     """LCI (or -1) of every design at the same points: params (n_designs, k), pts (n, 3) -> (n_designs, n)."""
     n_designs = params.shape[0]

@@ -78,6 +78,11 @@ class Mechanism:
         return tuple(o.name for o in self.options)
 
     @property
+    def pose_axes(self) -> tuple[str, ...]:
+        """Names of the values of an FK solution (default: the task axes; 6-DOF mechanisms add orientation)."""
+        return self.task_axes
+
+    @property
     def planar(self) -> bool:
         return len(self.task_axes) == 2
 
