@@ -332,3 +332,53 @@ def rps_upu_lci(design, options, z, theta, psi):
     out[good] = sv[:, -1] / sv[:, 0]
     out[ok & ~np.all(q > 0, axis=1)] = 0.0
     return out.reshape(z.shape)
+
+
+def rps_upu_tool_lci(design, options, x, y, z):
+    """Seed 002, spec §2.8: LCI = 1/cond_2 of dq/dT (NumPy SVD) of the tool point T = (x, y, z) = O' + R (0, 0, -d),
+    P-model, principal branch; -1 where T is out of reach, the pose leaves the z/theta/psi ranges or a leg leaves
+    the stroke limits.
+
+    The pose comes from the spec's inverse (psi = asin(T_y/d), theta = asin(-T_x/(d cos psi)),
+    z0 = T_z + d cos theta cos psi), q from the closed-form q_i^2 of §2.3, and dq/dT by complex-step
+    differentiation of that composition.
+    """
+    x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
+    g, h, c, e = (float(design[k]) for k in ("g", "h", "c", "e"))
+    d = float(options["tool_offset"])
+    pts = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=-1)
+
+    def pose(t):
+        ps = np.arcsin(t[:, 1] / d)
+        th = np.arcsin(-t[:, 0] / (d * np.cos(ps)))
+        return t[:, 2] + d * np.cos(th) * np.cos(ps), th, ps
+
+    def legs(t):
+        z0, th, ps = pose(t)
+        q1s = g**2 + h**2 + z0**2 - 2 * g * h * np.cos(ps) - 2 * h * z0 * np.cos(th) * np.sin(ps)
+        q2s = g**2 + h**2 + z0**2 - 2 * g * h * np.cos(ps) + 2 * h * z0 * np.cos(th) * np.sin(ps)
+        q3s = c**2 + e**2 + z0**2 - 2 * c * e * np.cos(th) - 2 * c * z0 * np.sin(th)
+        return np.sqrt(np.stack([q1s, q2s, q3s], axis=-1))
+
+    ok = (np.abs(pts[:, 1]) <= d) & (np.abs(pts[:, 0]) <= d * np.sqrt(np.clip(1 - (pts[:, 1] / d) ** 2, 0, 1)))
+    ok &= np.abs(pts[:, 1]) < d  # psi = +-pi/2 leaves theta undetermined
+    out = np.full(pts.shape[0], -1.0)
+    t = pts[ok]
+    z0, th, ps = pose(t)
+    keep = np.ones(t.shape[0], dtype=bool)
+    for name, v in (("z_range", z0), ("theta_range", th), ("psi_range", ps)):
+        keep &= (v >= options[name][0]) & (v <= options[name][1])
+    q = legs(t)
+    if options.get("stroke_limits") is not None:
+        lo, hi = options["stroke_limits"]
+        keep &= np.all((q >= lo) & (q <= hi), axis=1)
+    step = 1e-20
+    jac = np.zeros((t.shape[0], 3, 3))
+    for k in range(3):
+        tc = t.astype(complex)
+        tc[:, k] += 1j * step
+        jac[:, :, k] = legs(tc).imag / step
+    sv = np.linalg.svd(jac, compute_uv=False)
+    lci = np.where(keep, sv[:, -1] / sv[:, 0], -1.0)
+    out[np.nonzero(ok)[0]] = lci
+    return out.reshape(x.shape)

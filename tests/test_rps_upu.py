@@ -18,7 +18,7 @@ from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import get
 
 from conftest import SHARED
-from naive import grid_metrics, grid_nodes, rps_upu_lci
+from naive import grid_metrics, grid_nodes, rps_upu_lci, rps_upu_tool_lci
 
 M = get("rps-upu")
 REF = json.loads((SHARED / "spec" / "cases" / "ref002.json").read_text())
@@ -505,3 +505,106 @@ def test_config_loads_and_evaluates(root):
     # box 100 mm x 0.628^2 rad^2; the feasible share on nodes is 153595/400869 = 0.383 (spec §2.8)
     assert rep.measure == pytest.approx(100 * 0.628**2 * 153595 / 400869, rel=0.02)
     assert 0.3 < rep.gci < 0.5
+
+
+# ----- tool-point position workspace (spec §2.8) --------------------------------------------------------------
+TOOL = rps.TOOL_MECHANISM
+T_OPT = TOOL.resolve_options({})  # d = 50 mm, q in [40, 90] (ASSUMED), the paper's pose box
+
+
+def test_tool_point_inverse_and_forward():
+    """T = O' + R (0, 0, -d) of the case-1 solution; its principal pose gives back q = (80, 90, 80)."""
+    x = np.array(REF["case1"]["fk"])
+    tp = TOOL.tool_point(PAPER, T_OPT, x)
+    z, th, ps = x
+    np.testing.assert_allclose(tp, [-50 * math.sin(th) * math.cos(ps), 50 * math.sin(ps),
+                                    z - 50 * math.cos(th) * math.cos(ps)], atol=1e-12)  # fmt: skip
+    poses = {s.label: s.values for s in TOOL.poses_of_tool_point(PAPER, T_OPT, tp)}
+    assert set(poses) == {"++", "-+", "+-", "--"}
+    np.testing.assert_allclose(poses["++"], x, atol=1e-12)
+    for v in poses.values():  # every pose branch places the tool at T
+        np.testing.assert_allclose(TOOL.tool_point(PAPER, T_OPT, v), tp, atol=1e-10)
+    sols = {s.label: s.values for s in TOOL.inverse_kinematics(PAPER, T_OPT, tp)}
+    np.testing.assert_allclose(sols[TOOL.kernel_branch(T_OPT)], (80, 90, 80), atol=1e-10)
+    fk_t = TOOL.forward_kinematics(PAPER, T_OPT, (80, 90, 80))
+    assert fk_t[0].label == "1++"
+    np.testing.assert_allclose(fk_t[0].values, tp, atol=1e-10)
+    assert TOOL.inverse_kinematics(PAPER, T_OPT, (0.0, 60.0, 10.0)) == []  # |T_y| > d
+    assert TOOL.point_kernel(TOOL.pack(PAPER, T_OPT), 0.0, 60.0, 10.0) == -1.0
+    assert TOOL.measure_key("mm") == "volume_mm3"
+
+
+@pytest.mark.parametrize(
+    ("design", "options"),
+    [({}, {}), ({"e": 15.0}, {"tool_offset": 80.0, "stroke_limits": [30.0, 100.0]}),
+     ({}, {"theta_range": [-1.0, 1.0], "psi_range": [-1.2, 1.2], "stroke_limits": None})],
+)  # fmt: skip
+def test_tool_kernel_matches_numpy_twin(design, options):
+    design = TOOL.resolve_design(design)
+    options = TOOL.resolve_options(options)
+    g = make_grid(TOOL, design, options, 20)
+    lci = kgrid.sample_grid(TOOL.point_kernel, TOOL.pack(design, options), g.lo, g.step, g.shape)
+    twin = rps_upu_tool_lci(design, options, *grid_nodes(g.lo, g.step, g.shape))
+    assert np.array_equal(lci >= 0, twin >= 0)
+    assert np.count_nonzero(lci >= 0) > 100
+    np.testing.assert_allclose(lci[lci >= 0], twin[twin >= 0], rtol=1e-7, atol=1e-12)
+    rep = evaluate(TOOL, design, options, resolution=20)
+    assert rep.measure_key == "volume_mm3" and rep.metrics["voxels"] == np.count_nonzero(twin >= 0)
+
+
+def test_tool_workspace_is_the_image_of_the_pose_workspace():
+    """Sampled poses in the box: the tool kernel at T(pose) is feasible iff the (z, theta, psi) kernel is, with
+    the LCI of dq/dT = dq/dx dx/dT; every T(pose) lies in the tool bounding box."""
+    rng = np.random.default_rng(2)
+    lo, hi = TOOL.bounding_box(PAPER, T_OPT)
+    pk, tk = M.pack(PAPER, P_OPT), TOOL.pack(PAPER, T_OPT)
+    feasible = 0
+    for _ in range(400):
+        pose = (rng.uniform(-10, 90), rng.uniform(-0.314, 0.314), rng.uniform(-0.314, 0.314))
+        tp = TOOL.tool_point(PAPER, T_OPT, pose)
+        assert np.all(tp >= lo) and np.all(tp <= hi)
+        a, b = M.point_kernel(pk, *pose), TOOL.point_kernel(tk, *tp)
+        assert (a >= 0) == (b >= 0)
+        if b >= 0:
+            feasible += 1
+            q = M.inverse_kinematics(PAPER, P_OPT, pose)[0].values
+            assert TOOL.lci(PAPER, T_OPT, tp, q) == pytest.approx(b, rel=1e-9)
+    assert feasible > 50
+
+
+def test_tool_jacobian_matches_central_differences():
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        pose = (rng.uniform(20, 90), rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5))
+        tp = TOOL.tool_point(PAPER, T_OPT, pose)
+        q = M.inverse_kinematics(PAPER, P_OPT, pose)[0].values
+        jac = TOOL.jacobians(PAPER, T_OPT, tp, q)
+        num = np.zeros((3, 3))
+        for k in range(3):
+            vals = {}
+            for m in (-2, -1, 1, 2):
+                t = tp.copy()
+                t[k] += m * 1e-3
+                vals[m] = {s.label: s.values for s in TOOL.inverse_kinematics(PAPER, T_OPT, t)}["++"]
+            num[:, k] = (vals[-2] - 8 * vals[-1] + 8 * vals[1] - vals[2]) / 12e-3
+        np.testing.assert_allclose(jac["dq_dT"], num, rtol=1e-7, atol=1e-8)
+        np.testing.assert_allclose(jac["J"] @ jac["dq_dT"], np.eye(3), atol=1e-10)
+        assert TOOL.singularity(PAPER, T_OPT, tp, q) == "none"
+
+
+def test_tool_singular_where_t_stops_fixing_theta():
+    """cos theta = 0: dT/d(z, theta, psi) has det -d^2 cos(theta) cos(psi)^2 = 0."""
+    pose = (80.0, math.pi / 2, 0.0)
+    tp = TOOL.tool_point(PAPER, T_OPT, pose)
+    np.testing.assert_allclose(tp, (-50.0, 0.0, 80.0), atol=1e-12)
+    q = M.inverse_kinematics(PAPER, P_OPT, pose)[0].values
+    assert TOOL.singularity(PAPER, T_OPT, tp, q) == "forward"
+    assert TOOL.lci(PAPER, T_OPT, tp, q) < 1e-12
+
+
+def test_tool_options_validation():
+    with pytest.raises(InvalidParameter, match="^options.tool_offset: "):
+        TOOL.resolve_options({"tool_offset": 0})
+    with pytest.raises(InvalidParameter, match="^options.model: unknown option"):
+        TOOL.resolve_options({"model": "C"})
+    assert TOOL.resolve_options(T_OPT) == T_OPT  # resolving twice is a no-op

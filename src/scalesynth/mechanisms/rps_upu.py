@@ -20,7 +20,11 @@ The LCI is 1/kappa_2 of the homogenised Jacobian dq/d(z, L theta, L psi): the an
 same as measuring angular rates by the tangential speed L omega; the homogenised matrix is dimensionless.
 
 Singularities: ``inverse`` when a leg length vanishes (q_i = 0: the leg direction is undefined), ``forward``
-when the rows of the constraint Jacobian become dependent (det dq/dx = 0: assembly modes merge).
+when the rows of the constraint Jacobian become dependent (det dq/dx = 0: assembly modes merge). A zero leg
+also zeroes its constraint row, so q_i = 0 is always ``both``.
+
+``TOOL_MECHANISM`` (``rps-upu-tool``) is the optional second workspace of spec §2.8: the position workspace of
+the tool point T = O' + R (0, 0, -d) over (x, y, z), P-model, through the closed-form inverse T -> (z, theta, psi).
 """
 
 from __future__ import annotations
@@ -528,6 +532,18 @@ class RpsUpu(Mechanism):
             raise InvalidParameter(f"options.model: must be 'P' or 'C', got {options['model']!r}")
         if options["c3_variant"] not in C3_VARIANTS:
             raise InvalidParameter(f"options.c3_variant: must be 'plane' or 'upu', got {options['c3_variant']!r}")
+        self._check_limits(options)
+        length = options["characteristic_length"]
+        if length is not None:
+            if isinstance(length, bool) or not isinstance(length, (int, float)) or not math.isfinite(length):
+                raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {length!r}")
+            if length <= 0:
+                raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
+            options["characteristic_length"] = float(length)
+
+    @staticmethod
+    def _check_limits(options: dict[str, Any]) -> None:
+        """Validate (in place) the stroke limits and the z / theta / psi ranges."""
         stroke = parse_range("stroke_limits", options["stroke_limits"])
         if stroke is not None and stroke[0] < 0.0:
             raise InvalidParameter(f"options.stroke_limits: leg lengths are >= 0, got lower bound {stroke[0]:g}")
@@ -536,13 +552,6 @@ class RpsUpu(Mechanism):
             if options[name] is None:
                 raise InvalidParameter(f"options.{name}: required [lo, hi] (the workspace box), got null")
             options[name] = parse_range(name, options[name])
-        length = options["characteristic_length"]
-        if length is not None:
-            if isinstance(length, bool) or not isinstance(length, (int, float)) or not math.isfinite(length):
-                raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {length!r}")
-            if length <= 0:
-                raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
-            options["characteristic_length"] = float(length)
 
     def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         """L (mm) dividing the angle columns of dq/d(z, theta, psi); default h, the platform half-width."""
@@ -715,6 +724,252 @@ MECHANISM = RpsUpu(
         Option("theta_range", [-0.314, 0.314], "workspace box in theta (rad), the paper's"),
         Option("psi_range", [-0.314, 0.314], "workspace box in psi (rad), the paper's"),
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
+    ),
+    default_length_unit="mm",
+)
+
+
+# ----- optional second workspace: the tool point T = O' + R (0, 0, -d) over (x, y, z) (spec §2.8) ---------
+# packed layout of the tool kernel (see RpsUpuTool.pack): the first N_PACKED entries as above, then
+_D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI = range(N_PACKED, N_PACKED + 7)
+N_PACKED_TOOL = N_PACKED + 7
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def tool_point_lci(p, x, y, z):
+    """LCI of dq/dT (dimensionless) at tool point T = (x, y, z) mm of the P-model, principal branch
+    (cos theta > 0, cos psi > 0), or -1 when T is out of reach of that branch, its pose leaves the z/theta/psi
+    ranges or a leg leaves the stroke limits.
+
+    Pose from T (spec §2.8): sin psi = T_y/d, sin theta = -T_x/(d cos psi), z0 = T_z + d cos theta cos psi; then
+    dq/dT = dq/d(z0, theta, psi) . d(z0, theta, psi)/dT with the closed-form inverse of dT/d(z0, theta, psi).
+    """
+    d = p[_D]
+    sp = y / d
+    if sp > 1.0 or sp < -1.0:
+        return -1.0
+    cp = math.sqrt(1.0 - sp * sp)
+    if cp <= 1e-12:
+        return -1.0  # psi = +-pi/2: theta is undetermined, the branch is not defined
+    st = -x / (d * cp)
+    if st > 1.0 or st < -1.0:
+        return -1.0
+    ct = math.sqrt(1.0 - st * st)
+    z0 = z + d * ct * cp
+    th = math.asin(st)
+    ps = math.asin(sp)
+    if not (p[_ZLO] <= z0 <= p[_ZHI] and p[_TLO] <= th <= p[_THI] and p[_PLO] <= ps <= p[_PHI]):
+        return -1.0
+    _, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _p_model_rows(
+        p[_G], p[_H], p[_C], p[_E], z0, st, ct, sp, cp
+    )
+    lo = p[_QLO]
+    hi = p[_QHI]
+    ok1, q1 = _leg_ok(q1s, lo, hi)
+    ok2, q2 = _leg_ok(q2s, lo, hi)
+    ok3, q3 = _leg_ok(q3s, lo, hi)
+    if not (ok1 and ok2 and ok3):
+        return -1.0
+    if q1 == 0.0 or q2 == 0.0 or q3 == 0.0 or ct <= 1e-12:
+        return 0.0  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
+    # d(z0, theta, psi)/dT, rows z0, theta, psi; columns T_x, T_y, T_z
+    inv = 1.0 / (d * ct * cp)
+    m11 = st / ct
+    m12 = -sp / (ct * cp)
+    m21 = -inv
+    m22 = st * sp * inv / cp
+    m32 = 1.0 / (d * cp)
+    # row i of dq/dT = (q_i dq_i/dx) M / q_i
+    i1 = 1.0 / q1
+    i2 = 1.0 / q2
+    i3 = 1.0 / q3
+    return lci_3x3(
+        (a11 * m11 + a12 * m21) * i1, (a11 * m12 + a12 * m22 + a13 * m32) * i1, a11 * i1,
+        (a21 * m11 + a22 * m21) * i2, (a21 * m12 + a22 * m22 + a23 * m32) * i2, a21 * i2,
+        (a31 * m11 + a32 * m21) * i3, (a31 * m12 + a32 * m22 + a33 * m32) * i3, a31 * i3,
+    )  # fmt: skip
+
+
+def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """([min, max] of sin, [min, max] of cos) over the angle interval [lo, hi]: the ends and every multiple of
+    pi/2 inside."""
+    pts = [lo, hi] + [k * math.pi / 2 for k in range(math.ceil(lo / (math.pi / 2)), math.floor(hi / (math.pi / 2)) + 1)]
+    s = [math.sin(a) for a in pts]
+    c = [math.cos(a) for a in pts]
+    return (min(s), max(s)), (min(c), max(c))
+
+
+def _interval_product(a: tuple[float, float], b: tuple[float, float]) -> tuple[float, float]:
+    corners = [a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]]
+    return min(corners), max(corners)
+
+
+class RpsUpuTool(RpsUpu):
+    """Position workspace of the tool point T = O' + R (0, 0, -d) of the P-model (spec §2.8), task axes (x, y, z).
+
+    The pose ranges (z_range of O', theta_range, psi_range) act as limits on the pose that places T; the kernel
+    uses the principal branch (cos theta > 0, cos psi > 0). The Jacobian dq/dT is in mm/mm, so the LCI needs no
+    characteristic length. Only the P-model has the closed-form inverse, so there is no ``model`` option.
+    """
+
+    def check_options(self, options: dict[str, Any]) -> None:
+        self._check_limits(options)
+        d = options["tool_offset"]
+        if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) or d <= 0:
+            raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
+        options["tool_offset"] = float(d)
+
+    @staticmethod
+    def _p(options: Mapping[str, Any]) -> dict[str, Any]:
+        """The options with the P-model settings that the inherited (z, theta, psi) kinematics read."""
+        return {**options, "model": "P", "c3_variant": "plane", "characteristic_length": None}
+
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        p = np.empty(N_PACKED_TOOL)
+        p[:N_PACKED] = super().pack(design, self._p(options))
+        p[_D] = options["tool_offset"]
+        p[_ZLO], p[_ZHI] = options["z_range"]
+        p[_TLO], p[_THI] = options["theta_range"]
+        p[_PLO], p[_PHI] = options["psi_range"]
+        return p
+
+    @property
+    def point_kernel(self):
+        return tool_point_lci
+
+    def kernel_branch(self, options) -> str:
+        return "++"
+
+    def bounding_box(self, design, options):
+        """Interval bound of T = (-d sin(theta) cos(psi), d sin(psi), z0 - d cos(theta) cos(psi)) over the pose
+        ranges (mm)."""
+        d = options["tool_offset"]
+        (s_t, c_t), (s_p, c_p) = _sin_cos_range(*options["theta_range"]), _sin_cos_range(*options["psi_range"])
+        tx = _interval_product(s_t, c_p)
+        tz = _interval_product(c_t, c_p)
+        z_lo, z_hi = options["z_range"]
+        lo = np.array([-d * tx[1], d * s_p[0], z_lo - d * tz[1]])
+        hi = np.array([-d * tx[0], d * s_p[1], z_hi - d * tz[0]])
+        return lo, hi
+
+    # ----- tool point <-> pose ----------------------------------------------------------------------------
+    def platform_pose(self, design, options, pose) -> dict[str, Any]:
+        """As RpsUpu.platform_pose for a pose (z, theta, psi) of the P-model."""
+        return super().platform_pose(design, self._p(options), pose)
+
+    def tool_point(self, design, options, pose) -> np.ndarray:
+        """T (mm) of a pose (z, theta, psi) of the P-model."""
+        z, th, ps = self.check_vector("pose", pose, 3)
+        d = options["tool_offset"]
+        return np.array([-d * math.sin(th) * math.cos(ps), d * math.sin(ps), z - d * math.cos(th) * math.cos(ps)])
+
+    def poses_of_tool_point(self, design, options, point) -> list[Solution]:
+        """Every pose (z, theta, psi) that puts the tool at T (spec §2.8), labelled by the signs of cos theta and
+        cos psi ('++' is the kernel's); the pose ranges are not applied. [] when |T_y| > d or |T_x| > d |cos psi|."""
+        tx, ty, tz = self.check_vector("pose", point, 3)
+        d = options["tool_offset"]
+        if abs(ty) > d:
+            return []
+        out = []
+        ps0 = math.asin(ty / d)
+        for lp, ps in (("+", ps0), ("-", math.pi - ps0)):
+            cp = math.cos(ps)
+            if abs(cp) <= 1e-12 or abs(tx) > d * abs(cp):
+                continue
+            th0 = math.asin(-tx / (d * cp))
+            for lt, th in (("+", th0), ("-", math.pi - th0)):
+                z = tz + d * math.cos(th) * cp
+                out.append(Solution(lt + lp, np.array([z, *_wrap(np.array([th, ps]))])))
+        return out
+
+    # ----- IK, FK -----------------------------------------------------------------------------------------
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """Leg lengths (mm) of every pose that places the tool at T = pose (labels as poses_of_tool_point)."""
+        out = []
+        for sol in self.poses_of_tool_point(design, options, pose):
+            (legs,) = super().inverse_kinematics(design, self._p(options), sol.values)
+            out.append(Solution(sol.label, legs.values))
+        return out
+
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        """T (mm) of every P-model assembly mode with z > 0 (labels as RpsUpu.forward_kinematics)."""
+        return [
+            Solution(s.label, self.tool_point(design, options, s.values))
+            for s in super().forward_kinematics(design, self._p(options), inputs)
+        ]
+
+    # ----- Jacobians --------------------------------------------------------------------------------------
+    def _pose_for(self, design, options, point, q) -> np.ndarray:
+        """The pose placing the tool at T whose leg lengths are closest to q."""
+        poses = self.poses_of_tool_point(design, options, point)
+        if not poses:
+            raise InvalidPose(f"pose: tool point {list(map(float, point))} is out of reach (|T_y| or |T_x| > d)")
+        qv = self.check_vector("inputs", q, 3)
+        legs = [RpsUpu.inverse_kinematics(self, design, self._p(options), s.values)[0].values for s in poses]
+        return poses[int(np.argmin([np.abs(lv - qv).max() for lv in legs]))].values
+
+    def jacobians(self, design, options, pose, q) -> dict[str, np.ndarray | None]:
+        """At tool point T with leg lengths q: dq_dT = dq/d(z0, theta, psi) . d(z0, theta, psi)/dT (dimensionless),
+        Jx = diag(q) dq_dT, Jq = diag(q) and the forward Jacobian J = dT/dq (None at a singularity). The pose is
+        the one (of up to four) whose legs are closest to q."""
+        x = self._pose_for(design, options, pose, q)
+        base = super().jacobians(design, self._p(options), x, q)
+        _, th, ps = x
+        d = options["tool_offset"]
+        st, ct, sp, cp = math.sin(th), math.cos(th), math.sin(ps), math.cos(ps)
+        dT_dx = np.array([[0.0, -d * ct * cp, d * st * sp], [0.0, 0.0, d * cp], [1.0, d * st * cp, d * ct * sp]])
+        jx = np.linalg.solve(dT_dx.T, base["Jx"].T).T if abs(ct * cp) > 0.0 else None
+        out: dict[str, np.ndarray | None] = {"Jx": jx, "Jq": base["Jq"], "dT_dx": dT_dx, "dq_dT": None, "J": None}
+        if jx is not None and base["dq_dx"] is not None:
+            out["dq_dT"] = jx / base["Jq"].diagonal()[:, None]
+            try:
+                out["J"] = np.linalg.solve(jx, base["Jq"])
+            except np.linalg.LinAlgError:
+                out["J"] = None
+        return out
+
+    def lci(self, design, options, pose, q) -> float:
+        """LCI = sigma_min / sigma_max of dq/dT with NumPy's SVD (0 at any singularity)."""
+        jac = self.jacobians(design, options, pose, q)
+        if jac["dq_dT"] is None:
+            return 0.0
+        sv = np.linalg.svd(jac["dq_dT"], compute_uv=False)
+        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'inverse' when a leg length q_i <= tol (g + h + c); 'forward' when the normalised rows of q_i dq_i/dT are
+        dependent (sigma ratio <= tol) or |cos theta cos psi| <= tol (T no longer fixes the pose)."""
+        jac = self.jacobians(design, options, pose, q)
+        g, h, c, _ = self._geom(design)
+        inverse = bool(np.any(jac["Jq"].diagonal() <= tol * (g + h + c)))
+        if jac["Jx"] is None:
+            forward = True
+        else:
+            norms = np.linalg.norm(jac["Jx"], axis=1)
+            forward = bool(np.any(norms == 0.0))
+            if not forward:
+                sv = np.linalg.svd(jac["Jx"] / norms[:, None], compute_uv=False)
+                forward = bool(sv[-1] <= tol * sv[0])
+            x = self._pose_for(design, options, pose, q)
+            forward = forward or abs(math.cos(x[1]) * math.cos(x[2])) <= tol
+        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
+            (inverse, forward), "both"
+        )
+
+
+TOOL_MECHANISM = RpsUpuTool(
+    name="rps-upu-tool",
+    title="2-RPS-UPU tool-point position workspace (seed 002, P-model)",
+    seed="002",
+    motion="2R1T",
+    task_axes=("x", "y", "z"),
+    task_units=("length", "length", "length"),
+    joints=("q1", "q2", "q3"),
+    joint_units=("length", "length", "length"),
+    parameters=MECHANISM.parameters,
+    options=(
+        Option("tool_offset", 50.0, "d (mm): T = O' + R (0, 0, -d); illustrative default, the paper has no tool"),
+        *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
     ),
     default_length_unit="mm",
 )
