@@ -187,3 +187,9 @@ def test_cli_optimize_plots_select_evaluate(tmp_path):
     assert r.returncode == 2 and "--weights" in r.stderr
     r = _cli("plot-front", str(tmp_path))
     assert r.returncode == 2 and "not a scalesynth results directory" in r.stderr
+
+
+def test_reproduce_from_manifest(small_run, tmp_path):
+    r = _cli("reproduce", str(small_run.out_dir), "--out", str(tmp_path / "again"))
+    assert r.returncode == 0, r.stderr
+    assert "pareto.csv identical" in r.stdout

@@ -305,3 +305,21 @@ def load_result(out: Path) -> RunResult:
         history=pd.read_csv(out / "history.csv"),
         manifest=manifest,
     )
+
+
+def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
+    """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes."""
+    from scalesynth.config import config_from_dict
+
+    original = load_result(run_dir)
+    cfg = config_from_dict(original.manifest["config"])
+    result = run(cfg, out_dir, plots=False)
+    same = (Path(run_dir) / "pareto.csv").read_bytes() == (Path(out_dir) / "pareto.csv").read_bytes()
+    return {
+        "identical": same,
+        "original": str(run_dir),
+        "rerun": str(out_dir),
+        "wall_seconds": result.manifest["wall_seconds"],
+        "hypervolume": result.manifest["hypervolume"],
+        "original_hypervolume": original.manifest["hypervolume"],
+    }

@@ -34,7 +34,8 @@ def front_figure(
     for k, (label, rx, ry) in enumerate(references):
         label0 = "reference designs (re-evaluated)" if k == 0 else None
         ax.scatter([rx], [ry], marker="s", s=40, c="C3", zorder=4, label=label0)
-        ax.annotate(label, (rx, ry), textcoords="offset points", xytext=(5, 4), fontsize=8, color="C3")
+        # staggered labels: reference designs often sit close together
+        ax.annotate(label, (rx, ry), textcoords="offset points", xytext=(5, 4 + 9 * (k % 4)), fontsize=8, color="C3")
     for label, hx, hy in highlight:
         ax.scatter([hx], [hy], marker="*", s=160, c="gold", edgecolors="k", zorder=5)
         ax.annotate(label, (hx, hy), textcoords="offset points", xytext=(6, -12), fontsize=9)

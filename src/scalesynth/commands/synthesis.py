@@ -94,3 +94,23 @@ def select_cmd(
     typer.echo(f"{method} design: " + ", ".join(f"{k}={v:.6g}" for k, v in chosen["design"].items()))
     typer.echo("  " + ", ".join(f"{k}={v:.6g}" for k, v in chosen["metrics"].items()))
     typer.echo(f"  config written to {chosen['config']}")
+
+
+@app.command("reproduce")
+@handles_errors
+def reproduce_cmd(
+    run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
+    out: Annotated[Path | None, typer.Option("--out", help="where to re-run (default: a temporary directory)")] = None,
+) -> None:
+    """Re-run a finished run from its manifest (config and seed) and check pareto.csv is byte-identical."""
+    import tempfile
+
+    from scalesynth.optimize import reproduce
+
+    with tempfile.TemporaryDirectory() as tmp:
+        info = reproduce(run_dir, out if out is not None else Path(tmp) / "rerun")
+    verdict = "identical" if info["identical"] else "DIFFERENT"
+    typer.echo(f"pareto.csv {verdict}: HV {info['hypervolume']:.6g} (original {info['original_hypervolume']:.6g}), "
+               f"re-run took {info['wall_seconds']:.1f} s")
+    if not info["identical"]:
+        raise typer.Exit(1)
