@@ -193,3 +193,19 @@ def test_reproduce_from_manifest(small_run, tmp_path):
     r = _cli("reproduce", str(small_run.out_dir), "--out", str(tmp_path / "again"))
     assert r.returncode == 0, r.stderr
     assert "pareto.csv identical" in r.stdout
+
+
+def test_results_validator_accepts_a_run_and_catches_damage(tmp_path):
+    import shutil
+
+    from scalesynth.validate_results import check_results
+
+    res = run(small_cfg(), tmp_path / "ok")  # with plots and report
+    assert check_results(res.out_dir) == []
+    bad = tmp_path / "bad"
+    shutil.copytree(res.out_dir, bad)
+    p = pd.read_csv(bad / "pareto.csv")
+    p.loc[1, "gci"] = p["gci"].min() - 0.01  # worse than every row in both objectives: dominated
+    p.loc[1, "volume_m3"] = p["volume_m3"].min() - 0.01
+    p.to_csv(bad / "pareto.csv", index=False)
+    assert any("dominated" in msg for msg in check_results(bad))

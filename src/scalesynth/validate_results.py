@@ -1,0 +1,92 @@
+"""Schema and invariant checks of a finished results directory (CI: `python -m scalesynth.validate_results DIR`).
+
+Checks: every file present and parseable; pareto.csv has the design variables, derived and metric columns; no
+NaN/inf; design variables within bounds; LCI-type metrics in [0, 1]; band shares sum to 1; every row non-dominated
+and no two rows equal in objective space; history generations 1..n_gen with non-decreasing hypervolume; manifest
+status finished with matching evaluations.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from scalesynth.config import load_config
+from scalesynth.problem import SynthesisProblem
+
+
+def check_results(run_dir: Path) -> list[str]:
+    """Problems found (empty list: the directory is valid)."""
+    run_dir = Path(run_dir)
+    problems: list[str] = []
+    for name in ("pareto.csv", "population.csv", "history.csv", "manifest.json", "config.yaml", "report.md"):
+        if not (run_dir / name).is_file():
+            problems.append(f"{name}: missing")
+    if problems:
+        return problems
+    leftovers = [p.name for p in run_dir.iterdir() if p.name.endswith(".tmp") or p.name == "checkpoint.pkl"]
+    if leftovers:
+        problems.append(f"leftover files: {', '.join(sorted(leftovers))}")
+    cfg = load_config(run_dir / "config.yaml")
+    problem = SynthesisProblem(cfg)
+    manifest = json.loads((run_dir / "manifest.json").read_text())
+    pareto = pd.read_csv(run_dir / "pareto.csv")
+    history = pd.read_csv(run_dir / "history.csv")
+    expected = [*problem.var_names, *cfg.mech.derived_columns(problem.base_design), *problem.metric_columns, "rank"]
+    missing = [c for c in expected if c not in pareto.columns]
+    if missing:
+        problems.append(f"pareto.csv: missing columns {missing}")
+        return problems
+    numeric = pareto.select_dtypes(include=[np.number]).to_numpy(dtype=float)
+    if not np.all(np.isfinite(numeric)):
+        problems.append("pareto.csv: NaN or inf values")
+    for k in problem.var_names:
+        lo, hi = cfg.bounds[k]
+        if not pareto[k].between(lo, hi).all():
+            problems.append(f"pareto.csv: {k} outside bounds [{lo}, {hi}]")
+    for col in ("gci", "fci", "min_lci", "max_lci") + tuple(c for c in pareto.columns if c.endswith("_share")):
+        if col in pareto.columns and not pareto[col].between(0.0, 1.0).all():
+            problems.append(f"pareto.csv: {col} outside [0, 1]")
+    shares = [c for c in pareto.columns if c.startswith("band") and c.endswith("_share")]
+    nonempty = pareto["voxels"] > 0
+    if shares and not np.allclose(pareto.loc[nonempty, shares].sum(axis=1), 1.0, atol=1e-9):
+        problems.append("pareto.csv: band shares do not sum to 1")
+    F = pareto[problem.objective_keys].to_numpy(dtype=float) * problem.signs
+    for i in range(len(F)):
+        dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
+        if dominated.any():
+            problems.append(f"pareto.csv: row {i} is dominated by row {int(np.argmax(dominated))}")
+            break
+    if len(np.unique(F, axis=0)) != len(F):
+        problems.append("pareto.csv: duplicate rows in objective space")
+    if (pareto["rank"] != 0).any():
+        problems.append("pareto.csv: rank must be 0 on the front")
+    gens = list(history["generation"])
+    if gens != list(range(1, cfg.algorithm.n_gen + 1)):
+        problems.append(f"history.csv: generations {gens[:3]}... are not 1..{cfg.algorithm.n_gen}")
+    if (np.diff(history["hypervolume"]) < -1e-12).any():
+        problems.append("history.csv: hypervolume decreased")
+    if manifest.get("status") != "finished":
+        problems.append("manifest.json: status is not finished")
+    if manifest.get("evaluations") != int(history["evaluations"].iloc[-1]):
+        problems.append("manifest.json: evaluations differ from history.csv")
+    return problems
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 1:
+        print("usage: python -m scalesynth.validate_results RUN_DIR", file=sys.stderr)
+        return 2
+    problems = check_results(Path(argv[0]))
+    for p in problems:
+        print(f"FAIL {p}")
+    print(f"{argv[0]}: {'ok' if not problems else f'{len(problems)} problem(s)'}")
+    return 0 if not problems else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
