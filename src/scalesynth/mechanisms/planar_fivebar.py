@@ -273,6 +273,44 @@ class PlanarFivebar(Mechanism):
         j = self.jacobians(design, options, pose, branches[self.kernel_branch(options)])["J"]
         return math.inf if j is None else float(np.linalg.norm(j @ dq))
 
+    # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
+    def topology(self, design, options):
+        """Joint list of paper §1 (planar, each parallelogram counted as one 1-DOF joint): the right chain is
+        two parallelograms in series (active arm + arm link, then forearm + forearm link, joined by the hinge
+        plate), the left chain a revolute arm and a forearm (its two rods act as one link): n = 5 (base, platform,
+        hinge plate, left arm, left forearm), g = 5, sum f = 5, planar G-K 3(5 - 5 - 1) + 5 = 2."""
+        from scalesynth.mobility import Topology
+
+        return Topology(
+            n_links=5,
+            chains=(("PaPa (right)", ("Pa", "Pa")), ("RRR (left)", ("R", "R", "R"))),
+            order=3,
+            note="paper §1: planar G-K; the parallelograms only keep the platform from turning",
+        )
+
+    def joint_screws(self, design, options, pose, q):
+        """Unit joint screws (omega; v) per chain at pose P = (x, y) with arm angles q, the plane z = 0 embedded in
+        space (mm). Chain 1 (right, pivot B1): the hinge plate translates along dQ1/dalpha1 ~ (-sin alpha1,
+        cos alpha1, 0), the platform relative to it along (-sin beta1, cos beta1, 0). Chain 2 (left): revolutes
+        about z at B2, Q2 and P."""
+        from scalesynth.mobility import Joint, chain_screws
+
+        x, y = self.check_vector("pose", pose, 2)
+        a1, _ = self.check_vector("inputs", q, 2)
+        b1, _ = self.forearm_angles(design, pose, q)
+        _, q2 = self.elbows(design, q)
+        zhat = (0.0, 0.0, 1.0)
+        right = chain_screws([
+            Joint("Pa", axes=((-math.sin(a1), math.cos(a1), 0.0),)),
+            Joint("Pa", axes=((-math.sin(b1), math.cos(b1), 0.0),)),
+        ])
+        left = chain_screws([
+            Joint("R", (-design["r"], 0.0, 0.0), (zhat,)),
+            Joint("R", (q2[0], q2[1], 0.0), (zhat,)),
+            Joint("R", (x, y, 0.0), (zhat,)),
+        ])
+        return [right, left]
+
 
 def _wrap(t: float) -> float:
     """Angle in (-pi, pi]."""
