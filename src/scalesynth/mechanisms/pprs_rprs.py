@@ -655,6 +655,57 @@ class PprsRprs(Mechanism):
         q = np.asarray(q, dtype=float)
         return [n for n, v, (lo, hi) in zip(JOINTS, q, self.joint_limits(options), strict=True) if not lo <= v <= hi]
 
+    # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
+    def topology(self, design, options):
+        """Joint list of spec §1.2: chains PPRS, PPRS, RPRS; n = 11 (base, platform, three links per chain),
+        g = 12, sum f = 18, classical G-K 6(11 - 12 - 1) + 18 = 6 with no redundant constraint."""
+        from scalesynth.mobility import Topology
+
+        return Topology(
+            n_links=11,
+            chains=(
+                ("PPRS-1", ("P", "P", "R", "S")),
+                ("PPRS-2", ("P", "P", "R", "S")),
+                ("RPRS", ("R", "P", "R", "S")),
+            ),
+            note="spec §1.2 (paper): classical G-K, every chain has six independent joint twists",
+        )
+
+    def joint_screws(self, design, options, pose, q):
+        """Unit joint screws (omega; v) per chain at a pose (x, y, z[, phi, theta, psi]) with inputs
+        q = (w1, w2, beta, s1, s2, s3), fixed frame of spec §1.1 (mm).
+
+        PPRS_i: carriage along u_i, slider along z, revolute about u_i through D_i = B_i + s_i z, spherical
+        joint at C_i. RPRS: revolute about e3 through B3 = R u3, prismatic along d3 = -cos(beta) u3 + sin(beta) z,
+        revolute about n3 = e3 x d3 through D3 = B3 + s3 d3, spherical joint at C3."""
+        from scalesynth.mobility import Joint, chain_screws
+
+        X = self.full_pose(options, pose)
+        w1, w2, beta, s1, s2, s3 = self.check_vector("inputs", q, 6)
+        geo = Geometry.of(design, options)
+        centres = X[:3] + rotation(*X[3:]) @ geo.body.T
+        zhat = np.array([0.0, 0.0, 1.0])
+        chains = []
+        for k, (w, s) in enumerate(((w1, s1), (w2, s2))):
+            u = geo.u[k]
+            b = (geo.rail - w if geo.conv_r else w) * u
+            chains.append(chain_screws([
+                Joint("P", axes=(u,)),
+                Joint("P", axes=(zhat,)),
+                Joint("R", b + s * zhat, (u,)),
+                Joint("S", centres[:, k]),
+            ]))
+        u3, e3 = geo.u[2], geo.e[2]
+        d3 = -math.cos(beta) * u3 + math.sin(beta) * zhat
+        b3 = geo.rail * u3
+        chains.append(chain_screws([
+            Joint("R", b3, (e3,)),
+            Joint("P", axes=(d3,)),
+            Joint("R", b3 + s3 * d3, (np.cross(e3, d3),)),
+            Joint("S", centres[:, 2]),
+        ]))
+        return chains
+
 
 def _is_vector(value) -> bool:
     try:
