@@ -400,6 +400,15 @@ def test_e_nonzero_fk_matches_table_style_solution():
         rps.fk_p_quartic(M._geom(design), q)
 
 
+@pytest.mark.parametrize("pose", [(75.0, 0.0, 0.0), (75.0, 1.0, 0.0)])
+def test_bracketing_finds_roots_at_the_interval_ends(pose):
+    """psi = 0 gives q1 = q2 (D = 0): the root sits where cos psi = 1, an end of the bracketing interval, and F
+    touches zero there without a sign change (found by hypothesis)."""
+    design = M.resolve_design({"g": 40.0, "h": 20.0, "c": 20.0, "e": 1.0})
+    q = M.inverse_kinematics(design, P_OPT, pose)[0].values
+    assert nearest(fk(P_OPT, q, design), pose)[1] < 1e-9
+
+
 def test_fk_unreachable_inputs_give_no_solution():
     assert fk(P_OPT, (1.0, 1.0, 1.0)) == []
     assert fk(PLANE, (1.0, 1.0, 1.0)) == []

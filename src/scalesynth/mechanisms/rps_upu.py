@@ -383,8 +383,8 @@ def fk_p_bracket(geom: tuple, q, samples: int = 2048) -> np.ndarray:
     the q3 equation and cos psi are real; the ends are where the branches join or |cos psi| = 1. Each branch's
     F(z) (see ``_p_branch_residual``) is sampled at ``samples`` points and every sign change bisected; the
     samples around each local minimum of |F| below 1 % of max |F| are added as candidates, so that a pair of roots
-    closer than the sample step (next to a forward singularity) still gets a start for the Newton polish.
-    z > 0 only.
+    closer than the sample step (next to a forward singularity) still gets a start for the Newton polish, and so
+    do both ends. z > 0 only.
     """
     g, h, c, e = geom
     q = np.asarray(q, dtype=float)
@@ -396,7 +396,11 @@ def fk_p_bracket(geom: tuple, q, samples: int = 2048) -> np.ndarray:
     zs = np.linspace(math.sqrt(t_lo), math.sqrt(t_hi), samples)
     z_out, th_out = [], []
     for branch in (1.0, -1.0):
-        f, _ = _p_branch_residual(geom, q, zs, branch)
+        f, theta = _p_branch_residual(geom, q, zs, branch)
+        # the ends are candidates too: with q1 = q2 (D = 0, psi = 0) the root sits where |cos psi| = 1, and F
+        # touches zero there without changing sign
+        z_out.extend(zs[[0, -1]])
+        th_out.extend(theta[[0, -1]])
         # a pair of roots closer than the sample step shows as a local minimum of |F| without a sign change:
         # its neighbourhood goes to the Newton polish as extra candidates
         af = np.abs(f)
