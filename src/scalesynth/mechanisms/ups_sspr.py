@@ -334,6 +334,68 @@ class UpsSspr(Mechanism):
             out.append(Solution(label, np.array([alpha, beta, yy])))
         return out
 
+    # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
+    def topology(self, design, options):
+        """Joint list of spec §3.2: chains UPS, UPS and the hybrid (S+SPR)R (S at A0 on the link A0B1, the
+        SPR chain S-P-R closing on that link, the revolute at B1); n = 9 (base, platform, two links per UPS
+        chain, the SPR cylinder and piston, the link A0B1), g = 11, sum f = 21, classical G-K
+        6(9 - 11 - 1) + 21 = 3 with no redundant constraint."""
+        from scalesynth.mobility import Topology
+
+        return Topology(
+            n_links=9,
+            chains=(
+                ("UPS-2", ("U", "P", "S")),
+                ("UPS-3", ("U", "P", "S")),
+                ("(S+SPR)R", ("S", "S", "P", "R", "R")),
+            ),
+            note="spec §3.2 recount (classical G-K; the paper's own count was lost in extraction)",
+        )
+
+    def joint_screws(self, design, options, pose, q=None):
+        """Joint screws (omega; v) per chain at pose (alpha, beta, Y), fixed frame A0-xyz of spec §3.1 (mm);
+        ``q`` is not needed (the legs follow from the pose).
+
+        UPS_i (i = 2, 3): U at A_i turning about the base-fixed tangent z x A_i / |A_i| and then about the
+        axis normal to it and to the leg (the paper gives no axis directions; any U whose axes do not contain
+        the leg gives the same six-dimensional twist space), prismatic along the leg, S at B_i. (S+SPR)R: its
+        inner loop enters as the link A0B1's twists, those common to the S at A0 and to the SPR chain (S at M,
+        prismatic along M -> B0, B0 = k0 B1, revolute about the link's x axis Ry(beta) x through B0): the
+        "equivalent 2R" of spec §3.1, about y and the link's x axis through A0; then the revolute at B1 about
+        the platform's u axis R x."""
+        from scalesynth.errors import InvalidPose
+        from scalesynth.mobility import Joint, body_twists, chain_screws
+
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        a, b, c = design["a"], design["b"], design["c"]
+        if not abs(yy) < c:
+            raise InvalidPose(f"pose: |Y| = {abs(yy):g} must be below c = {c:g}")
+        rho = math.sqrt(c * c - yy * yy)
+        sa, ca, sb, cb = math.sin(alpha), math.cos(alpha), math.sin(beta), math.cos(beta)
+        # R = Ry(beta) Rx(alpha)
+        rot = np.array([[cb, sb * sa, sb * ca], [0.0, ca, -sa], [-sb, cb * sa, cb * ca]])
+        p = np.array([sb * rho, yy, cb * rho])
+        bxy = b * INV_SQRT2
+        chains = []
+        for sx in (-1.0, 1.0):  # leg 2 (A2, B2'), leg 3 (A3, B3')
+            base = np.array([sx * SQRT3_2 * a, -a / 2.0, 0.0])
+            top = p + rot @ np.array([sx * bxy, bxy, 0.0])
+            tangent = np.cross((0.0, 0.0, 1.0), base)
+            chains.append(chain_screws([
+                Joint("U", base, (tangent, np.cross(tangent, top - base))),
+                Joint("P", axes=(top - base,)),
+                Joint("S", top),
+            ]))
+        x_link = rot[:, 0]  # Ry(beta) x: the link's and the platform's x axis
+        m = np.array([0.0, -a / 2.0, 0.0])
+        b0 = K0 * p
+        link = body_twists(
+            Joint("S", (0.0, 0.0, 0.0)).screws(),
+            chain_screws([Joint("S", m), Joint("P", axes=(b0 - m,)), Joint("R", b0, (x_link,))]),
+        )
+        chains.append(link + Joint("R", p, (x_link,)).screws())
+        return chains
+
 
 def _starts():
     """Newton starting points (alpha, beta) [rad]: (0, 0) first, then a 12 x 5 grid."""
