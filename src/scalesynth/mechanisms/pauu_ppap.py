@@ -403,32 +403,32 @@ class PauuPpap(Mechanism):
 
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
-        """Joint list of paper §1 for the G-K counts, each parallelogram Pa counted as one 1-DOF joint: chains
-        PaUU, PaUU and PPaP; n = 8 (base, platform, two links per chain), g = 9, sum f = 13. The classical count
-        6(8 - 9 - 1) + 13 = 1 misses nu = 2 redundant constraints: each PaUU chain exerts one couple and PPaP
-        three, and together they span only the three couples, so the modified count is 3."""
+        """Joint list of paper §1 for the G-K counts, each parallelogram Pa counted as one 1-DOF joint:
+        chains PaUU, PaUU and PPaP; n = 8 (base, platform, two links per chain), g = 9, sum f = 13. The
+        classical count 6(8 - 9 - 1) + 13 = 1 misses nu = 2 redundant constraints: each PaUU chain exerts
+        one couple and PPaP three, and together they span only the three couples: the modified count is 3."""
         from scalesynth.mobility import Topology
 
         return Topology(
             n_links=8,
             chains=(("PaUU-1", ("Pa", "U", "U")), ("PaUU-2", ("Pa", "U", "U")), ("PPaP", ("P", "Pa", "P"))),
             redundant=2,
-            note="the paper (§1.2, POC sets) counts F = sum f - sum xi_L = 13 - (6 + 4) = 3; as a modified G-K "
-            "count the chains' 1 + 1 + 3 constraint couples span 3: nu = 2",
+            note="the paper (§1.2, POC sets) counts F = sum f - sum xi_L = 13 - (6 + 4) = 3; as a modified "
+            "G-K count the chains' 1 + 1 + 3 constraint couples span 3: nu = 2",
         )
 
     def joint_screws(self, design, options, pose, q):
-        """Unit joint screws (omega; v) per chain at pose P = (x, y, z) with inputs q = (theta1, theta2, d), in the
-        fixed frame of spec §1.1 (design length units).
+        """Unit joint screws (omega; v) per chain at pose P = (x, y, z) with inputs q = (theta1, theta2, d),
+        in the fixed frame of spec §1.1 (design length units).
 
-        PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction
-        (-s_i sin theta_i, 0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes) then
-        about t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about t_i then
-        y, so the chain's one constraint is a couple along the xz-projection of w_i. PPaP: the paper gives no
-        dimensions, only three translations in different directions (its eq. 4); taken as the stroke d along y,
-        a parallelogram in the xz-plane with long links l1 + l2 pivoted at x = 0 (so every |x| of the workspace is
-        reachable; its moving link translates along (-sin phi, 0, cos phi), cos phi = x / (l1 + l2)) and a slide
-        along z."""
+        PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction (-s_i sin theta_i,
+        0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes) then about
+        t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about t_i then y, so
+        the chain's one constraint is a couple along the xz-projection of w_i. PPaP: the paper gives no
+        dimensions, only three translations in different directions (its eq. 4); taken as the stroke d along
+        y, a parallelogram in the xz-plane with long links L = l1 + l2 pivoted at x = 0 (so every |x| of the
+        workspace is reachable; its moving link translates along (-sin phi, 0, cos phi), cos phi = x / L)
+        and a slide along z."""
         from scalesynth.mobility import Joint, chain_screws
 
         x, y, z = self.check_vector("pose", pose, 3)

@@ -275,10 +275,11 @@ class PlanarFivebar(Mechanism):
 
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
-        """Joint list of paper §1 (planar, each parallelogram counted as one 1-DOF joint): the right chain is
-        two parallelograms in series (active arm + arm link, then forearm + forearm link, joined by the hinge
-        plate), the left chain a revolute arm and a forearm (its two rods act as one link): n = 5 (base, platform,
-        hinge plate, left arm, left forearm), g = 5, sum f = 5, planar G-K 3(5 - 5 - 1) + 5 = 2."""
+        """Joint list of paper §1 (planar, each parallelogram counted as one 1-DOF joint): the right chain
+        is two parallelograms in series (active arm + arm link, then forearm + forearm link, joined by the
+        hinge plate), the left chain a revolute arm and a forearm (its two rods act as one link): n = 5
+        (base, platform, hinge plate, left arm, left forearm), g = 5, sum f = 5: planar G-K
+        3(5 - 5 - 1) + 5 = 2."""
         from scalesynth.mobility import Topology
 
         return Topology(
@@ -289,10 +290,10 @@ class PlanarFivebar(Mechanism):
         )
 
     def joint_screws(self, design, options, pose, q):
-        """Unit joint screws (omega; v) per chain at pose P = (x, y) with arm angles q, the plane z = 0 embedded in
-        space (mm). Chain 1 (right, pivot B1): the hinge plate translates along dQ1/dalpha1 ~ (-sin alpha1,
-        cos alpha1, 0), the platform relative to it along (-sin beta1, cos beta1, 0). Chain 2 (left): revolutes
-        about z at B2, Q2 and P."""
+        """Unit joint screws (omega; v) per chain at pose P = (x, y) with arm angles q, the plane z = 0
+        embedded in space (mm). Chain 1 (right, pivot B1): the hinge plate translates along dQ1/dalpha1 ~
+        (-sin alpha1, cos alpha1, 0), the platform relative to it along (-sin beta1, cos beta1, 0). Chain 2
+        (left): revolutes about z at B2, Q2 and P."""
         from scalesynth.mobility import Joint, chain_screws
 
         x, y = self.check_vector("pose", pose, 2)
