@@ -421,10 +421,10 @@ class PauuPpap(Mechanism):
         """Unit joint screws (omega; v) per chain at pose P = (x, y, z) with inputs q = (theta1, theta2, d),
         in the fixed frame of spec §1.1 (design length units).
 
-        PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction (-s_i sin theta_i,
-        0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes) then about
-        t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about t_i then y, so
-        the chain's one constraint is a couple along the xz-projection of w_i. PPaP: the paper gives no
+        PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction
+        (-s_i sin theta_i, 0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes)
+        then about t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about
+        t_i then y, so the chain's one constraint is a couple along the xz-projection of w_i. PPaP: the paper gives no
         dimensions, only three translations in different directions (its eq. 4); taken as the stroke d along
         y, a parallelogram in the xz-plane with long links L = l1 + l2 pivoted at x = 0 (so every |x| of the
         workspace is reachable; its moving link translates along (-sin phi, 0, cos phi), cos phi = x / L)
