@@ -424,11 +424,12 @@ class PauuPpap(Mechanism):
         PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction
         (-s_i sin theta_i, 0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes)
         then about t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about
-        t_i then y, so the chain's one constraint is a couple along the xz-projection of w_i. PPaP: the paper gives no
-        dimensions, only three translations in different directions (its eq. 4); taken as the stroke d along
-        y, a parallelogram in the xz-plane with long links L = l1 + l2 pivoted at x = 0 (so every |x| of the
-        workspace is reachable; its moving link translates along (-sin phi, 0, cos phi), cos phi = x / L)
-        and a slide along z."""
+        t_i then y, so the chain's one constraint is a couple along the xz-projection of w_i.
+
+        PPaP: the paper gives no dimensions, only three translations in different directions (its eq. 4);
+        taken as the stroke d along y, a parallelogram in the xz-plane with long links L = l1 + l2 pivoted at
+        x = 0 (so every |x| of the workspace is reachable; its moving link translates along
+        (-sin phi, 0, cos phi), cos phi = x / L) and a slide along z."""
         from scalesynth.mobility import Joint, chain_screws
 
         x, y, z = self.check_vector("pose", pose, 3)
