@@ -676,8 +676,9 @@ class PprsRprs(Mechanism):
         q = (w1, w2, beta, s1, s2, s3), fixed frame of spec §1.1 (mm).
 
         PPRS_i: carriage along u_i, slider along z, revolute about u_i through D_i = B_i + s_i z, spherical
-        joint at C_i. RPRS: revolute about e3 through B3 = R u3, prismatic along d3 = -cos(beta) u3 + sin(beta) z,
-        revolute about n3 = e3 x d3 through D3 = B3 + s3 d3, spherical joint at C3."""
+        joint at C_i. RPRS: revolute about e3 through B3 = R u3, prismatic along
+        d3 = -cos(beta) u3 + sin(beta) z, revolute about n3 = e3 x d3 through D3 = B3 + s3 d3, spherical joint
+        at C3."""
         from scalesynth.mobility import Joint, chain_screws
 
         X = self.full_pose(options, pose)
