@@ -2,35 +2,37 @@
 
 Two independent answers to "how many degrees of freedom, and which motions?":
 
-* **Counting** (:func:`grubler`, :func:`modified_grubler`) from a :class:`Topology`: n links (base and platform
-  included), g joints with freedoms f_i.
+* **Counting** (:func:`grubler`, :func:`modified_grubler`) from a :class:`Topology`: n links (base and
+  platform included), g joints with freedoms f_i.
   - classical G-K: ``M = d (n - g - 1) + sum f`` with d = 6 in space, 3 for a planar mechanism;
   - modified G-K (Huang's form): ``M = (d - lambda)(n - g - 1) + sum f + nu - zeta`` with lambda the common
     constraints (shared by every chain), nu the redundant (over-) constraints among the chains and zeta the
     passive (idle) freedoms. The topology carries the values the papers (or the spec) use, and says so.
-* **Screw theory** (:func:`screw_analysis`, :func:`screw_mobility`) from the joint screws at one configuration:
-  each chain's constraint wrenches span the reciprocal of its joint twists; the platform's twists span the
-  reciprocal of all the chains' wrenches together; dof = its dimension, the number of rotations = the rank of
-  the angular parts, the rest are translations. The numeric lambda and nu come out as by-products:
-  lambda = dim of the wrenches common to all chains (= 6 - rank of all joint screws together) and
+* **Screw theory** (:func:`screw_analysis`, :func:`screw_mobility`) from the joint screws at one
+  configuration: each chain's constraint wrenches span the reciprocal of its joint twists; the platform's
+  twists span the reciprocal of all the chains' wrenches together; dof = its dimension, the number of
+  rotations = the rank of the angular parts, the rest are translations. The numeric lambda and nu come out as
+  by-products: lambda = dim of the wrenches common to all chains (= 6 - rank of all joint screws together) and
   nu = sum_i c_i - rank(W) - (k - 1) lambda for k chains with c_i constraints each (Huang's nu for a
   mechanism whose only loops are the ones between its chains; a chain with an inner loop enters through its
   resultant twists, see :func:`body_twists`).
 
 :func:`mobility_report` ties both to a registered mechanism: it samples K random reachable configurations
 (points of the bounding box accepted by the point kernel, joint values from the inverse kinematics in the
-kernel's branch) and reports the range of the constraint rank, the generic (most frequent) value and the motion
-type. A mechanism takes part by defining ``topology(design, options) -> Topology`` and
+kernel's branch) and reports the range of the constraint rank, its generic (most frequent) value and the
+motion type. A mechanism takes part by defining ``topology(design, options) -> Topology`` and
 ``joint_screws(design, options, pose, q) -> [[6-vector, ...] per chain]`` (fixed frame).
 
-Screws are 6-vectors (angular; linear) = (omega; v): a revolute joint on the line through r with direction
-omega is (omega; r x omega), a prismatic joint (or a parallelogram, a circular translation) along v is (0; v).
-A wrench (f; m) is reciprocal to a twist (omega; v) when omega . m + v . f = 0.
+Screws are 6-vectors (direction; moment). A twist (omega; v): a revolute joint on the line through r with
+direction omega is (omega; r x omega), a prismatic joint (or a parallelogram, a circular translation) along v
+is (0; v). A wrench (f; m) is reciprocal to a twist (omega; v) when omega . m + v . f = 0. Numerical ranks
+use screws whose moment parts are divided by a length L (:func:`_length`) and then scaled to unit norm:
+that is the same mechanism scaled by 1/L, so reciprocity, ranks and angular parts are unchanged, and one
+relative tolerance fits millimetres and metres alike.
 """
 
 from __future__ import annotations
 
-import math
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -42,7 +44,8 @@ from scalesynth.errors import InvalidParameter, InvalidPose, ScalesynthError
 
 # freedoms of each joint type; "Pa" is a parallelogram counted as one joint (a 1-DOF circular translation)
 FREEDOM = {"R": 1, "P": 1, "U": 2, "S": 3, "Pa": 1}
-# default relative tolerance for numerical ranks (singular values of unit, length-normalised screws)
+_AXES = {"R": 1, "P": 1, "Pa": 1, "U": 2, "S": 3}
+# relative tolerance of numerical ranks (singular values of unit, length-normalised screws)
 RTOL = 1e-8
 
 
@@ -50,14 +53,14 @@ class NoTopology(ScalesynthError):
     """The mechanism declares no joint topology or joint screws, so its mobility cannot be analysed."""
 
 
-# ----- joints and topologies --------------------------------------------------------------------------------
+# ----- joints and topologies ----------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Joint:
     """A joint and, for the numeric check, its geometry at one configuration (fixed frame).
 
     kind: 'R', 'P', 'U', 'S' or 'Pa'. point: a point on the axes (R, U; the centre of S), unused for P and Pa.
     axes: R one direction, U two (in the order of the chain), S three (default x, y, z: any three independent
-    directions span the same twists), P the sliding direction, Pa the velocity direction of the
+    directions give the same twists), P the sliding direction, Pa the velocity direction of the
     parallelogram's moving link.
     """
 
@@ -68,17 +71,17 @@ class Joint:
     def __post_init__(self):
         if self.kind not in FREEDOM:
             raise InvalidParameter(f"joint.kind: expected one of {', '.join(FREEDOM)}, got {self.kind!r}")
-        axes = tuple(tuple(float(v) for v in np.asarray(a, dtype=float).reshape(3)) for a in self.axes)
+        axes = tuple(_vector3("joint.axes", a) for a in self.axes)
         if self.kind == "S" and not axes:
             axes = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-        wanted = {"R": 1, "P": 1, "Pa": 1, "U": 2, "S": 3}[self.kind]
-        if len(axes) != wanted:
+        if len(axes) != _AXES[self.kind]:
+            wanted = _AXES[self.kind]
             raise InvalidParameter(f"joint.axes: a {self.kind} joint needs {wanted} axes, got {len(axes)}")
         point = None
         if self.kind in ("R", "U", "S"):
             if self.point is None:
                 raise InvalidParameter(f"joint.point: a {self.kind} joint needs a point on its axes")
-            point = tuple(float(v) for v in np.asarray(self.point, dtype=float).reshape(3))
+            point = _vector3("joint.point", self.point)
         object.__setattr__(self, "axes", axes)
         object.__setattr__(self, "point", point)
 
@@ -92,14 +95,21 @@ class Joint:
         for axis in self.axes:
             a = np.asarray(axis)
             norm = float(np.linalg.norm(a))
-            if not (norm > 0.0 and math.isfinite(norm)):
-                raise InvalidPose(f"joint.axes: a {self.kind} joint has a zero or non-finite axis {axis}")
+            if not norm > 0.0:
+                raise InvalidPose(f"joint.axes: a {self.kind} joint has a zero axis")
             a = a / norm
             if self.kind in ("P", "Pa"):
                 out.append(np.concatenate([np.zeros(3), a]))
             else:
                 out.append(np.concatenate([a, np.cross(np.asarray(self.point), a)]))
         return out
+
+
+def _vector3(name: str, value) -> tuple[float, float, float]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise InvalidPose(f"{name}: expected 3 finite numbers, got {value!r}")
+    return float(arr[0]), float(arr[1]), float(arr[2])
 
 
 def chain_screws(joints: Sequence[Joint]) -> list[np.ndarray]:
@@ -111,11 +121,11 @@ def chain_screws(joints: Sequence[Joint]) -> list[np.ndarray]:
 class Topology:
     """Links and joints of a parallel mechanism for the G-K counts.
 
-    n_links counts every rigid body, base and platform included (a parallelogram counted as one joint adds only
-    its moving link). chains: (label, joint kinds) per chain between base and platform; a chain with an inner
-    loop lists all its joints (their links go into n_links). order: 6 for a spatial mechanism, 3 for a planar
-    one. common (lambda, beyond the plane's 3 for a planar mechanism), redundant (nu) and passive (zeta): the
-    values of the modified count; note: where they come from and how the paper counts.
+    n_links counts every rigid body, base and platform included (a parallelogram counted as one joint adds
+    only its moving link). chains: (label, joint kinds) per chain between base and platform; a chain with an
+    inner loop lists all its joints (their links go into n_links). order: 6 for a spatial mechanism, 3 for a
+    planar one. common (lambda, beyond the plane's 3 for a planar mechanism), redundant (nu) and passive
+    (zeta): the terms of the modified count; note: where they come from and how the paper counts.
     """
 
     n_links: int
@@ -131,6 +141,8 @@ class Topology:
             raise InvalidParameter(f"topology.order: 6 (spatial) or 3 (planar), got {self.order!r}")
         if self.n_links < 2:
             raise InvalidParameter(f"topology.n_links: base and platform at least, got {self.n_links}")
+        if not self.chains:
+            raise InvalidParameter("topology.chains: at least one chain")
         for label, kinds in self.chains:
             for kind in kinds:
                 if kind not in FREEDOM:
@@ -155,14 +167,17 @@ class Topology:
     def expanded(self) -> Topology:
         """The same mechanism with every parallelogram drawn as its four revolutes (two more links each).
 
-        Its classical count is lower by 3 per parallelogram in space (each planar 4R loop is overconstrained by
-        3) and unchanged in the plane; the redundant constraints grow accordingly, so the modified count agrees.
-        """
-        chains = tuple((label, tuple(j for k in kinds for j in (("R",) * 4 if k == "Pa" else (k,))))
-                       for label, kinds in self.chains)
+        In space each planar 4R loop is overconstrained by 3, so the classical count drops by 3 per
+        parallelogram and nu grows by 3 (the modified count is unchanged); in the plane nothing changes."""
+        chains = tuple(
+            (label, tuple(j for k in kinds for j in (("R",) * 4 if k == "Pa" else (k,))))
+            for label, kinds in self.chains
+        )
         extra = 3 * self.parallelograms if self.order == 6 else 0
-        return Topology(self.n_links + 2 * self.parallelograms, chains, self.order, self.common,
-                        self.redundant + extra, self.passive, self.note)
+        return Topology(
+            self.n_links + 2 * self.parallelograms, chains, self.order, self.common, self.redundant + extra,
+            self.passive, self.note,
+        )
 
 
 def grubler(top: Topology) -> int:
@@ -176,7 +191,7 @@ def modified_grubler(top: Topology) -> int:
     return d * (top.n_links - top.n_joints - 1) + top.sum_freedom + top.redundant - top.passive
 
 
-# ----- screw algebra -------------------------------------------------------------------------------------------
+# ----- screw algebra -------------------------------------------------------------------------------------
 _SWAP = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])  # reciprocal product matrix
 
 
@@ -187,30 +202,10 @@ def _stack(screws) -> np.ndarray:
     return arr
 
 
-def _rank_and_null(rows: np.ndarray, rtol: float) -> tuple[int, np.ndarray]:
-    """Rank of a (k, 6) matrix (singular values above rtol * 1, the screws being unit) and an orthonormal basis
-    (rows) of its null space."""
-    if rows.shape[0] == 0:
-        return 0, np.eye(6)
-    _, sv, vt = np.linalg.svd(rows)
-    rank = int(np.sum(sv > rtol * max(1.0, sv[0])))
-    return rank, vt[rank:]
-
-
-def reciprocal(screws, rtol: float = RTOL) -> np.ndarray:
-    """Orthonormal basis (rows) of the screws reciprocal to all given screws: x with s^T Delta x = 0, where
-    Delta = [[0, I], [I, 0]]. Twists in, wrenches out, and the other way round."""
-    rows = _stack(screws)
-    return _rank_and_null(rows @ _SWAP, rtol)[1]
-
-
-def rank(screws, rtol: float = RTOL) -> int:
-    return _rank_and_null(_stack(screws), rtol)[0]
-
-
 def _length(stacks: Sequence[np.ndarray]) -> float:
-    """The largest distance from the origin of a screw's axis ((|v| / |omega|) over the screws with omega != 0),
-    1 when there is none: the length that makes the linear parts comparable with the unit angular parts."""
+    """The largest distance from the origin of a screw axis, |moment| / |direction| over the screws with a
+    non-zero direction part (1 when there is none): the length that makes moments comparable with unit
+    directions."""
     every = np.vstack(stacks) if stacks else np.zeros((0, 6))
     w = np.linalg.norm(every[:, :3], axis=1)
     rot = w > 0.0
@@ -218,17 +213,11 @@ def _length(stacks: Sequence[np.ndarray]) -> float:
     return length if length > 0.0 else 1.0
 
 
-def _normalised(chains: Sequence[Sequence[np.ndarray]]) -> list[np.ndarray]:
-    """Chains' screws with the linear parts divided by :func:`_length`, each screw then scaled to unit norm, so
-    that one relative rank tolerance fits mm and m alike.
-
-    Dividing every linear part by L describes the same mechanism scaled by 1/L: reciprocity, ranks and the
-    angular parts (hence the motion type) are unchanged."""
-    stacks = [_stack(c) for c in chains]
-    scale = np.concatenate([np.ones(3), np.full(3, 1.0 / _length(stacks))])
+def _scaled(stacks: Sequence[np.ndarray], length: float) -> list[np.ndarray]:
+    """Screws with moments divided by ``length``, each row then of unit norm."""
     out = []
     for s in stacks:
-        s = s * scale
+        s = s * np.array([1.0, 1.0, 1.0, 1.0 / length, 1.0 / length, 1.0 / length])
         norms = np.linalg.norm(s, axis=1)
         if np.any(norms == 0.0):
             raise InvalidPose("joint screws: a zero screw")
@@ -236,9 +225,44 @@ def _normalised(chains: Sequence[Sequence[np.ndarray]]) -> list[np.ndarray]:
     return out
 
 
+def _unscaled(rows: np.ndarray, length: float) -> np.ndarray:
+    """Back to the original units (moments times ``length``)."""
+    return rows * np.array([1.0, 1.0, 1.0, length, length, length])
+
+
+def _rank_and_null(rows: np.ndarray, rtol: float) -> tuple[int, np.ndarray]:
+    """Numerical rank of a (k, 6) matrix of unit rows (singular values above rtol times the largest, at
+    least 1) and an orthonormal basis (rows) of its null space."""
+    if rows.shape[0] == 0:
+        return 0, np.eye(6)
+    _, sv, vt = np.linalg.svd(rows)
+    r = int(np.sum(sv > rtol * max(1.0, sv[0])))
+    return r, vt[r:]
+
+
+def _reciprocal_unit(rows: np.ndarray, rtol: float) -> np.ndarray:
+    """Orthonormal basis (rows) of the screws reciprocal to the given (already scaled) screws."""
+    return _rank_and_null(rows @ _SWAP, rtol)[1]
+
+
+def reciprocal(screws, rtol: float = RTOL) -> np.ndarray:
+    """Basis (rows) of the screws reciprocal to all given screws (x with s^T Delta x = 0 for every s, where
+    Delta = [[0, I], [I, 0]]), in the given units: twists in, wrenches out, and the other way round."""
+    stack = _stack(screws)
+    length = _length([stack])
+    return _unscaled(_reciprocal_unit(_scaled([stack], length)[0], rtol), length)
+
+
+def rank(screws, rtol: float = RTOL) -> int:
+    """Numerical rank of a set of screws (the dimension of their span)."""
+    stack = _stack(screws)
+    return _rank_and_null(_scaled([stack], _length([stack]))[0], rtol)[0]
+
+
 def motion_name(rotations: int, translations: int) -> str:
-    """The papers' names: '3T' and '2T' without rotations, '3R' without translations, rotations first when they
-    outnumber the translations ('2R1T'), translations first otherwise ('3T3R', '3T1R', '2T1R')."""
+    """The papers' names: '3T' and '2T' without rotations, '3R' without translations, rotations first when
+    they outnumber the translations ('2R1T'), translations first otherwise ('3T3R', '3T1R', '2T1R'); '0' for
+    a rigid structure."""
     if rotations == 0 and translations == 0:
         return "0"
     if rotations == 0:
@@ -255,9 +279,10 @@ class ScrewResult:
     """Screw-theory mobility at one configuration.
 
     dof: dimension of the platform twist space; rotations: rank of its angular parts; motion: e.g. '2R1T';
-    chain_ranks / chain_constraints: per chain, rank of its joint twists and 6 minus that; constraint_rank: rank
-    of all chains' wrenches together (dof = 6 - constraint_rank); common (lambda) and redundant (nu) as in the
-    module docstring; twists / wrenches: orthonormal bases (rows) in the length-normalised frame.
+    chain_ranks / chain_constraints: per chain, the rank of its joint twists and 6 minus that;
+    constraint_rank: rank of all the chains' wrenches together (dof = 6 - constraint_rank); common (lambda)
+    and redundant (nu) as in the module docstring; twists / wrenches: bases (rows) of the platform twists and
+    of the constraint wrenches, in the units of the joint screws.
     """
 
     dof: int
@@ -280,23 +305,24 @@ def screw_analysis(chains: Sequence[Sequence[np.ndarray]], rtol: float = RTOL) -
     """Platform mobility from each chain's joint screws (lists of 6-vectors (omega; v) in one frame)."""
     if not chains:
         raise InvalidParameter("chains: at least one chain of joint screws is needed")
-    norm = _normalised(chains)
+    stacks = [_stack(c) for c in chains]
+    length = _length(stacks)
+    unit = _scaled(stacks, length)
     ranks, counts, wrench_rows = [], [], []
-    for s in norm:
-        r, _ = _rank_and_null(s, rtol)
-        w = reciprocal(s, rtol)
-        ranks.append(r)
+    for s in unit:
+        ranks.append(_rank_and_null(s, rtol)[0])
+        w = _reciprocal_unit(s, rtol)
         counts.append(w.shape[0])
         wrench_rows.append(w)
-    wrenches_all = np.vstack(wrench_rows)
-    constraint_rank, _ = _rank_and_null(wrenches_all, rtol)
-    twists = reciprocal(wrenches_all, rtol) if wrenches_all.shape[0] else np.eye(6)
+    wrenches = np.vstack(wrench_rows)
+    constraint_rank, _ = _rank_and_null(wrenches, rtol)
+    twists = _reciprocal_unit(wrenches, rtol) if wrenches.shape[0] else np.eye(6)
     dof = twists.shape[0]
     rotations = _rank_and_null(twists[:, :3], rtol)[0] if dof else 0
     # a wrench common to every chain is reciprocal to every joint screw of the mechanism
-    common = 6 - _rank_and_null(np.vstack(norm), rtol)[0]
-    redundant = sum(counts) - constraint_rank - (len(norm) - 1) * common
-    basis = np.linalg.svd(wrenches_all)[2][:constraint_rank] if constraint_rank else np.zeros((0, 6))
+    common = 6 - _rank_and_null(np.vstack(unit), rtol)[0]
+    redundant = sum(counts) - constraint_rank - (len(unit) - 1) * common
+    wrench_basis = np.linalg.svd(wrenches)[2][:constraint_rank] if constraint_rank else np.zeros((0, 6))
     return ScrewResult(
         dof=dof,
         rotations=rotations,
@@ -306,8 +332,8 @@ def screw_analysis(chains: Sequence[Sequence[np.ndarray]], rtol: float = RTOL) -
         constraint_rank=constraint_rank,
         common=common,
         redundant=redundant,
-        twists=twists,
-        wrenches=basis,
+        twists=_unscaled(twists, length),
+        wrenches=_unscaled(wrench_basis, length),
     )
 
 
@@ -318,26 +344,25 @@ def screw_mobility(chains: Sequence[Sequence[np.ndarray]], rtol: float = RTOL) -
 
 
 def body_twists(*subchains: Sequence[np.ndarray], rtol: float = RTOL) -> list[np.ndarray]:
-    """Twist basis of a body carried by several serial subchains in parallel (an inner loop of a hybrid chain):
-    the twists common to all the subchains' spans, in the given units. A hybrid chain then enters
+    """Twist basis of a body carried by several serial subchains in parallel (an inner loop of a hybrid
+    chain): the twists in every subchain's span, in the given units. A hybrid chain then enters
     :func:`screw_analysis` as these resultant twists followed by the joints after the loop."""
     if not subchains:
         raise InvalidParameter("subchains: at least one serial subchain is needed")
-    length = _length([_stack(s) for s in subchains])
-    scale = np.concatenate([np.ones(3), np.full(3, 1.0 / length)])
-    stacks = [_stack(s) * scale for s in subchains]
-    stacks = [s / np.linalg.norm(s, axis=1)[:, None] for s in stacks]
+    raw = [_stack(s) for s in subchains]
+    length = _length(raw)
+    stacks = _scaled(raw, length)
     first = stacks[0].T
     # t in every span: t = T_1 a_1 = T_k a_k (k >= 2), a null space of [T_1, -T_2, 0, ...; T_1, 0, -T_3, ...]
     others = stacks[1:]
-    blocks = []
-    for k in range(len(others)):
-        row = [first] + [-s.T if j == k else np.zeros_like(s.T) for j, s in enumerate(others)]
-        blocks.append(np.hstack(row))
+    blocks = [
+        np.hstack([first] + [-s.T if j == k else np.zeros_like(s.T) for j, s in enumerate(others)])
+        for k in range(len(others))
+    ]
     if blocks:
         system = np.vstack(blocks)
         _, sv, vt = np.linalg.svd(system)
-        coeffs = vt[int(np.sum(sv > rtol * max(1.0, float(sv[0])))):, : first.shape[1]]
+        coeffs = vt[int(np.sum(sv > rtol * max(1.0, float(sv[0])))) :, : first.shape[1]]
         images = coeffs @ first.T
     else:
         images = stacks[0]
@@ -345,10 +370,10 @@ def body_twists(*subchains: Sequence[np.ndarray], rtol: float = RTOL) -> list[np
         return []
     _, sv, vt = np.linalg.svd(images, full_matrices=False)
     basis = vt[: int(np.sum(sv > rtol * max(1.0, float(sv[0]))))]
-    return list(basis / scale)
+    return list(_unscaled(basis, length))
 
 
-# ----- a registered mechanism ----------------------------------------------------------------------------------
+# ----- a registered mechanism ----------------------------------------------------------------------------
 def _capable(mech) -> None:
     if not callable(getattr(mech, "topology", None)) or not callable(getattr(mech, "joint_screws", None)):
         raise NoTopology(
@@ -360,7 +385,8 @@ def _capable(mech) -> None:
 def sample_configurations(mech, design, options, count: int, seed: int = 0, max_draws: int | None = None):
     """``count`` random feasible configurations [(pose, q)]: points drawn uniformly in the bounding box, kept
     where the point kernel accepts them (reachable within every limit), with the joint values of the kernel's
-    IK branch. Raises InvalidPose when ``max_draws`` points (default 2000 per configuration) give too few."""
+    IK branch. Deterministic for a given seed. Raises InvalidPose when ``max_draws`` points (default 2000 per
+    configuration) give too few."""
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
         raise InvalidParameter(f"samples: expected an integer >= 1, got {count!r}")
     lo, hi = (np.asarray(v, dtype=float) for v in mech.bounding_box(design, options))
@@ -375,7 +401,7 @@ def sample_configurations(mech, design, options, count: int, seed: int = 0, max_
         batch = rng.uniform(lo, hi, size=(min(256, limit - draws), 3))
         draws += batch.shape[0]
         for point in batch:
-            if kernel(packed, point[0], point[1], point[2]) < 0.0:
+            if not kernel(packed, point[0], point[1], point[2]) >= 0.0:
                 continue
             pose = point[:dims].copy()
             sols = {s.label: s.values for s in mech.inverse_kinematics(design, options, pose)}
@@ -403,45 +429,48 @@ class MobilityReport:
     results: tuple[ScrewResult, ...]
 
     @property
-    def _generic(self) -> ScrewResult:
+    def generic(self) -> ScrewResult:
         """A result at the most frequent constraint rank (ties: the higher rank, i.e. the lower dof)."""
         counts = Counter(r.constraint_rank for r in self.results)
         best = max(counts.items(), key=lambda kv: (kv[1], kv[0]))[0]
         return next(r for r in self.results if r.constraint_rank == best)
 
     @property
-    def dof(self) -> int:
-        return self._generic.dof
-
-    @property
-    def motion(self) -> str:
-        return self._generic.motion
+    def common_in_plane_terms(self) -> int:
+        """The numeric lambda in the topology's terms (without a planar mechanism's 3 common constraints)."""
+        return self.generic.common - (6 - self.topology.order)
 
     @property
     def agrees(self) -> bool:
         """Counting, screw theory and the mechanism's declared motion all give the same answer."""
-        g = self._generic
+        g = self.generic
         top = self.topology
         return (
             self.modified == g.dof
             and g.motion == self.expected_motion
-            and g.common == (6 - top.order) + top.common
+            and self.common_in_plane_terms == top.common
             and g.redundant == top.redundant
         )
 
+    def uses(self) -> str:
+        """Which terms the modified count uses, in words."""
+        top = self.topology
+        words = []
+        if top.order == 3:
+            words.append("planar: d = 3 (in space: lambda = 3 common constraints)")
+        if top.common:
+            words.append(f"lambda = {top.common} common constraints")
+        if top.redundant:
+            words.append(f"nu = {top.redundant} redundant constraints")
+        if top.passive:
+            words.append(f"zeta = {top.passive} passive freedoms")
+        return "; ".join(words) or "none (equal to the classical count)"
+
     def to_dict(self) -> dict[str, Any]:
         top = self.topology
-        g = self._generic
+        g = self.generic
         ranks = [r.constraint_rank for r in self.results]
-        uses = []
-        if top.order == 3:
-            uses.append("planar: d = 3 (in space, lambda = 3 common constraints)")
-        if top.common:
-            uses.append(f"lambda = {top.common} common constraints")
-        if top.redundant:
-            uses.append(f"nu = {top.redundant} redundant constraints")
-        if top.passive:
-            uses.append(f"zeta = {top.passive} passive freedoms")
+        dofs = [r.dof for r in self.results]
         out: dict[str, Any] = {
             "mechanism": self.mechanism,
             "expected_motion": self.expected_motion,
@@ -460,18 +489,18 @@ class MobilityReport:
                 "lambda": top.common,
                 "nu": top.redundant,
                 "zeta": top.passive,
-                "uses": "; ".join(uses) or "none (equal to the classical count)",
+                "uses": self.uses(),
                 "note": top.note,
             },
             "numeric": {
                 "samples": len(self.results),
                 "constraint_rank": {"generic": g.constraint_rank, "min": min(ranks), "max": max(ranks)},
-                "dof": {"generic": g.dof, "min": min(r.dof for r in self.results),
-                        "max": max(r.dof for r in self.results)},
+                "dof": {"generic": g.dof, "min": min(dofs), "max": max(dofs)},
                 "motion": g.motion,
                 "motions_seen": sorted({r.motion for r in self.results}),
                 "chain_constraints": list(g.chain_constraints),
-                "lambda": g.common,
+                "lambda": self.common_in_plane_terms,
+                "lambda_in_space": g.common,
                 "nu": g.redundant,
             },
             "agrees": self.agrees,
@@ -489,8 +518,9 @@ class MobilityReport:
         return out
 
 
-def mobility_report(mech, design, options, samples: int = 20, seed: int = 0, rtol: float = RTOL) -> MobilityReport:
-    """G-K counts of ``mech.topology`` and the screw analysis at ``samples`` random feasible configurations."""
+def mobility_report(mech, design, options, samples: int = 20, seed: int = 0) -> MobilityReport:
+    """G-K counts of ``mech.topology`` and the screw analysis at ``samples`` random feasible configurations
+    (raises NoTopology for a mechanism without ``topology`` and ``joint_screws``)."""
     _capable(mech)
     top = mech.topology(design, options)
     results = []
@@ -498,9 +528,9 @@ def mobility_report(mech, design, options, samples: int = 20, seed: int = 0, rto
         chains = mech.joint_screws(design, options, pose, q)
         if len(chains) != len(top.chains):
             raise InvalidParameter(
-                f"joint_screws: {mech.name} returned {len(chains)} chains, its topology lists {len(top.chains)}"
+                f"joint_screws: {mech.name} gave {len(chains)} chains, its topology lists {len(top.chains)}"
             )
-        results.append(screw_analysis(chains, rtol))
+        results.append(screw_analysis(chains))
     return MobilityReport(
         mechanism=mech.name,
         expected_motion=mech.motion,
