@@ -703,6 +703,53 @@ class RpsUpu(Mechanism):
             (inverse, forward), "both"
         )
 
+    # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
+    def topology(self, design, options):
+        """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
+        g = 9, sum f = 15, classical G-K 6(8 - 9 - 1) + 15 = 3 with no redundant constraint."""
+        from scalesynth.mobility import Topology
+
+        return Topology(
+            n_links=8,
+            chains=(("RPS-1", ("R", "P", "S")), ("RPS-2", ("R", "P", "S")), ("UPU", ("U", "P", "U"))),
+            note="spec §2.2 (paper): classical G-K; three coplanar constraint forces",
+        )
+
+    def joint_screws(self, design, options, pose, q=None):
+        """Joint screws (omega; v) per chain at pose (z, theta, psi), fixed frame O-xyz of spec §2.1 (mm);
+        ``q`` is not needed (the legs follow from the pose).
+
+        The P-model violates the RPS joint constraints (spec §2.3: B1, B2 leave the plane x = 0), so the
+        joints are placed at the constraint-consistent C-model pose with the same (z, theta, psi) and the
+        configured chain-3 variant. RPS_i: revolute about x through A_i, prismatic along A_i -> B_i, S at B_i.
+        UPU, variant 'upu': U at A3 about x and then the middle axis m = x x w, prismatic along the leg, U at
+        B3 about m and then the platform axis w = R z. Variant 'plane' (B3 held in y = 0, spec §2.3) has no
+        stated joint axes: its chain enters as the five twists reciprocal to its constraint force along y
+        through B3 (a revolute about y through A3, the leg prismatic, S at B3)."""
+        from scalesynth.mobility import Joint, chain_screws
+
+        x = self.check_vector("pose", pose, 3)
+        g, h, c, e = self._geom(design)
+        variant = options.get("c3_variant", "plane")
+        # RpsUpu's own platform_pose: a subclass (the tool workspace) pins its override to the P-model
+        plat = RpsUpu.platform_pose(self, design, {**options, "model": "C", "c3_variant": variant}, x)
+        rot, p = plat["R"], plat["p"]
+        base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
+        xhat = np.array([1.0, 0.0, 0.0])
+        chains = []
+        for i in (0, 1):
+            leg_i = Joint("P", axes=(top[i] - base[i],))
+            chains.append(chain_screws([Joint("R", base[i], (xhat,)), leg_i, Joint("S", top[i])]))
+        leg = Joint("P", axes=(top[2] - base[2],))
+        if variant == "upu":
+            w = rot[:, 2]
+            m = np.cross(xhat, w)
+            chains.append(chain_screws([Joint("U", base[2], (xhat, m)), leg, Joint("U", top[2], (m, w))]))
+        else:
+            chains.append(chain_screws([Joint("R", base[2], ((0.0, 1.0, 0.0),)), leg, Joint("S", top[2])]))
+        return chains
+
 
 MECHANISM = RpsUpu(
     name="rps-upu",
@@ -959,6 +1006,13 @@ class RpsUpuTool(RpsUpu):
         return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
             (inverse, forward), "both"
         )
+
+    # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
+    def joint_screws(self, design, options, pose, q):
+        """RpsUpu.joint_screws at the pose (of up to four) that places the tool at T = pose with legs closest
+        to q (as in ``jacobians``)."""
+        x = self._pose_for(design, options, pose, q)
+        return super().joint_screws(design, self._p(options), x, q)
 
 
 TOOL_MECHANISM = RpsUpuTool(
