@@ -19,11 +19,12 @@ from scalesynth.config import load_config
 from scalesynth.problem import SynthesisProblem
 
 
-def check_results(run_dir: Path) -> list[str]:
-    """Problems found (empty list: the directory is valid)."""
+def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
+    """Problems found (empty list: the directory is valid). ``require_report``: report.md must exist too."""
     run_dir = Path(run_dir)
     problems: list[str] = []
-    for name in ("pareto.csv", "population.csv", "history.csv", "manifest.json", "config.yaml", "report.md"):
+    names = ["pareto.csv", "population.csv", "history.csv", "manifest.json", "config.yaml"]
+    for name in names + (["report.md"] if require_report else []):
         if not (run_dir / name).is_file():
             problems.append(f"{name}: missing")
     if problems:
