@@ -26,9 +26,8 @@ motion type. A mechanism takes part by defining ``topology(design, options) -> T
 Screws are 6-vectors (direction; moment). A twist (omega; v): a revolute joint on the line through r with
 direction omega is (omega; r x omega), a prismatic joint (or a parallelogram, a circular translation) along v
 is (0; v). A wrench (f; m) is reciprocal to a twist (omega; v) when omega . m + v . f = 0. Numerical ranks
-use screws whose moment parts are divided by a length L (:func:`_length`) and then scaled to unit norm:
-that is the same mechanism scaled by 1/L, so reciprocity, ranks and angular parts are unchanged, and one
-relative tolerance fits millimetres and metres alike.
+are taken in a working frame centred on the joint axes with moments divided by the mechanism's size
+(:class:`_Frame`), so one relative tolerance fits millimetres and metres, near the origin or far from it.
 """
 
 from __future__ import annotations
@@ -202,32 +201,45 @@ def _stack(screws) -> np.ndarray:
     return arr
 
 
-def _length(stacks: Sequence[np.ndarray]) -> float:
-    """The largest distance from the origin of a screw axis, |moment| / |direction| over the screws with a
-    non-zero direction part (1 when there is none): the length that makes moments comparable with unit
-    directions."""
-    every = np.vstack(stacks) if stacks else np.zeros((0, 6))
-    w = np.linalg.norm(every[:, :3], axis=1)
-    rot = w > 0.0
-    length = float(np.max(np.linalg.norm(every[rot, 3:], axis=1) / w[rot], initial=0.0))
-    return length if length > 0.0 else 1.0
+@dataclass(frozen=True)
+class _Frame:
+    """A working frame for numerical ranks: origin c at the point nearest to all the screw axes (least
+    squares) and moments divided by L, the largest distance of an axis from c. Screws there describe the same
+    mechanism moved and scaled by 1/L, so reciprocity, ranks and angular parts are unchanged while every entry
+    is O(1). Moment ratios below 1e-9 count as zero (L = 1: all axes through c)."""
 
+    centre: np.ndarray
+    length: float
 
-def _scaled(stacks: Sequence[np.ndarray], length: float) -> list[np.ndarray]:
-    """Screws with moments divided by ``length``, each row then of unit norm."""
-    out = []
-    for s in stacks:
-        s = s * np.array([1.0, 1.0, 1.0, 1.0 / length, 1.0 / length, 1.0 / length])
-        norms = np.linalg.norm(s, axis=1)
+    @classmethod
+    def of(cls, stacks: Sequence[np.ndarray]) -> _Frame:
+        every = np.vstack(stacks) if stacks else np.zeros((0, 6))
+        w2 = np.einsum("ij,ij->i", every[:, :3], every[:, :3])
+        rot = w2 > 0.0
+        centre = np.zeros(3)
+        if np.any(rot):
+            # the point nearest to all the axes (least squares): sum_k (I - u_k u_k^T)(c - foot_k) = 0
+            units = every[rot, :3] / np.sqrt(w2[rot, None])
+            feet = np.cross(every[rot, :3], every[rot, 3:]) / w2[rot, None]  # w x m / |w|^2 for m = r x w
+            proj = np.eye(3)[None] - units[:, :, None] * units[:, None, :]
+            centre = np.linalg.lstsq(proj.sum(axis=0), np.einsum("kij,kj->i", proj, feet), rcond=1e-10)[0]
+        moved = every[rot, 3:] - np.cross(centre, every[rot, :3])
+        length = float(np.max(np.linalg.norm(moved, axis=1) / np.sqrt(w2[rot]), initial=0.0))
+        return cls(centre, length if length > 1e-9 * max(1.0, float(np.linalg.norm(centre))) else 1.0)
+
+    def into(self, rows: np.ndarray) -> np.ndarray:
+        """Screws (rows) in the working frame, each scaled to unit norm."""
+        moved = (rows[:, 3:] - np.cross(self.centre, rows[:, :3])) / self.length
+        out = np.hstack([rows[:, :3], moved])
+        norms = np.linalg.norm(out, axis=1)
         if np.any(norms == 0.0):
             raise InvalidPose("joint screws: a zero screw")
-        out.append(s / norms[:, None])
-    return out
+        return out / norms[:, None]
 
-
-def _unscaled(rows: np.ndarray, length: float) -> np.ndarray:
-    """Back to the original units (moments times ``length``)."""
-    return rows * np.array([1.0, 1.0, 1.0, length, length, length])
+    def back(self, rows: np.ndarray) -> np.ndarray:
+        """Screws (rows) from the working frame back to the original one."""
+        rows = np.atleast_2d(rows)
+        return np.hstack([rows[:, :3], rows[:, 3:] * self.length + np.cross(self.centre, rows[:, :3])])
 
 
 def _rank_and_null(rows: np.ndarray, rtol: float) -> tuple[int, np.ndarray]:
@@ -249,14 +261,14 @@ def reciprocal(screws, rtol: float = RTOL) -> np.ndarray:
     """Basis (rows) of the screws reciprocal to all given screws (x with s^T Delta x = 0 for every s, where
     Delta = [[0, I], [I, 0]]), in the given units: twists in, wrenches out, and the other way round."""
     stack = _stack(screws)
-    length = _length([stack])
-    return _unscaled(_reciprocal_unit(_scaled([stack], length)[0], rtol), length)
+    frame = _Frame.of([stack])
+    return frame.back(_reciprocal_unit(frame.into(stack), rtol))
 
 
 def rank(screws, rtol: float = RTOL) -> int:
     """Numerical rank of a set of screws (the dimension of their span)."""
     stack = _stack(screws)
-    return _rank_and_null(_scaled([stack], _length([stack]))[0], rtol)[0]
+    return _rank_and_null(_Frame.of([stack]).into(stack), rtol)[0]
 
 
 def motion_name(rotations: int, translations: int) -> str:
@@ -306,8 +318,8 @@ def screw_analysis(chains: Sequence[Sequence[np.ndarray]], rtol: float = RTOL) -
     if not chains:
         raise InvalidParameter("chains: at least one chain of joint screws is needed")
     stacks = [_stack(c) for c in chains]
-    length = _length(stacks)
-    unit = _scaled(stacks, length)
+    frame = _Frame.of(stacks)
+    unit = [frame.into(s) for s in stacks]
     ranks, counts, wrench_rows = [], [], []
     for s in unit:
         ranks.append(_rank_and_null(s, rtol)[0])
@@ -332,8 +344,8 @@ def screw_analysis(chains: Sequence[Sequence[np.ndarray]], rtol: float = RTOL) -
         constraint_rank=constraint_rank,
         common=common,
         redundant=redundant,
-        twists=_unscaled(twists, length),
-        wrenches=_unscaled(wrench_basis, length),
+        twists=frame.back(twists),
+        wrenches=frame.back(wrench_basis),
     )
 
 
@@ -350,8 +362,8 @@ def body_twists(*subchains: Sequence[np.ndarray], rtol: float = RTOL) -> list[np
     if not subchains:
         raise InvalidParameter("subchains: at least one serial subchain is needed")
     raw = [_stack(s) for s in subchains]
-    length = _length(raw)
-    stacks = _scaled(raw, length)
+    frame = _Frame.of(raw)
+    stacks = [frame.into(s) for s in raw]
     first = stacks[0].T
     # t in every span: t = T_1 a_1 = T_k a_k (k >= 2), a null space of [T_1, -T_2, 0, ...; T_1, 0, -T_3, ...]
     others = stacks[1:]
@@ -370,7 +382,7 @@ def body_twists(*subchains: Sequence[np.ndarray], rtol: float = RTOL) -> list[np
         return []
     _, sv, vt = np.linalg.svd(images, full_matrices=False)
     basis = vt[: int(np.sum(sv > rtol * max(1.0, float(sv[0]))))]
-    return list(_unscaled(basis, length))
+    return list(frame.back(basis))
 
 
 # ----- a registered mechanism ----------------------------------------------------------------------------

@@ -59,7 +59,8 @@ def _text(mech, out: dict) -> list[str]:
     if ex:
         lines.append(
             f"  parallelograms as 4 R each: n = {ex['n_links']}, g = {ex['n_joints']}, "
-            f"sum f = {ex['sum_freedom']}: classical {ex['classical']}, nu = {ex['nu']}, modified {ex['modified']}"
+            f"sum f = {ex['sum_freedom']}: classical {ex['classical']}, nu = {ex['nu']}, "
+            f"modified {ex['modified']}"
         )
     rank, dof = num["constraint_rank"], num["dof"]
     lines += [
