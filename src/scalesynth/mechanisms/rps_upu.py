@@ -712,7 +712,8 @@ class RpsUpu(Mechanism):
         return Topology(
             n_links=8,
             chains=(("RPS-1", ("R", "P", "S")), ("RPS-2", ("R", "P", "S")), ("UPU", ("U", "P", "U"))),
-            note="spec §2.2 (paper): classical G-K; three coplanar constraint forces",
+            note="spec §2.2 (paper): classical G-K; three coplanar constraint forces. Joint screws at the "
+            "C-model placement of the pose (the P-model violates the RPS joint constraints, spec §2.3)",
         )
 
     def joint_screws(self, design, options, pose, q=None):
