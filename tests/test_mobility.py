@@ -250,6 +250,19 @@ def test_counts_and_screw_theory_agree_with_the_papers(name):
     assert rep.agrees and motion == mech.motion
 
 
+@settings(max_examples=12, deadline=None)
+@given(
+    st.floats(0.2, 0.8), st.floats(0.2, 0.8), st.floats(0.5, 2.0), st.floats(0.5, 2.0), st.floats(0.05, 0.3),
+    st.integers(0, 1000),
+)
+def test_pauu_ppap_is_3t_for_any_design(m, n, l1, l2, c, seed):
+    # |m - n| <= 0.6 < l1 + l2: a non-empty workspace
+    mech = get("2pauu-ppap")
+    design = mech.resolve_design(dict(m=m, n=n, l1=l1, l2=l2, c=c))
+    rep = mobility_report(mech, design, mech.resolve_options({}), samples=2, seed=seed)
+    assert {(r.dof, r.motion, r.redundant) for r in rep.results} == {(3, "3T", 2)}
+
+
 def test_parallelograms_expanded_into_revolutes():
     top = get("2pauu-ppap").topology({}, {}).expanded()
     # three planar 4R loops, each overconstrained by 3 in space: 1 - 9 = -8, nu = 2 + 9
