@@ -114,15 +114,120 @@ def _mirror_plan(lo, step, n):
     return 0, 1.0, -1
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def _column_pass1(x, y, k0, k1, lo_z, step_z, p, flag, targ, tq, tp, tc2, td2):
+    """Cells k0..k1 of column (x, y), no theta limits: everything of point_lci up to the trigonometric step of
+    lci_3x3, written branch-free into scratch arrays so that the compiler can vectorise the loop.
+
+    flag: 1 reachable, 2 reachable but inverse-singular (LCI 0), 0 unreachable; targ: argument of acos; tq, tp: the
+    centre and scale of the eigenvalue problem; tc2: sum of the squared 2x2 minors; td2: det^2 (see lci_3x3).
+    """
+    delta = p[_DELTA]
+    l1 = p[_L1]
+    l2 = p[_L2]
+    e = p[_E]
+    s1 = p[_S1]
+    s2 = p[_S2]
+    zmin = p[_ZMIN]
+    yy = y * y
+    a1 = x - delta
+    a2 = -x - delta
+    a1s = a1 * a1
+    a2s = a2 * a2
+    cst = yy + l1 * l1 - l2 * l2
+    inv2l1 = 1.0 / (2.0 * l1)
+    for k in range(k0, k1 + 1):
+        z = lo_z + (k + 0.5) * step_z
+        b = z - e
+        bb = b * b
+        r2a = a1s + bb
+        r2b = a2s + bb
+        kka = (r2a + cst) * inv2l1
+        kkb = (r2b + cst) * inv2l1
+        s2a = r2a - kka * kka
+        s2b = r2b - kkb * kkb
+        ok = (s2a >= 0.0) & (s2b >= 0.0) & (r2a > 1e-300) & (r2b > 1e-300) & (z >= zmin)
+        sqa = math.sqrt(max(s2a, 0.0))
+        sqb = math.sqrt(max(s2b, 0.0))
+        ia = 1.0 / max(r2a, 1e-300)
+        ib = 1.0 / max(r2b, 1e-300)
+        ca = (a1 * kka + s1 * b * sqa) * ia
+        sa = (-b * kka + s1 * a1 * sqa) * ia
+        cb = (a2 * kkb + s2 * b * sqb) * ib
+        sb = (-b * kkb + s2 * a2 * sqb) * ib
+        q1 = -s1 * l1 * sqa
+        q2 = -s2 * l1 * sqb
+        sing = (q1 == 0.0) | (q2 == 0.0)
+        iq1 = 1.0 / (q1 if q1 != 0.0 else 1.0)
+        iq2 = 1.0 / (q2 if q2 != 0.0 else 1.0)
+        u1 = (a1 - l1 * ca) * iq1
+        u2 = y * iq1
+        u3 = (b + l1 * sa) * iq1
+        v1 = -(a2 - l1 * cb) * iq2
+        v2 = y * iq2
+        v3 = (b + l1 * sb) * iq2
+        g11 = u1 * u1 + u2 * u2 + u3 * u3
+        g22 = v1 * v1 + v2 * v2 + v3 * v3
+        g12 = u1 * v1 + u2 * v2 + u3 * v3
+        cx = u2 * v3 - u3 * v2
+        cy = u3 * v1 - u1 * v3
+        cz = u1 * v2 - u2 * v1
+        c2 = cx * cx + cy * cy + cz * cz + u3 * u3 + u1 * u1 + v3 * v3 + v1 * v1
+        det = u3 * v1 - u1 * v3
+        tr = g11 + g22 + 1.0
+        q = tr / 3.0
+        b11 = g11 - q
+        b22 = g22 - q
+        b33 = 1.0 - q
+        p2 = b11 * b11 + b22 * b22 + b33 * b33 + 2.0 * (g12 * g12 + u2 * u2 + v2 * v2)
+        pp_ = math.sqrt(p2 / 6.0)
+        ip = 1.0 / max(pp_, 1e-300)
+        b11 *= ip
+        b22 *= ip
+        b33 *= ip
+        b12 = g12 * ip
+        b13 = u2 * ip
+        b23 = v2 * ip
+        r = 0.5 * (b11 * (b22 * b33 - b23 * b23) - b12 * (b12 * b33 - b23 * b13) + b13 * (b12 * b23 - b22 * b13))
+        targ[k] = min(max(r, -1.0), 1.0)
+        tq[k] = q
+        tp[k] = pp_
+        tc2[k] = c2
+        td2[k] = det * det
+        flag[k] = 0.0 if not ok else (2.0 if sing else 1.0)
+
+@njit(cache=True, fastmath=FASTMATH)
+def _column_pass2(k0, k1, targ):
+    """The only transcendental step, in a loop of its own: cos(acos(r) / 3)."""
+    for k in range(k0, k1 + 1):
+        targ[k] = math.cos(math.acos(targ[k]) / 3.0)
+
+@njit(cache=True, fastmath=FASTMATH)
+def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, out):
+    """LCI from the largest eigenvalue and the sum/product of the other two (as in lci_3x3); -1 if unreachable."""
+    for k in range(k0, k1 + 1):
+        lmax = tq[k] + 2.0 * tp[k] * targ[k]
+        lmax = max(lmax, 1e-300)
+        prod = td2[k] / lmax
+        s = (tc2[k] - prod) / lmax
+        disc = max(s * s - 4.0 * prod, 0.0)
+        lmid = max(0.5 * (s + math.sqrt(disc)), 1e-300)
+        ratio = min(max(prod / lmid / lmax, 0.0), 1.0)
+        v = math.sqrt(ratio)
+        v = v if (s > 0.0) & (prod > 0.0) else 0.0
+        f = flag[k]
+        out[k] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
+
 @njit(cache=True, parallel=True, fastmath=FASTMATH)
 def population_stats_fast(params, lo, step, shape, edges):
     """Same statistics as kernels.grid.population_stats(point_lci, ...), computed faster.
 
-    Two exact savings (spec §1.9): (1) for each (x, y) column the reachable z are the intersection of the two
-    chains' annuli, so only the cells of (at most two) z-intervals are visited (widened by one cell and then
-    tested point by point, so the set of counted cells is exactly the pointwise one); (2) LCI is even in y, and
-    in x for the mirror-symmetric modes (++, --) with equal theta limits, so a symmetric grid is visited over a half
-    or a quarter and weighted.
+    Three savings: (1) for each (x, y) column the reachable z are the intersection of the two chains' annuli
+    (spec §1.9), so only the cells of (at most two) z-intervals are visited, widened by one cell and then tested
+    cell by cell, so the counted cells are the pointwise ones; (2) LCI is even in y, and in x for the
+    mirror-symmetric modes (++, --) with equal theta limits, so a symmetric grid is visited over a half or a
+    quarter and weighted; (3) without theta limits the cells of a column go through branch-free passes that the
+    compiler vectorises, with acos/cos alone in a scalar loop (designs with theta limits use point_lci per cell).
     """
     n_designs = params.shape[0]
     nx, ny, nz = shape[0], shape[1], shape[2]
@@ -148,13 +253,20 @@ def population_stats_fast(params, lo, step, shape, edges):
         j0, wy_half, j_mid = _mirror_plan(lo[d, 1], step[d, 1], ny)
         if not y_sym:
             j0, wy_half, j_mid = 0, 1.0, -1
+        scalar = p[_HAS_THETA] > 0.0
+        flag = np.empty(nz)
+        targ = np.empty(nz)
+        tq = np.empty(nz)
+        tp = np.empty(nz)
+        tc2 = np.empty(nz)
+        td2 = np.empty(nz)
+        out = np.empty(nz)
         x = lo[d, 0] + (i + 0.5) * step[d, 0]
-        delta = p[_DELTA]
         l1 = p[_L1]
         l2 = p[_L2]
         e = p[_E]
-        a1 = x - delta
-        a2 = -x - delta
+        a1 = x - p[_DELTA]
+        a2 = -x - p[_DELTA]
         a1s = a1 * a1
         a2s = a2 * a2
         amax = a1s if a1s > a2s else a2s
@@ -168,7 +280,7 @@ def population_stats_fast(params, lo, step, shape, edges):
             w = wx * (1.0 if j == j_mid else wy_half)
             y = lo[d, 1] + (j + 0.5) * step[d, 1]
             yy = y * y
-            if yy >= l2 * l2:
+            if yy >= l2 * l2 or y < p[_DLO] or y > p[_DHI]:
                 continue
             rho = math.sqrt(l2 * l2 - yy)
             ro = l1 + rho
@@ -191,9 +303,17 @@ def population_stats_fast(params, lo, step, shape, edges):
             for part in range(2):
                 k0 = kl0 if part == 0 else ku0
                 k1 = kl1 if part == 0 else ku1
+                if k1 < k0:
+                    continue
+                if scalar:
+                    for k in range(k0, k1 + 1):
+                        out[k] = point_lci(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2])
+                else:
+                    _column_pass1(x, y, k0, k1, lo[d, 2], step[d, 2], p, flag, targ, tq, tp, tc2, td2)
+                    _column_pass2(k0, k1, targ)
+                    _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, out)
                 for k in range(k0, k1 + 1):
-                    z = lo[d, 2] + (k + 0.5) * step[d, 2]
-                    v = point_lci(p, x, y, z)
+                    v = out[k]
                     if v >= 0.0:
                         count += w
                         s1 += w * v
