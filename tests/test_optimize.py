@@ -74,7 +74,9 @@ def test_outputs_and_invariants(small_run):
     h = pd.read_csv(out / "history.csv")
     assert list(h["generation"]) == list(range(1, 7))
     assert list(h["evaluations"]) == [16 * g for g in range(1, 7)]
-    assert (np.diff(h["hypervolume"]) >= -1e-12).all()  # elitist NSGA-II never loses hypervolume
+    # while the front is smaller than the population, elitism keeps every non-dominated design: HV cannot drop
+    # (once the front fills the population, crowding truncation may lose a little; see validate_results)
+    assert (h["n_nondominated"] < 16).all() and (np.diff(h["hypervolume"]) >= -1e-12).all()
     m = json.loads((out / "manifest.json").read_text())
     assert m["status"] == "finished" and m["seed"] == 3 and m["evaluations"] == 96 and m["grid_resolution"] == 12
     assert m["hv_reference"] == [0.0, 0.0] and m["machine"]["cores"] >= 1

@@ -2,7 +2,7 @@
 
 Checks: every file present and parseable; pareto.csv has the design variables, derived and metric columns; no
 NaN/inf; design variables within bounds; LCI-type metrics in [0, 1]; band shares sum to 1; every row non-dominated
-and no two rows equal in objective space; history generations 1..n_gen with non-decreasing hypervolume; manifest
+and no two rows equal in objective space; history generations 1..n_gen, hypervolume finite and higher at the end than at the start; manifest
 status finished with matching evaluations.
 """
 
@@ -69,8 +69,10 @@ def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
     gens = list(history["generation"])
     if gens != list(range(1, cfg.algorithm.n_gen + 1)):
         problems.append(f"history.csv: generations {gens[:3]}... are not 1..{cfg.algorithm.n_gen}")
-    if (np.diff(history["hypervolume"]) < -1e-12).any():
-        problems.append("history.csv: hypervolume decreased")
+    hv = history["hypervolume"].to_numpy(dtype=float)
+    # NSGA-II can lose a little hypervolume when a full front is truncated by crowding, so only the trend is checked
+    if not np.all(np.isfinite(hv)) or (hv < 0).any() or hv[-1] < hv[0]:
+        problems.append("history.csv: hypervolume not finite, negative, or lower at the end than at the start")
     if manifest.get("status") != "finished":
         problems.append("manifest.json: status is not finished")
     if manifest.get("evaluations") != int(history["evaluations"].iloc[-1]):
