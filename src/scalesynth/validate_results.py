@@ -1,9 +1,9 @@
 """Schema and invariant checks of a finished results directory (CI: `python -m scalesynth.validate_results DIR`).
 
-Checks: every file present and parseable; pareto.csv has the design variables, derived and metric columns; no
-NaN/inf; design variables within bounds; LCI-type metrics in [0, 1]; band shares sum to 1; every row non-dominated
-and no two rows equal in objective space; history generations 1..n_gen, hypervolume finite and higher at the end than at the start; manifest
-status finished with matching evaluations.
+Checks: every file present and parseable; pareto.csv has the design variables, derived and metric columns;
+no NaN/inf; design variables within bounds; LCI-type metrics in [0, 1]; band shares sum to 1; every row
+non-dominated and no two rows equal in objective space; history generations 1..n_gen, hypervolume finite and
+higher at the end than at the start; manifest status finished with matching evaluations.
 """
 
 from __future__ import annotations
