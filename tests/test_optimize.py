@@ -211,3 +211,23 @@ def test_results_validator_accepts_a_run_and_catches_damage(tmp_path):
     p.loc[1, "volume_m3"] = p["volume_m3"].min() - 0.01
     p.to_csv(bad / "pareto.csv", index=False)
     assert any("dominated" in msg for msg in check_results(bad))
+
+
+def test_designs_equal_up_to_m_minus_n_are_duplicates():
+    """Spec §1.1: the model depends on m, n only through m - n, so NSGA-II must treat such designs as one."""
+    from pymoo.core.population import Population
+
+    from scalesynth.optimize import CanonicalX, make_algorithm
+    from scalesynth.problem import SynthesisProblem
+
+    problem = SynthesisProblem(small_cfg())
+    X = np.array([[0.9, 0.7, 1.2, 1.4, 0.2],   # m - n = 0.2
+                  [1.1, 0.9, 1.2, 1.4, 0.2],   # same model
+                  [1.1, 0.8, 1.2, 1.4, 0.2]])  # m - n = 0.3: different
+    key = CanonicalX(problem)(Population.new("X", X))
+    assert np.array_equal(key[0], key[1]) and not np.array_equal(key[0], key[2])
+    elim = make_algorithm(small_cfg(), problem).eliminate_duplicates
+    kept = elim.do(Population.new("X", X))
+    assert len(kept) == 2
+    M = problem.metrics(X)
+    assert np.array_equal(M[0], M[1])  # identical metrics, as the invariance says
