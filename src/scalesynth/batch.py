@@ -245,7 +245,8 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
         if echo is not None:
             hv = f"HV {rec.hypervolume:.6g}, " if rec.hypervolume is not None else ""
             why = f": {rec.error}" if rec.error else ""
-            echo(f"[{done}/{len(tasks)}] {rec.config} seed {rec.seed}: {rec.status}{why} ({hv}{rec.wall_seconds:.1f} s)")
+            where = f"[{done}/{len(tasks)}] {rec.config} seed {rec.seed}"
+            echo(f"{where}: {rec.status}{why} ({hv}{rec.wall_seconds:.1f} s)")
     return [r for r in records if r is not None]
 
 
@@ -280,9 +281,7 @@ def combined_front(fronts: dict[int, Any], keys: Sequence[str], signs: np.ndarra
 
 
 def hypervolume_figure(histories: dict[int, dict[str, list[float]]], title: str):
-    from scalesynth import plotting  # noqa: F401  (selects the Agg backend)
-
-    import matplotlib.pyplot as plt
+    from scalesynth.plotting import plt  # pyplot with the Agg backend selected
 
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for seed, h in sorted(histories.items()):

@@ -22,7 +22,9 @@ def batch_cmd(
     ] = None,
     out: Annotated[Path, typer.Option("--out", help="batch directory")] = Path("results/batch"),
     sets: SetOpt = None,
-    as_json: Annotated[bool, typer.Option("--json", help="print the summary (batch.json) instead of the table")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="print the summary (batch.json) instead of the table")
+    ] = False,
 ) -> None:
     """Run every (config, seed) pair as one dask task into OUT/<name>/seed<k>/ (finished tasks are skipped,
     unfinished ones resumed); write OUT/batch.json and, per config, the combined front and a hypervolume plot.
