@@ -306,9 +306,18 @@ def config_from_dict(data: Any, overrides: list[str] | None = None) -> RunConfig
     try:
         return RunConfig.model_validate(data)
     except ValidationError as err:
-        raise ConfigError(_format_validation_error(err)) from None
+        raise ConfigError(_one_line(_format_validation_error(err))) from None
     except ScalesynthError as err:
-        raise ConfigError(str(err)) from None
+        raise ConfigError(_one_line(str(err))) from None
+
+
+# every character str.splitlines() breaks at: a key or value quoted in a message must not break its line
+_LINE_BREAKS = {ord(c): repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"}
+
+
+def _one_line(message: str) -> str:
+    """The message with line breaks (from keys or values it quotes) escaped, so errors stay one line."""
+    return message.translate(_LINE_BREAKS)
 
 
 def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConfig:
