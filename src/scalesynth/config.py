@@ -142,7 +142,8 @@ class UnitsConfig(_Strict):
 
 
 class RunConfig(_Strict):
-    name: str = Field(..., min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")
+    # used as a directory name (results/<name>, batch OUT/<name>): no separators, no leading dot ('.', '..')
+    name: str = Field(..., min_length=1, max_length=128, pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
     mechanism: str
     units: UnitsConfig = Field(default_factory=UnitsConfig)
     design: dict[str, float] = Field(default_factory=dict, description="design evaluated by `evaluate`")
