@@ -190,6 +190,17 @@ class Mechanism:
         return arr
 
 
+def singularity_label(inverse: bool, forward: bool) -> str:
+    """'none', 'inverse', 'forward' or 'both' from the two singularity tests."""
+    return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get((inverse, forward), "both")
+
+
+def svd_lci(matrix) -> float:
+    """sigma_min / sigma_max of a matrix by NumPy's SVD (the kernels' reference); 0 for a zero matrix."""
+    sv = np.linalg.svd(np.asarray(matrix, dtype=float), compute_uv=False)
+    return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+
+
 def _finite_float(field_name: str, value: Any) -> float:
     if isinstance(value, bool):
         raise InvalidParameter(f"{field_name}: expected a number, got {value!r}")

@@ -19,7 +19,7 @@ from scalesynth.errors import InvalidParameter
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label, svd_lci
 
 MODES = ("++", "+-", "-+", "--")
 
@@ -509,17 +509,14 @@ class PauuPpap(Mechanism):
         n1, n2 = np.hypot(*w1), np.hypot(*w2)
         cross = w1[0] * w2[1] - w1[1] * w2[0]
         forward = n1 == 0.0 or n2 == 0.0 or abs(cross) <= tol * n1 * n2
-        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
-            (inverse, forward), "both"
-        )
+        return singularity_label(inverse, forward)
 
     def lci(self, design, options, pose, q) -> float:
         """LCI = 1/kappa_2(J) with NumPy's SVD (0 at any singularity)."""
         jac = self.jacobians(design, options, pose, q)
         if jac["J"] is None or self.singularity(design, options, pose, q, tol=0.0) != "none":
             return 0.0
-        sv = np.linalg.svd(jac["J"], compute_uv=False)
-        return float(sv[-1] / sv[0])
+        return svd_lci(jac["J"])
 
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):

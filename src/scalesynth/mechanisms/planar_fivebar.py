@@ -32,7 +32,7 @@ from numba import njit
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.conditioning import lci_2x2
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label, svd_lci
 
 MODES = ("++", "+-", "-+", "--")
 TWO_PI = 2.0 * math.pi
@@ -250,17 +250,14 @@ class PlanarFivebar(Mechanism):
         b1, b2 = self.forearm_angles(design, pose, q)
         inverse = abs(math.sin(b1 - a1)) <= tol or abs(math.sin(b2 - a2)) <= tol
         forward = abs(math.sin(b1 - b2)) <= tol
-        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
-            (inverse, forward), "both"
-        )
+        return singularity_label(inverse, forward)
 
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of J with NumPy's SVD (0 at any singularity)."""
         jac = self.jacobians(design, options, pose, q)
         if jac["J"] is None or self.singularity(design, options, pose, q, tol=0.0) != "none":
             return 0.0
-        sv = np.linalg.svd(jac["J"], compute_uv=False)
-        return float(sv[-1] / sv[0])
+        return svd_lci(jac["J"])
 
     def resolution_index(self, design, options, pose, dalpha=(1.0, 1.0)) -> float:
         """Kinematic resolution |J dalpha| (mm per the arm increments dalpha in rad; spec §2.4, paper eq. 18) in

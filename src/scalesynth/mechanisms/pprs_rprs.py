@@ -33,7 +33,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label
 
 SQRT3_2 = math.sqrt(3.0) / 2.0
 # spec §1.8 search box (mm); bounding_box never extends beyond it
@@ -634,9 +634,7 @@ class PprsRprs(Mechanism):
         a /= np.linalg.norm(a, axis=1, keepdims=True)
         sv = np.linalg.svd(a, compute_uv=False)
         forward = bool(sv[-1] <= tol * sv[0])
-        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
-            (inverse, forward), "both"
-        )
+        return singularity_label(inverse, forward)
 
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of the homogenised J_t (NumPy SVD); 0 at a serial singularity."""

@@ -39,7 +39,7 @@ from numba import njit
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label, svd_lci
 
 MODELS = ("P", "C")
 C3_VARIANTS = ("plane", "upu")
@@ -682,8 +682,7 @@ class RpsUpu(Mechanism):
         jac = self.jacobians(design, options, pose, q)
         if jac["dq_dx_h"] is None:
             return 0.0
-        sv = np.linalg.svd(jac["dq_dx_h"], compute_uv=False)
-        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+        return svd_lci(jac["dq_dx_h"])
 
     def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
         """'inverse' when a leg length q_i <= tol (g + h + c), 'forward' when the rows of Jx, each normalised and
@@ -699,9 +698,7 @@ class RpsUpu(Mechanism):
         else:
             sv = np.linalg.svd(rows / norms[:, None], compute_uv=False)
             forward = bool(sv[-1] <= tol * sv[0])
-        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
-            (inverse, forward), "both"
-        )
+        return singularity_label(inverse, forward)
 
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
@@ -985,8 +982,7 @@ class RpsUpuTool(RpsUpu):
         jac = self.jacobians(design, options, pose, q)
         if jac["dq_dT"] is None:
             return 0.0
-        sv = np.linalg.svd(jac["dq_dT"], compute_uv=False)
-        return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+        return svd_lci(jac["dq_dT"])
 
     def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
         """'inverse' when a leg length q_i <= tol (g + h + c); 'forward' when the normalised rows of q_i dq_i/dT are
@@ -1004,9 +1000,7 @@ class RpsUpuTool(RpsUpu):
                 forward = bool(sv[-1] <= tol * sv[0])
             x = self._pose_for(design, options, pose, q)
             forward = forward or abs(math.cos(x[1]) * math.cos(x[2])) <= tol
-        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
-            (inverse, forward), "both"
-        )
+        return singularity_label(inverse, forward)
 
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def joint_screws(self, design, options, pose, q):

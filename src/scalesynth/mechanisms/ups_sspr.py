@@ -30,7 +30,7 @@ from numba import njit
 from scalesynth.errors import InvalidParameter
 from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range
+from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label
 
 K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
 SQRT3_2 = math.sqrt(3.0) / 2.0
@@ -279,9 +279,7 @@ class UpsSspr(Mechanism):
             r2, r3 = rows[1][:2], rows[2][:2]
             det = r2[0] * r3[1] - r2[1] * r3[0]
             forward = abs(det) <= tol * math.hypot(*r2) * math.hypot(*r3)
-        return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get(
-            (inverse, forward), "both"
-        )
+        return singularity_label(inverse, forward)
 
     def lci(self, design, options, pose, q=None) -> float:
         """LCI = 1/kappa_2 of Jx diag(1/L, 1/L, 1) with NumPy's SVD (L = characteristic length); 0 at any
