@@ -214,7 +214,9 @@ def dask_client(scheduler: str | None, n_tasks: int) -> Iterator[Any]:
         n_workers=workers,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        # the scheduler always serves HTTP (health routes): a free port, not the default 8787; no dashboard
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
         silence_logs=logging.ERROR,
         env={"NUMBA_NUM_THREADS": str(numba_threads)},
     )

@@ -1,0 +1,232 @@
+"""`scalesynth batch` on a real dask LocalCluster (two worker processes): results equal sequential runs byte for
+byte, failing tasks do not stop the others (exit 1), re-running skips finished tasks and resumes unfinished ones.
+
+The main tests share one cluster (module fixture, passed as --scheduler, which also tests an existing cluster);
+one test starts the embedded cluster that `batch` creates without --scheduler.
+"""
+
+import copy
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from scalesynth.batch import combined_front, format_table, local_cluster_shape, nondominated_mask, run_batch
+from scalesynth.cli import app
+from scalesynth.config import config_from_dict
+from scalesynth.errors import RunError
+from scalesynth.optimize import run
+
+SMALL = {
+    "name": "alpha",
+    "mechanism": "2pauu-ppap",
+    "design": {"m": 0.857, "n": 0.706, "l1": 1.499, "l2": 1.5, "c": 0.1},
+    "bounds": {"m": [0.5, 1.5], "n": [0.2, 1.0], "l1": [0.5, 1.5], "l2": [0.5, 1.5], "c": [0.1, 0.5]},
+    "grid": {"resolution": 12},
+    "algorithm": {"pop_size": 16, "n_gen": 6, "seed": 3},
+    "output": {"checkpoint_every": 2},
+}
+ALPHA = SMALL
+# a maximised and a minimised objective, so the combined front's minimisation form is exercised
+BETA = {
+    **SMALL,
+    "name": "beta",
+    "objectives": [{"metric": "band_volume", "band": 2}, {"metric": "fci", "sense": "min"}],
+    "algorithm": {"pop_size": 16, "n_gen": 5, "seed": 11},
+}
+NOBOUNDS = {**SMALL, "name": "nobounds", "bounds": {}}  # valid config, but its run raises (nothing to optimise)
+BLOCKED = {**SMALL, "name": "blocked"}  # OUT/blocked will be a regular file: its directories cannot be made
+SEEDS = {"alpha": [3, 4], "beta": [11, 12]}
+
+
+def _write(path: Path, data: dict) -> Path:
+    path.write_text(yaml.safe_dump(copy.deepcopy(data)))
+    return path
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
+        silence_logs=logging.ERROR,
+        env={"NUMBA_NUM_THREADS": "1"},
+    ) as c:
+        yield c.scheduler_address
+
+
+@pytest.fixture(scope="module")
+def sequential(tmp_path_factory):
+    """Each task run on its own, in this process (default Numba threads): the reference bytes."""
+    base = tmp_path_factory.mktemp("sequential")
+    out = {}
+    for data in (ALPHA, BETA):
+        for seed in SEEDS[data["name"]]:
+            res = run(config_from_dict(copy.deepcopy(data)), base / data["name"] / f"seed{seed}", seed=seed,
+                      plots=False)
+            out[(data["name"], seed)] = res.out_dir
+    return out
+
+
+@pytest.fixture(scope="module")
+def first_batch(tmp_path_factory, cluster):
+    """A batch of 4 configs x 2 seeds: alpha seed 4 left unfinished beforehand (a checkpoint after 2
+    generations), nobounds fails in its run, blocked cannot create its directories."""
+    tmp = tmp_path_factory.mktemp("batch")
+    paths = [_write(tmp / f"{d['name']}.yaml", d) for d in (ALPHA, BETA, NOBOUNDS, BLOCKED)]
+    out = tmp / "out"
+    out.mkdir()
+    (out / "blocked").write_text("a file where the batch wants a directory\n")
+    with pytest.raises(RunError):
+        run(config_from_dict(copy.deepcopy(ALPHA)), out / "alpha" / "seed4", seed=4, plots=False, stop_after=2)
+    assert (out / "alpha" / "seed4" / "checkpoint.pkl").exists()
+    args = ["batch", *map(str, paths), "--seeds", "2", "--out", str(out), "--scheduler", cluster]
+    result = CliRunner().invoke(app, args)
+    return {"out": out, "args": args, "result": result, "summary": json.loads((out / "batch.json").read_text())}
+
+
+def _tasks(summary):
+    return {(t["config"], t["seed"]): t for t in summary["tasks"]}
+
+
+def test_failing_tasks_do_not_stop_the_others_and_exit_1(first_batch):
+    r, summary = first_batch["result"], first_batch["summary"]
+    assert r.exit_code == 1, r.output
+    tasks = _tasks(summary)
+    assert len(tasks) == 8 and summary["n_failed"] == 4 and summary["n_finished"] == 4
+    for key in [("alpha", 3), ("alpha", 4), ("beta", 11), ("beta", 12)]:
+        t = tasks[key]
+        assert t["status"] == "finished" and t["error"] is None, t
+        assert t["hypervolume"] > 0 and t["pareto_size"] >= 1 and t["wall_seconds"] > 0
+        assert Path(t["results"]) == first_batch["out"] / key[0] / f"seed{key[1]}"
+    for seed in (3, 4):
+        t = tasks[("nobounds", seed)]
+        assert t["status"] == "failed" and t["hypervolume"] is None
+        assert t["error"] == "bounds: at least one design variable needs bounds to optimise"
+        t = tasks[("blocked", seed)]
+        assert t["status"] == "failed" and "cannot create output directory" in t["error"]
+        assert "\n" not in t["error"]
+    # the table lists every task with its status; the failures' errors are on their rows
+    lines = r.output.splitlines()
+    assert "4 of 8 tasks failed" in r.output
+    assert any(ln.startswith("nobounds") and "failed" in ln and "bounds: at least one" in ln for ln in lines)
+    assert sum(" finished " in ln for ln in lines if ln.startswith(("alpha", "beta"))) == 4
+    assert summary["combined"]["nobounds"]["seeds"] == [] and summary["combined"]["nobounds"]["failed_seeds"] == [3, 4]
+
+
+def test_batch_results_equal_sequential_runs_byte_for_byte(first_batch, sequential):
+    """Determinism under the batch runner: worker processes with one Numba thread each reproduce the sequential
+    runs exactly, including alpha seed 4, which the batch resumed from a checkpoint."""
+    out = first_batch["out"]
+    for (name, seed), ref_dir in sequential.items():
+        for f in ("pareto.csv", "population.csv"):
+            assert (out / name / f"seed{seed}" / f).read_bytes() == (ref_dir / f).read_bytes(), (name, seed, f)
+        h_batch = pd.read_csv(out / name / f"seed{seed}" / "history.csv")
+        h_ref = pd.read_csv(ref_dir / "history.csv")
+        pd.testing.assert_frame_equal(h_batch.drop(columns="seconds"), h_ref.drop(columns="seconds"))
+        assert not (out / name / f"seed{seed}" / "checkpoint.pkl").exists()
+        assert not list((out / name / f"seed{seed}").glob(".*.tmp"))
+
+
+def test_combined_front_is_the_nondominated_merge_of_the_seeds(first_batch):
+    out, summary = first_batch["out"], first_batch["summary"]
+    for name, keys, signs in [
+        ("alpha", ["volume_m3", "gci"], np.array([-1.0, -1.0])),
+        ("beta", ["band2_volume_m3", "fci"], np.array([-1.0, 1.0])),
+    ]:
+        combined = pd.read_csv(out / name / "combined_pareto.csv")
+        seeds = pd.concat(
+            [pd.read_csv(out / name / f"seed{s}" / "pareto.csv").assign(seed=s) for s in SEEDS[name]],
+            ignore_index=True,
+        )
+        F_all = seeds[keys].to_numpy() * signs
+        F = combined[keys].to_numpy() * signs
+        # brute force: exactly the seeds' points that no seed point dominates, each objective vector once
+        dominated = [np.any(np.all(F_all <= f, axis=1) & np.any(F_all < f, axis=1)) for f in F_all]
+        expected = {tuple(f) for f, d in zip(F_all, dominated, strict=True) if not d}
+        assert {tuple(f) for f in F} == expected and len(F) == len(expected)
+        assert list(combined.columns[:1]) == ["seed"] and "rank" not in combined.columns
+        for _, row in combined.iterrows():  # every row is a row of its own seed's front
+            mine = seeds[seeds["seed"] == row["seed"]]
+            assert np.any(np.all(np.isclose(mine[keys].to_numpy(), row[keys].to_numpy(dtype=float)), axis=1))
+        info = summary["combined"][name]
+        assert info["seeds"] == SEEDS[name] and info["pareto_size"] == len(combined)
+        seed_hv = [t["hypervolume"] for t in summary["tasks"] if t["config"] == name]
+        assert info["hypervolume"] >= max(seed_hv) - 1e-12
+        png = (out / name / "hypervolume_by_seed.png").read_bytes()
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
+
+
+def test_rerun_skips_finished_tasks(first_batch):
+    out = first_batch["out"]
+    before = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in out.glob("*/seed*/*") if p.is_file()}
+    r = CliRunner().invoke(app, first_batch["args"])
+    assert r.exit_code == 1, r.output  # the failing tasks fail again
+    tasks = _tasks(json.loads((out / "batch.json").read_text()))
+    for key in [("alpha", 3), ("alpha", 4), ("beta", 11), ("beta", 12)]:
+        assert tasks[key]["status"] == "skipped", tasks[key]
+    for key, t in _tasks(first_batch["summary"]).items():
+        if t["status"] == "finished":
+            assert tasks[key]["hypervolume"] == t["hypervolume"]
+    assert [tasks[("nobounds", s)]["status"] for s in (3, 4)] == ["failed", "failed"]
+    after = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in out.glob("*/seed*/*") if p.is_file()}
+    assert after == before  # skipped tasks leave their directories untouched
+    assert " skipped " in r.output
+
+
+def test_embedded_local_cluster(tmp_path):
+    """Without --scheduler the batch starts (and stops) its own LocalCluster."""
+    cfg = config_from_dict({**copy.deepcopy(SMALL), "name": "solo", "algorithm": {"pop_size": 8, "n_gen": 2}})
+    lines = []
+    summary = run_batch([("solo.yaml", cfg)], tmp_path, seeds=1, echo=lines.append)
+    assert summary.scheduler == "local" and summary.n_failed == 0
+    (task,) = summary.tasks
+    assert task.status == "finished" and task.seed == 1 and (tmp_path / "solo" / "seed1" / "manifest.json").exists()
+    assert lines == [f"[1/1] solo seed 1: finished (HV {task.hypervolume:.6g}, {task.wall_seconds:.1f} s)"]
+    assert json.loads((tmp_path / "batch.json").read_text())["n_finished"] == 1
+
+
+@pytest.mark.parametrize(
+    ("tasks", "cores", "expected"),
+    [(1, 2, (1, 2)), (2, 2, (2, 1)), (8, 2, (2, 1)), (3, 8, (3, 2)), (5, 16, (5, 3)), (4, 1, (1, 1))],
+)
+def test_local_cluster_never_oversubscribes(tasks, cores, expected):
+    workers, threads = local_cluster_shape(tasks, cores)
+    assert (workers, threads) == expected and workers * threads <= cores
+
+
+def test_combined_front_by_hand():
+    """Two seeds' fronts of (max a, min b): the merge keeps the non-dominated points once, lowest seed first."""
+    s1 = pd.DataFrame({"a": [1.0, 2.0], "b": [0.5, 1.0], "rank": [0, 0]})
+    s2 = pd.DataFrame({"a": [3.0, 2.0, 1.5], "b": [2.0, 1.0, 1.5], "rank": [0, 0, 0]})
+    front = combined_front({2: s2, 1: s1}, ["a", "b"], np.array([-1.0, 1.0]))
+    # minimisation form (-a, b): (-3, 2) s2, (-2, 1) s1 and s2 (kept once: seed 1), (-1, 0.5) s1; (-1.5, 1.5) is
+    # dominated by (-2, 1)
+    assert front.to_dict("list") == {"seed": [2, 1, 1], "a": [3.0, 2.0, 1.0], "b": [2.0, 1.0, 0.5]}
+    assert nondominated_mask(np.array([[0.0, 1.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])).tolist() == [
+        True, True, False, True,
+    ]
+
+
+def test_table_format():
+    from scalesynth.batch import TaskRecord
+
+    rows = [
+        TaskRecord("a", "a.yaml", 1, "out/a/seed1", "finished", wall_seconds=1.5, hypervolume=2.5),
+        TaskRecord("bb", "b.yaml", 2, "out/bb/seed2", "failed", error="bounds: at least one"),
+    ]
+    assert format_table(rows).splitlines() == [
+        "config  seed  status    wall_s  hypervolume  results       error",
+        "a       1     finished  1.5     2.5          out/a/seed1",
+        "bb      2     failed    0.0     -            out/bb/seed2  bounds: at least one",
+    ]
