@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import os
 import pickle
+import re
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -58,6 +59,25 @@ def write_atomic(path: Path, writer: Callable[[Any], None], mode: str = "w") -> 
     finally:
         if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
+
+
+# write_atomic's temp names: '.' + target name + '.' + mkstemp's 8 random characters + '.tmp'
+_TEMP_NAME = re.compile(r"^\..+\.[a-z0-9_]{8}\.tmp$")
+
+
+def remove_stale_temps(directory: Path) -> list[Path]:
+    """Delete temp files that a killed writer (SIGKILL mid-write) left in ``directory`` and its subdirectories
+    one level down; returns them. Only names made by ``write_atomic`` are touched."""
+    stale = []
+    for pattern in (".*.tmp", "*/.*.tmp"):
+        for path in Path(directory).glob(pattern):
+            if _TEMP_NAME.match(path.name) and path.is_file():
+                try:
+                    path.unlink()
+                except FileNotFoundError:
+                    continue
+                stale.append(path)
+    return stale
 
 
 def write_text(path: Path, text: str) -> None:

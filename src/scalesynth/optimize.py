@@ -180,6 +180,7 @@ def run(
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
     out = Path(out_dir) if out_dir is not None else cfg.output_dir()
     rio.ensure_dir(out)
+    rio.remove_stale_temps(out)  # a run killed mid-write leaves its temp file behind
     ckpt_path = out / rio.CHECKPOINT
     problem = SynthesisProblem(cfg)
     ref = problem.hv_reference()
