@@ -230,3 +230,15 @@ def test_table_format():
         "a       1     finished  1.5     2.5          out/a/seed1",
         "bb      2     failed    0.0     -            out/bb/seed2  bounds: at least one",
     ]
+
+
+def test_ci_workflow_runs_a_small_batch_and_uploads_its_directory(root):
+    """The example workflow installs the dask extra, runs quick.yaml x 2 seeds and uploads that batch directory."""
+    wf = yaml.safe_load((root / ".github" / "workflows" / "synthesis.yml").read_text())
+    steps = wf["jobs"]["batch"]["steps"]
+    runs = "\n".join(s.get("run", "") for s in steps)
+    assert 'pip install -e ".[dask]"' in runs
+    assert "scalesynth batch configs/quick.yaml --seeds 2 --out results/ci-batch" in runs
+    (upload,) = [s for s in steps if s.get("uses", "").startswith("actions/upload-artifact")]
+    assert upload["with"]["path"].rstrip("/") == "results/ci-batch" and upload["if"] == "always()"
+    assert (root / "configs" / "quick.yaml").is_file()
