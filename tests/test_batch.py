@@ -242,3 +242,38 @@ def test_ci_workflow_runs_a_small_batch_and_uploads_its_directory(root):
     (upload,) = [s for s in steps if s.get("uses", "").startswith("actions/upload-artifact")]
     assert upload["with"]["path"].rstrip("/") == "results/ci-batch" and upload["if"] == "always()"
     assert (root / "configs" / "quick.yaml").is_file()
+
+
+def test_unreachable_scheduler_is_a_one_line_error_exit_1(tmp_path, monkeypatch):
+    from scalesynth import batch
+
+    monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
+    cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"),
+                                 "--scheduler", "tcp://127.0.0.1:9"])
+    assert r.exit_code == 1, r.output
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: --scheduler tcp://127.0.0.1:9: cannot connect"), lines
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_lost_worker_fails_only_its_task(monkeypatch):
+    """A future that raises (e.g. KilledWorker when a worker process dies) becomes a failed record."""
+    from concurrent.futures import Future
+
+    from scalesynth import batch
+
+    class Client:
+        def submit(self, fn, data, seed, out_dir, **kwargs):
+            fut = Future()
+            if seed == 2:
+                fut.set_exception(RuntimeError("Attempted to run task on 3 different workers,\n all died"))
+            else:
+                fut.set_result({"status": "skipped", "hypervolume": 1.0})
+            return fut
+
+    monkeypatch.setattr("dask.distributed.as_completed", lambda futures: list(futures))
+    tasks = [batch.BatchTask("a", "a.yaml", s, Path(f"out/a/seed{s}"), {}) for s in (1, 2, 3)]
+    records = batch.run_tasks(tasks, Client())
+    assert [r.status for r in records] == ["skipped", "failed", "skipped"]
+    assert records[1].error == "RuntimeError: Attempted to run task on 3 different workers, all died"

@@ -40,6 +40,7 @@ SUMMARY = "batch.json"
 COMBINED = "combined_pareto.csv"
 HV_PLOT = "hypervolume_by_seed.png"
 MAX_SEED = 2**32 - 1
+CONNECT_TIMEOUT = "20s"  # for --scheduler: how long to try to reach the scheduler
 
 
 @dataclass(frozen=True)
@@ -203,7 +204,7 @@ def dask_client(scheduler: str | None, n_tasks: int) -> Iterator[Any]:
         raise RunError("batch needs dask.distributed: pip install 'scalesynth[dask]'") from None
     if scheduler:
         try:
-            client = Client(scheduler, timeout="20s")
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError, ValueError) as err:
             raise RunError(f"--scheduler {scheduler}: cannot connect ({one_line(err)})") from None
         with client:
@@ -345,8 +346,8 @@ def run_batch(
     t0 = time.perf_counter()
     out = Path(out)
     tasks = plan(configs, seeds, out)  # bad input fails here, before anything is written
-    rio.ensure_dir(out)
     with dask_client(scheduler, len(tasks)) as client:
+        rio.ensure_dir(out)  # after connecting: an unreachable scheduler leaves nothing behind
         records = run_tasks(tasks, client, echo)
     combined = {}
     for _, cfg in configs:
