@@ -188,12 +188,20 @@ def test_embedded_local_cluster(tmp_path):
     """Without --scheduler the batch starts (and stops) its own LocalCluster."""
     cfg = config_from_dict({**copy.deepcopy(SMALL), "name": "solo", "algorithm": {"pop_size": 8, "n_gen": 2}})
     lines = []
-    summary = run_batch([("solo.yaml", cfg)], tmp_path, seeds=1, echo=lines.append)
+    summary = run_batch([("solo.yaml", cfg)], tmp_path, seeds=2, echo=lines.append)
     assert summary.scheduler == "local" and summary.n_failed == 0
-    (task,) = summary.tasks
-    assert task.status == "finished" and task.seed == 1 and (tmp_path / "solo" / "seed1" / "manifest.json").exists()
-    assert lines == [f"[1/1] solo seed 1: finished (HV {task.hypervolume:.6g}, {task.wall_seconds:.1f} s)"]
-    assert json.loads((tmp_path / "batch.json").read_text())["n_finished"] == 1
+    assert [(t.status, t.seed) for t in summary.tasks] == [("finished", 1), ("finished", 2)]
+    # one progress line per task as it completes: [done/total], in completion order
+    assert [ln[:6] for ln in lines] == ["[1/2] ", "[2/2] "]
+    assert sorted(ln[6:] for ln in lines) == [
+        f"solo seed {t.seed}: finished (HV {t.hypervolume:.6g}, {t.wall_seconds:.1f} s)" for t in summary.tasks
+    ]
+    assert json.loads((tmp_path / "batch.json").read_text())["n_finished"] == 2
+    # the workers got NUMBA_NUM_THREADS so that workers x Numba threads <= cores (the manifest records it)
+    _, threads = local_cluster_shape(2)
+    for seed in (1, 2):
+        manifest = json.loads((tmp_path / "solo" / f"seed{seed}" / "manifest.json").read_text())
+        assert manifest["machine"]["numba_threads"] == threads
 
 
 @pytest.mark.parametrize(
