@@ -8,6 +8,7 @@ one test starts the embedded cluster that `batch` creates without --scheduler.
 import copy
 import json
 import logging
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -285,3 +286,12 @@ def test_a_lost_worker_fails_only_its_task(monkeypatch):
     records = batch.run_tasks(tasks, Client())
     assert [r.status for r in records] == ["skipped", "failed", "skipped"]
     assert records[1].error == "RuntimeError: Attempted to run task on 3 different workers, all died"
+
+
+def test_without_dask_the_batch_says_how_to_install_it(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # makes `import dask.distributed` fail
+    cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out")])
+    assert r.exit_code == 1
+    assert r.output.strip() == "error: batch needs dask.distributed: pip install 'scalesynth[dask]'"
+    assert not (tmp_path / "out").exists()
