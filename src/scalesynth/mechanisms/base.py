@@ -190,6 +190,13 @@ class Mechanism:
         return arr
 
 
+def wrap_angle(a):
+    """Angle(s) in (-pi, pi]: a float for a scalar, an array for an array."""
+    w = np.arctan2(np.sin(a), np.cos(a))
+    w = np.where(w == -np.pi, np.pi, w)
+    return float(w) if np.ndim(w) == 0 else w
+
+
 def singularity_label(inverse: bool, forward: bool) -> str:
     """'none', 'inverse', 'forward' or 'both' from the two singularity tests."""
     return {(False, False): "none", (True, False): "inverse", (False, True): "forward"}.get((inverse, forward), "both")

@@ -19,7 +19,16 @@ from scalesynth.errors import InvalidParameter
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label, svd_lci
+from scalesynth.mechanisms.base import (
+    Mechanism,
+    Option,
+    Parameter,
+    Solution,
+    parse_range,
+    singularity_label,
+    svd_lci,
+    wrap_angle,
+)
 
 MODES = ("++", "+-", "-+", "--")
 
@@ -435,7 +444,7 @@ class PauuPpap(Mechanism):
                 return []
             g = math.acos(min(1.0, max(-1.0, k)))
             base = math.atan2(-b, a)
-            roots.append({+1: _wrap(base + g), -1: _wrap(base - g)})
+            roots.append({+1: wrap_angle(base + g), -1: wrap_angle(base - g)})
         return [
             Solution(s1 + s2, np.array([roots[0][1 if s1 == "+" else -1], roots[1][1 if s2 == "+" else -1], y]))
             for s1 in "+-"
@@ -572,12 +581,6 @@ class PauuPpap(Mechanism):
             Joint("P", axes=((0.0, 0.0, 1.0),)),
         ]))
         return chains
-
-
-def _wrap(t: float) -> float:
-    """Angle in (-pi, pi]."""
-    w = math.atan2(math.sin(t), math.cos(t))
-    return math.pi if w == -math.pi else w
 
 
 MECHANISM = PauuPpap(

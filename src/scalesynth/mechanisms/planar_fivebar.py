@@ -32,7 +32,16 @@ from numba import njit
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.conditioning import lci_2x2
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label, svd_lci
+from scalesynth.mechanisms.base import (
+    Mechanism,
+    Option,
+    Parameter,
+    Solution,
+    parse_range,
+    singularity_label,
+    svd_lci,
+    wrap_angle,
+)
 
 MODES = ("++", "+-", "-+", "--")
 TWO_PI = 2.0 * math.pi
@@ -173,7 +182,7 @@ class PlanarFivebar(Mechanism):
                 return []
             g = math.acos(min(1.0, max(-1.0, k)))
             base = math.atan2(ee, dd)
-            roots.append({1: _wrap(base - g), -1: _wrap(base + g)})
+            roots.append({1: wrap_angle(base - g), -1: wrap_angle(base + g)})
         return [
             Solution(s1 + s2, np.array([roots[0][1 if s1 == "+" else -1], roots[1][1 if s2 == "+" else -1]]))
             for s1 in "+-"
@@ -308,12 +317,6 @@ class PlanarFivebar(Mechanism):
             Joint("R", (x, y, 0.0), (zhat,)),
         ])
         return [right, left]
-
-
-def _wrap(t: float) -> float:
-    """Angle in (-pi, pi]."""
-    w = math.atan2(math.sin(t), math.cos(t))
-    return math.pi if w == -math.pi else w
 
 
 MECHANISM = PlanarFivebar(

@@ -33,7 +33,15 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label
+from scalesynth.mechanisms.base import (
+    Mechanism,
+    Option,
+    Parameter,
+    Solution,
+    parse_range,
+    singularity_label,
+    wrap_angle,
+)
 
 SQRT3_2 = math.sqrt(3.0) / 2.0
 # spec §1.8 search box (mm); bounding_box never extends beyond it
@@ -357,21 +365,15 @@ def scaled(geo: Geometry, jt: np.ndarray) -> np.ndarray:
     return jt * row[:, None] * col[None, :]
 
 
-def _wrap(a):
-    """Angles into (-pi, pi]."""
-    w = np.mod(np.asarray(a, dtype=float) + np.pi, 2.0 * np.pi) - np.pi
-    return np.where(w == -np.pi, np.pi, w)
-
-
 def normalise_euler(X: np.ndarray) -> np.ndarray:
     """Pick the representative of the Euler duplicate pair (phi+pi, pi-theta, psi+pi) with theta in
     [-pi/2, pi/2], all angles in (-pi, pi] (spec §1.4 item 3)."""
     X = np.array(X, dtype=float)
-    theta = _wrap(X[..., 4])
+    theta = wrap_angle(X[..., 4])
     flip = np.abs(theta) > np.pi / 2
-    X[..., 3] = _wrap(np.where(flip, X[..., 3] + np.pi, X[..., 3]))
-    X[..., 4] = np.where(flip, _wrap(np.pi - theta), theta)
-    X[..., 5] = _wrap(np.where(flip, X[..., 5] + np.pi, X[..., 5]))
+    X[..., 3] = wrap_angle(np.where(flip, X[..., 3] + np.pi, X[..., 3]))
+    X[..., 4] = np.where(flip, wrap_angle(np.pi - theta), theta)
+    X[..., 5] = wrap_angle(np.where(flip, X[..., 5] + np.pi, X[..., 5]))
     return X
 
 
@@ -393,7 +395,7 @@ def newton_fk(
     def residual(Xs, rows):
         st = chain_state(geo, Xs, sigma)
         res = st.q - q[rows]
-        res[..., 2] = _wrap(res[..., 2])
+        res[..., 2] = wrap_angle(res[..., 2])
         err = np.max(np.abs(res * weight), axis=-1)
         return res, np.where(st.ok, err, np.inf)
 
@@ -455,7 +457,7 @@ def dedupe(X: np.ndarray, length: float, tol: float = 1e-6) -> np.ndarray:
 
 
 def _pose_distance(a: np.ndarray, b: np.ndarray, length: float) -> float:
-    return max(float(np.max(np.abs(a[:3] - b[:3]))), length * float(np.max(np.abs(_wrap(a[3:] - b[3:])))))
+    return max(float(np.max(np.abs(a[:3] - b[:3]))), length * float(np.max(np.abs(wrap_angle(a[3:] - b[3:])))))
 
 
 # ----- the mechanism ---------------------------------------------------------------------------------------

@@ -39,7 +39,16 @@ from numba import njit
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label, svd_lci
+from scalesynth.mechanisms.base import (
+    Mechanism,
+    Option,
+    Parameter,
+    Solution,
+    parse_range,
+    singularity_label,
+    svd_lci,
+    wrap_angle,
+)
 
 MODELS = ("P", "C")
 C3_VARIANTS = ("plane", "upu")
@@ -288,12 +297,6 @@ def _legs(geom: tuple, model: str, variant: str, x: np.ndarray):
     return valid, q, jx
 
 
-def _wrap(a):
-    """Angles in (-pi, pi]."""
-    w = np.arctan2(np.sin(a), np.cos(a))
-    return np.where(w == -np.pi, np.pi, w)
-
-
 # ----- forward kinematics -----------------------------------------------------------------------------------
 def _p_angles(geom: tuple, q: np.ndarray, z: np.ndarray, cos_theta: np.ndarray, sin_theta: np.ndarray) -> np.ndarray:
     """Complete P-model candidates (z, theta, psi) from z and theta (spec §2.4): cos psi from q1^2 + q2^2,
@@ -489,9 +492,11 @@ def _distinct(x: np.ndarray, res: np.ndarray) -> list[np.ndarray]:
     """Distinct poses (angles wrapped to (-pi, pi]), the smallest residual kept for each."""
     out: list[np.ndarray] = []
     for i in np.argsort(res, kind="stable"):
-        xi = np.array([x[i, 0], *_wrap(x[i, 1:])])
+        xi = np.array([x[i, 0], *wrap_angle(x[i, 1:])])
         if all(
-            abs(xi[0] - o[0]) > 1e-7 * max(1.0, abs(o[0])) or np.abs(_wrap(xi[1:] - o[1:])).max() > 1e-7 for o in out
+            abs(xi[0] - o[0]) > 1e-7 * max(1.0, abs(o[0]))
+            or np.abs(wrap_angle(xi[1:] - o[1:])).max() > 1e-7
+            for o in out
         ):
             out.append(xi)
     return out
@@ -928,7 +933,7 @@ class RpsUpuTool(RpsUpu):
             th0 = math.asin(-tx / (d * cp))
             for lt, th in (("+", th0), ("-", math.pi - th0)):
                 z = tz + d * math.cos(th) * cp
-                out.append(Solution(lt + lp, np.array([z, *_wrap(np.array([th, ps]))])))
+                out.append(Solution(lt + lp, np.array([z, *wrap_angle(np.array([th, ps]))])))
         return out
 
     # ----- IK, FK -----------------------------------------------------------------------------------------

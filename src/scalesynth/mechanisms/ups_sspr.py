@@ -30,7 +30,15 @@ from numba import njit
 from scalesynth.errors import InvalidParameter
 from scalesynth.kernels.conditioning import lci_3x3
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.base import Mechanism, Option, Parameter, Solution, parse_range, singularity_label
+from scalesynth.mechanisms.base import (
+    Mechanism,
+    Option,
+    Parameter,
+    Solution,
+    parse_range,
+    singularity_label,
+    wrap_angle,
+)
 
 K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
 SQRT3_2 = math.sqrt(3.0) / 2.0
@@ -140,12 +148,6 @@ def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
         jy = (d[1] - (d[0] * sb + d[2] * cb) * yy / rho) / ln
         rows.append([ja, jb, jy])
     return lengths, rows
-
-
-def _wrap(t: float) -> float:
-    """Angle in (-pi, pi]."""
-    w = math.atan2(math.sin(t), math.cos(t))
-    return math.pi if w == -math.pi else w
 
 
 class UpsSspr(Mechanism):
@@ -313,10 +315,10 @@ class UpsSspr(Mechanism):
             sol = _newton(a, b, c, yy, l2, l3, a0, b0, scale)
             if sol is None:
                 continue
-            alpha, beta = _wrap(sol[0]), _wrap(sol[1])
+            alpha, beta = wrap_angle(sol[0]), wrap_angle(sol[1])
             if not math.cos(beta) > 0.0:
                 continue  # Z < 0 assembly
-            if any(abs(_wrap(alpha - f[0])) < 1e-7 and abs(beta - f[1]) < 1e-7 for f in found):
+            if any(abs(wrap_angle(alpha - f[0])) < 1e-7 and abs(beta - f[1]) < 1e-7 for f in found):
                 continue
             _, rows = _legs(a, b, c, alpha, beta, yy)
             r2, r3 = rows[1][:2], rows[2][:2]
