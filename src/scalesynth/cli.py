@@ -172,11 +172,8 @@ def ik_cmd(
     rows = []
     for s in sols:
         row = s.as_dict()
-        try:
-            row["singularity"] = mech.singularity(design, options, p, s.values)
-            row["lci"] = mech.lci(design, options, p, s.values)
-        except NotImplementedError:
-            pass
+        row["singularity"] = mech.singularity(design, options, p, s.values)
+        row["lci"] = mech.lci(design, options, p, s.values)
         rows.append(row)
     _print_solutions(mech.joints, rows, as_json, "pose out of reach: no IK solution")
 

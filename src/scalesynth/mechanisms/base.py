@@ -12,6 +12,7 @@ limit, else ``-1.0``. Planar mechanisms ignore ``z``. The kernel must never retu
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -53,7 +54,7 @@ class Solution:
 
 
 @dataclass(frozen=True)
-class Mechanism:
+class Mechanism(ABC):
     """Base description; concrete mechanisms subclass and fill the methods."""
 
     name: str
@@ -116,39 +117,42 @@ class Mechanism:
         self.check_options(options)
         return options
 
-    def check_options(self, options: dict[str, Any]) -> None:
+    def check_options(self, options: dict[str, Any]) -> None:  # noqa: B027 - optional hook, no options by default
         """Validate option values in place (override); raise InvalidParameter naming the option."""
 
-    # ----- what subclasses provide ----------------------------------------------------------------
+    # ----- what subclasses provide (abstract: a registered mechanism cannot be created without them) -----------
+    @abstractmethod
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         """Flatten a resolved design and options into the float64 vector the point kernel reads."""
-        raise NotImplementedError  # abstract: every registered mechanism overrides it
 
     @property
-    def point_kernel(self):  # pragma: no cover - abstract
-        raise NotImplementedError  # abstract: every registered mechanism overrides it
+    @abstractmethod
+    def point_kernel(self):
+        """The Numba point kernel ``kernel(p, x, y, z) -> LCI or -1`` (module docstring)."""
 
+    @abstractmethod
     def bounding_box(self, design: Mapping[str, float], options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
         """Box (lo, hi), 3 entries each, that contains the whole reachable set."""
-        raise NotImplementedError  # abstract
 
+    @abstractmethod
     def inverse_kinematics(self, design, options, pose) -> list[Solution]:
-        raise NotImplementedError  # abstract
+        """Every IK branch of a pose, labelled; [] if the pose is out of reach."""
 
+    @abstractmethod
     def forward_kinematics(self, design, options, inputs) -> list[Solution]:
-        raise NotImplementedError  # abstract
+        """Every FK assembly mode found for the joint inputs, labelled."""
 
+    @abstractmethod
     def kernel_branch(self, options: Mapping[str, Any]) -> str:
         """Label of the IK branch (working mode) whose LCI the point kernel returns."""
-        raise NotImplementedError  # abstract
 
+    @abstractmethod
     def lci(self, design, options, pose, q) -> float:
         """LCI at a pose with joint values q, computed with NumPy (SVD); the point kernel's reference."""
-        raise NotImplementedError  # abstract
 
+    @abstractmethod
     def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
         """'none', 'inverse', 'forward' or 'both'."""
-        raise NotImplementedError  # abstract
 
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
         """Workspace statistics of many designs (layout of kernels.grid.population_stats). A mechanism may override
