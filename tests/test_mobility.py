@@ -31,7 +31,6 @@ from typer.testing import CliRunner
 from scalesynth.cli import app
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.mechanisms import get
-from scalesynth.mechanisms.base import Mechanism
 from scalesynth.mechanisms.rps_upu import TOOL_MECHANISM
 from scalesynth.mobility import (
     Joint,
@@ -426,8 +425,16 @@ def test_empty_workspace_and_bad_sample_count():
 
 
 def test_mechanism_without_topology_is_a_clear_error():
-    bare = Mechanism(name="bare", title="no joints", seed="-", motion="3T", task_axes=("x", "y", "z"),
-                     task_units=("length",) * 3, joints=("q",), joint_units=("length",), parameters=())
+    import dataclasses
+
+    from scalesynth.mechanisms.pauu_ppap import MECHANISM as PAUU
+    from scalesynth.mechanisms.pauu_ppap import PauuPpap
+
+    class Bare(PauuPpap):  # a complete mechanism that declares no joints
+        topology = None
+
+    fields = {f.name: getattr(PAUU, f.name) for f in dataclasses.fields(PAUU)}
+    bare = Bare(**{**fields, "name": "bare"})
     with pytest.raises(NoTopology, match="bare declares no joint topology"):
         mobility_report(bare, {}, {})
 
