@@ -30,3 +30,16 @@ SPEC_GCI = {1: 0.3438, 2: 0.3438, 3: 0.3439, 4: 0.3380, 5: 0.3438, 6: 0.3440}
 @pytest.fixture(scope="session")
 def root():
     return ROOT
+
+
+# a seed-000 synthesis small enough for tests (16 designs x 6 generations on a 12^3 grid), shared by the
+# optimisation, reliability and batch tests
+SMALL = {
+    "name": "small",
+    "mechanism": "2pauu-ppap",
+    "design": {"m": 0.857, "n": 0.706, "l1": 1.499, "l2": 1.5, "c": 0.1},
+    "bounds": {"m": [0.5, 1.5], "n": [0.2, 1.0], "l1": [0.5, 1.5], "l2": [0.5, 1.5], "c": [0.1, 0.5]},
+    "grid": {"resolution": 12},
+    "algorithm": {"pop_size": 16, "n_gen": 6, "seed": 3},
+    "output": {"checkpoint_every": 2},
+}

@@ -23,15 +23,9 @@ from scalesynth.config import config_from_dict
 from scalesynth.errors import RunError
 from scalesynth.optimize import run
 
-SMALL = {
-    "name": "alpha",
-    "mechanism": "2pauu-ppap",
-    "design": {"m": 0.857, "n": 0.706, "l1": 1.499, "l2": 1.5, "c": 0.1},
-    "bounds": {"m": [0.5, 1.5], "n": [0.2, 1.0], "l1": [0.5, 1.5], "l2": [0.5, 1.5], "c": [0.1, 0.5]},
-    "grid": {"resolution": 12},
-    "algorithm": {"pop_size": 16, "n_gen": 6, "seed": 3},
-    "output": {"checkpoint_every": 2},
-}
+from conftest import SMALL as SMALL_RUN
+
+SMALL = {**SMALL_RUN, "name": "alpha"}
 ALPHA = SMALL
 # a maximised and a minimised objective, so the combined front's minimisation form is exercised
 BETA = {

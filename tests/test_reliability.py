@@ -31,15 +31,7 @@ from scalesynth.evaluate import evaluate, evaluate_population
 from scalesynth.mechanisms import available, get
 from scalesynth.optimize import run
 
-SMALL = {
-    "name": "small",
-    "mechanism": "2pauu-ppap",
-    "design": {"m": 0.857, "n": 0.706, "l1": 1.499, "l2": 1.5, "c": 0.1},
-    "bounds": {"m": [0.5, 1.5], "n": [0.2, 1.0], "l1": [0.5, 1.5], "l2": [0.5, 1.5], "c": [0.1, 0.5]},
-    "grid": {"resolution": 12},
-    "algorithm": {"pop_size": 16, "n_gen": 6, "seed": 3},
-    "output": {"checkpoint_every": 2},
-}
+from conftest import SMALL
 
 
 def small(**changes):
