@@ -28,7 +28,7 @@ import scalesynth.mechanisms.rps_upu as rps
 from scalesynth.mechanisms import get
 
 ROOT = Path(__file__).resolve().parents[1]
-REF = ROOT.parent / "shared" / "spec" / "cases" / "ref002.json"
+REF = ROOT / "tests" / "data" / "cases" / "ref002.json"
 G, H, C = 80.0, 50.0, 50.0
 
 

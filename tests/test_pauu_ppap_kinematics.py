@@ -1,4 +1,4 @@
-"""Seed-000 kinematics against spec/cases/ref000_004.txt (mechanisms_000_004.md §1.8) and property tests."""
+"""Seed-000 kinematics against tests/data/cases/ref000_004.txt (spec mechanisms_000_004.md §1.8) and property tests."""
 
 import math
 
@@ -9,10 +9,13 @@ from hypothesis import strategies as st
 
 from scalesynth.mechanisms import get
 
+from refdata import seed000_modes, seed000_table2_roots, seed000_table3
+
 M = get("2pauu-ppap")
 TABLE = dict(m=1.0, n=0.5, l1=0.6, l2=1.2, c=0.1)  # spec §1.8
 OPT = M.resolve_options({})
 P_TABLE2 = (-0.9165, -0.5846, 0.8792)
+ROOTS = seed000_table2_roots()  # theta1 (+, -), theta2 (+, -) rad, e = 2c and e = c
 
 
 def ik(design, pose, options=OPT):
@@ -22,8 +25,8 @@ def ik(design, pose, options=OPT):
 def test_table2_ik_all_branches():
     sols = ik(TABLE, P_TABLE2)
     # spec §1.8 convention T, e = 2c (6 digits)
-    expected = {"++": (-2.285386, 0.658507), "+-": (-2.285386, -2.699931), "-+": (-3.103586, 0.658507),
-                "--": (-3.103586, -2.699931)}
+    (t1p, t1m), (t2p, t2m) = ROOTS["e=2c"]
+    expected = {"++": (t1p, t2p), "+-": (t1p, t2m), "-+": (t1m, t2p), "--": (t1m, t2m)}
     for label, (t1, t2) in expected.items():
         assert sols[label][0] == pytest.approx(t1, abs=1e-6)
         assert sols[label][1] == pytest.approx(t2, abs=1e-6)
@@ -38,30 +41,23 @@ def test_table2_ik_all_branches():
 
 def test_text_offset_e_equals_c():
     sols = ik(TABLE, P_TABLE2, M.resolve_options({"e": 0.1}))
-    assert sols["+-"][0] == pytest.approx(-2.379848, abs=1e-6)
-    assert sols["-+"][0] == pytest.approx(-2.897515, abs=1e-6)
-    assert sols["++"][1] == pytest.approx(0.450898, abs=1e-6)
-    assert sols["--"][1] == pytest.approx(-2.610725, abs=1e-6)
+    (t1p, t1m), (t2p, t2m) = ROOTS["e=c"]  # ref000_004.txt "[text offset e=c]"
+    assert sols["+-"][0] == pytest.approx(t1p, abs=1e-6)
+    assert sols["-+"][0] == pytest.approx(t1m, abs=1e-6)
+    assert sols["++"][1] == pytest.approx(t2p, abs=1e-6)
+    assert sols["--"][1] == pytest.approx(t2m, abs=1e-6)
 
 
-SPEC_MODES = {
-    # mode: (other FK solution, det Jx, diag Jq, LCI 2-norm, J rows)
-    "++": ((0.048772, -0.5846, -0.393145), 1.083876, (-0.374932, -0.475233), 0.227552,
-           [(0.361955, -0.099084, -0.442481), (0, 0, 1), (-0.020078, -0.448680, 0.583243)]),
-    "+-": ((1.065741, -0.5846, 0.230483), 0.215890, (-0.374932, 0.475233), 0.083532,
-           [(0.734153, 0.497449, -0.532776), (0, 0, 1), (1.665342, 2.252595, 0.174359)]),
-    "-+": ((-0.157611, -0.5846, -0.823564), 0.892908, (0.374932, -0.475233), 0.220420,
-           [(-0.439367, -0.349357, -0.255313), (0, 0, 1), (0.024373, -0.434797, 0.572860)]),
-    "--": ((0.859359, -0.5846, -0.199936), -0.284094, (0.374932, 0.475233), 0.110583,
-           [(0.557901, -1.098030, -0.480832), (0, 0, 1), (1.265536, -1.366568, 0.292187)]),
-}
+# mode: (the two FK solutions, det Jx, diag Jq[:2], LCI 2-norm, J rows), from ref000_004.txt
+SPEC_MODES = seed000_modes()
 
 
 @pytest.mark.parametrize("mode", list(SPEC_MODES))
 def test_modes_round_trip_jacobians_lci(mode):
     design = M.resolve_design(TABLE)
     q = ik(TABLE, P_TABLE2)[mode]
-    other, det_jx, diag_jq, lci, j_rows = SPEC_MODES[mode]
+    both, det_jx, diag_jq, lci, j_rows = SPEC_MODES[mode]
+    other = max(both, key=lambda p: np.abs(np.array(p) - P_TABLE2).max())  # the solution that is not the pose
     fk = [s.values for s in M.forward_kinematics(design, OPT, q)]
     assert len(fk) == 2
     # one assembly mode is the pose itself (exactly, to round-off), the other is the spec's
@@ -79,12 +75,7 @@ def test_modes_round_trip_jacobians_lci(mode):
     assert M.singularity(design, OPT, P_TABLE2, q) == "none"
 
 
-TABLE3 = [
-    ((-3.1033, -2.6997, -0.5846), [(-0.916594, -0.5846, 0.879246), (0.859400, -0.5846, -0.199685)]),
-    ((-3.1033, 0.6583, -0.5846), [(-0.157627, -0.5846, -0.823391), (-0.916553, -0.5846, 0.879297)]),
-    ((-2.2855, -2.6997, -0.5846), [(1.065599, -0.5846, 0.230233), (-0.916469, -0.5846, 0.879531)]),
-    ((-2.2855, 0.6583, -0.5846), [(0.048665, -0.5846, -0.393187), (-0.916521, -0.5846, 0.879295)]),
-]
+TABLE3 = seed000_table3()  # ref000_004.txt "000: Table 3 rounded inputs"
 
 
 @pytest.mark.parametrize(("q", "expected"), TABLE3)

@@ -1,4 +1,4 @@
-"""Seed-004 planar five-bar: spec mechanisms_000_004.md §2 (reference cases §2.7, cases/ref000_004.txt), the
+"""Seed-004 planar five-bar: spec mechanisms_000_004.md §2 (reference cases §2.7, tests/data/cases/ref000_004.txt), the
 kernel against its NumPy twin (tests/naive.py), and property tests (IK/FK round trips, J vs FK differences)."""
 
 import json
@@ -19,6 +19,7 @@ from scalesynth.mechanisms import get
 
 from conftest import ROOT
 from naive import fivebar_arm_angles, fivebar_lci, grid_metrics, grid_nodes
+from refdata import seed004_points
 
 M = get("planar-fivebar")
 ILLUSTRATIVE = dict(r=200.0, l1=475.0, l2=875.0)  # spec §2.7 (not from the paper)
@@ -45,19 +46,11 @@ def kernel(x, y, packed=PACKED):
 
 
 # ----- spec §2.7 reference cases ---------------------------------------------------------------------------
-# point: (alpha1, alpha2, beta1, beta2, J rows, LCI, |J (1, 1)^T|)
-SPEC_POINTS = {
-    "a": ((500, -850), (0.015438, -1.754420, -1.772088, -0.453036),
-          [(209.650923, 463.221842), (430.666667, -94.522904)], 0.775080, 752.163804),
-    "b": ((500, -600), (0.605347, -1.917643, -1.674519, -0.176093),
-          [(63.321547, 466.798272), (355.866289, -48.592014)], 0.762446, 612.735263),
-    "c": ((-500, -600), (-1.223950, 2.536246, -2.965499, -1.467074),
-          [(466.798272, 63.321547), (48.592014, -355.866289)], 0.762446, 612.735263),
-    "d": ((-500, -850), (-1.387173, 3.126154, -2.688556, -1.369504),
-          [(463.221842, 209.650923), (94.522904, -430.666667)], 0.775080, 752.163804),
-    "o": ((0, -725), (-0.305041, -2.836552, -2.413383, -0.728209),
-          [(273.330233, 273.330233), (306.527922, -306.527922)], 0.891698, 546.660466),
-}
+# |J (1, 1)^T| (mm) at the reference points: spec §2.7 table (not in ref000_004.txt)
+RESOLUTION = {"a": 752.163804, "b": 612.735263, "c": 612.735263, "d": 752.163804, "o": 546.660466}
+# point: ((x, y), (alpha1, alpha2, beta1, beta2), J rows, LCI, |J (1, 1)^T|), from tests/data/cases/ref000_004.txt
+SPEC_POINTS = {k: (*v[:4], RESOLUTION[k]) for k, v in seed004_points().items()}
+OTHER_FK = {k: v[4] for k, v in seed004_points().items()}  # the second assembly mode (x, y) mm
 
 
 @pytest.mark.parametrize("name", list(SPEC_POINTS))
@@ -87,7 +80,7 @@ def test_other_roots_and_second_assembly_mode_at_point_a():
     fk = {s.label: s.values for s in M.forward_kinematics(DESIGN, OPT, sols["+-"])}
     assert set(fk) == {"+", "-"}
     np.testing.assert_allclose(fk["+"], (500, -850), atol=1e-9)  # '+' is the lower (packing-side) mode
-    assert six(fk["-"][0], -111.788536) and six(fk["-"][1], 390.318432)
+    assert six(fk["-"][0], OTHER_FK["a"][0]) and six(fk["-"][1], OTHER_FK["a"][1])
 
 
 def test_ik_equals_half_angle_form_of_the_paper():

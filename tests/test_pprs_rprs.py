@@ -1,4 +1,4 @@
-"""Seed-001 2PPRS-RPRS: spec mechanisms_001_003.md §1 and spec/cases/ref001.json, the point kernel against its
+"""Seed-001 2PPRS-RPRS: spec mechanisms_001_003.md §1 and tests/data/cases/ref001.json, the point kernel against its
 NumPy twin (tests/naive.py), property tests, the drive curves and the `drives` command."""
 
 import json
@@ -27,13 +27,14 @@ from scalesynth.mechanisms.pprs_rprs import (
     sigma_vector,
 )
 
-from conftest import ROOT, SHARED
+from conftest import ROOT
 from naive import pprs_lci
+from refdata import load_case
 
 M = get("pprs-rprs")
 D = M.resolve_design({})  # Table 1: r = 160, R = 180, L1 = 100, L2 = L3 = 120
 OPT = M.resolve_options({})
-REF = json.loads((SHARED / "spec" / "cases" / "ref001.json").read_text())
+REF = load_case("ref001.json")  # tests/data/cases/, provenance in tests/data/README.md
 HOME = np.array([0.0, 0.0, 200.0, 0.0, 0.0, 0.0])
 CONFIG = ROOT / "configs" / "pprs_rprs.yaml"
 WIDE = {"w_limits": [-1e3, 1e3], "s_limits": [-1e3, 1e3], "beta_limits": [-math.pi, math.pi]}

@@ -1,5 +1,5 @@
 """Seed-002 2-RPS-UPU: spec mechanisms_001_003.md §2 (Table 2, Jacobians, C-model tables, §2.8 workspace) and
-spec/cases/ref002.json; kernel vs the NumPy twin tests/naive.py::rps_upu_lci; IK/FK property tests."""
+tests/data/cases/ref002.json; kernel vs the NumPy twin tests/naive.py::rps_upu_lci; IK/FK property tests."""
 
 import json
 import math
@@ -17,11 +17,11 @@ from scalesynth.evaluate import evaluate, make_grid
 from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import get
 
-from conftest import SHARED
 from naive import grid_metrics, grid_nodes, rps_upu_lci, rps_upu_tool_lci
+from refdata import load_case
 
 M = get("rps-upu")
-REF = json.loads((SHARED / "spec" / "cases" / "ref002.json").read_text())
+REF = load_case("ref002.json")  # tests/data/cases/, provenance in tests/data/README.md
 CASES = ("case1", "case2", "case3")
 PAPER = M.resolve_design({})  # g = 80, h = 50, c = 50, e = 0 (spec §2.1)
 P_OPT = M.resolve_options({})

@@ -1,4 +1,4 @@
-"""Seed-003 2-UPS/(S+SPR)R: spec mechanisms_001_003.md §3 (reference cases §3.7, cases/ref003.json), the kernel
+"""Seed-003 2-UPS/(S+SPR)R: spec mechanisms_001_003.md §3 (§3.7, tests/data/cases/ref003.json), the kernel
 against its NumPy twin (tests/naive.py), and property tests (IK/FK round trips, Jacobians vs differences).
 
 Dimensions a = 100, b = 80 are the spec's PLACEHOLDERS (not in the paper); c = 120 is the paper's.
@@ -21,15 +21,16 @@ from scalesynth.evaluate import evaluate, make_grid
 from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import available, get
 
-from conftest import ROOT, SHARED
+from conftest import ROOT
 from naive import grid_metrics, grid_nodes, ups_sspr_lci
+from refdata import load_case
 
 M = get("ups-sspr")
 DESIGN = M.resolve_design({})  # a = 100, b = 80 (placeholders), c = 120
 OPT = M.resolve_options({})
 PACKED = M.pack(DESIGN, OPT)
 NO_LIMITS = {"l1_limits": None, "l2_limits": None, "l3_limits": None}
-REF = json.loads((SHARED / "spec" / "cases" / "ref003.json").read_text())
+REF = load_case("ref003.json")  # tests/data/cases/, provenance in tests/data/README.md
 
 # spec §3.7 table: pose -> (l1, l2, l3), 10 decimals
 TABLE = {
