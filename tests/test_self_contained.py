@@ -1,5 +1,5 @@
 """The repository is self-contained: nothing in src/, tests/, benchmarks/, scripts/ or .ci/ reads the reference
-material that lives beside the checkout (the developers' spec folder), and the test data has its provenance written down."""
+material beside the checkout (the developers' spec folder), and the test data has its provenance written down."""
 
 import re
 

@@ -1,3 +1,6 @@
-from scalesynth.cli import main
+"""``python -m scalesynth``: the same CLI as the ``scalesynth`` command. Importing this module runs nothing."""
 
-main()
+if __name__ == "__main__":
+    from scalesynth.cli import main
+
+    main()
