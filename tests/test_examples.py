@@ -27,7 +27,7 @@ def test_configs_folder_is_a_byte_identical_copy_of_the_packaged_examples():
     user = {p.name: p.read_bytes() for p in (ROOT / "configs").glob("*.yaml")}
     assert set(user) == set(shipped) and "quick.yaml" in shipped
     stale = [name for name in shipped if user[name] != shipped[name]]
-    assert stale == [], f"edit src/scalesynth/examples/ and copy to configs/: cp src/scalesynth/examples/*.yaml configs/"
+    assert stale == [], f"{stale}: edit src/scalesynth/examples/, then cp src/scalesynth/examples/*.yaml configs/"
 
 
 @pytest.mark.parametrize("name", examples.names())
