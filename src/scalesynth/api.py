@@ -18,9 +18,10 @@ from scalesynth.evaluate import evaluate_config as _evaluate_config
 from scalesynth.mechanisms import available as _available
 from scalesynth.mechanisms import get as _get
 from scalesynth.mechanisms.base import Mechanism
-from scalesynth.optimize import ProgressFn, RunResult
-from scalesynth.optimize import load_result as _load_result
+from scalesynth.optimize import ProgressFn
 from scalesynth.optimize import run as _run
+from scalesynth.results import RunResult
+from scalesynth.results import load as _load_result
 
 ConfigLike = RunConfig | str | Path | Mapping[str, Any]
 

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import app, handles_errors
+from scalesynth.cliapp import app, handles_errors
 from scalesynth.errors import ConfigError
 
 
