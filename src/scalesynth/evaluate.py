@@ -99,20 +99,7 @@ def stats_to_metrics(stats: np.ndarray, cell_measure: np.ndarray, names: list[st
 
 @dataclass
 class WorkspaceReport:
-    """Metrics of one design (from ``evaluate``). ``measure_key`` is e.g. 'volume_m3'; band k covers
-    (edges[k], edges[k+1]].
-
-    Attributes:
-        metrics: {name: value}: the measure (``measure_key``, volume or area in the length unit), ``gci``, ``fci``,
-            ``min_lci``, ``max_lci`` (dimensionless, in [0, 1]), ``voxels`` (reachable cells), ``band<k>_share``
-            and ``band<k>_<measure_key>``; with a task, ``task_*`` and ``path_*``. Empty workspace: all 0.
-        lci_grid: only with ``keep_grid=True``: float64 array of shape ``grid.shape`` (nx, ny, nz; nz = 1 for planar
-            mechanisms), the LCI at each cell centre in [0, 1]; **-1 marks an unreachable cell** (no inverse
-            kinematic solution in the selected working mode, or outside a joint limit). Cell (i, j, k) has centre
-            ``(grid.axis(0)[i], grid.axis(1)[j], grid.axis(2)[k])`` in task-space units (``Mechanism.task_axes``).
-        grid: only with ``keep_grid=True``: the :class:`Grid` (``lo``, ``step``, ``shape``, ``cell_measure``).
-        seconds: kernel wall time of the metrics (without JIT compilation and without the ``lci_grid`` pass).
-    """
+    """Metrics of one design. ``measure_key`` is e.g. 'volume_m3'; band k covers (edges[k], edges[k+1]]."""
 
     mechanism: str
     design: dict[str, float]
