@@ -61,7 +61,7 @@ def _pauu(mech, design, options):
     base = [np.array([[m, m, 0], [-m, m, 0], [-m, -m, 0], [m, -m, 0]], dtype=float)]
     links = []
     for i in (1, 2):
-        links += [(pts[f"A{i}"], pts[f"B{i}"], f"c (A{i}B{i})" if i == 1 else ""),
+        links += [(pts[f"A{i}"], pts[f"B{i}"], f"e (A{i}B{i})" if i == 1 else ""),
                   (pts[f"B{i}"], pts[f"C{i}"], f"l1, theta{i}"), (pts[f"C{i}"], pts[f"D{i}"], "l2")]
     # chain 3 (PPaP): input d = y moves the platform along y; drawn from the base centre
     foot = np.array([0.0, d, 0.0])

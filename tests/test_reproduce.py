@@ -10,7 +10,8 @@ import sys
 import pytest
 
 from scalesynth.config import config_from_dict
-from scalesynth.optimize import _versions, run, version_differences
+from scalesynth.optimize import run
+from scalesynth.versions import installed_versions, version_differences
 
 from conftest import SMALL
 
@@ -27,7 +28,7 @@ def _reproduce(run_dir, out):
 
 
 def test_version_differences():
-    now = _versions()
+    now = installed_versions()
     assert version_differences(now) == []
     assert version_differences(dict(now, numpy="0.0.1")) == [f"numpy 0.0.1 -> {now['numpy']}"]
     assert version_differences(dict(now, nosuchpkg="1.0")) == ["nosuchpkg 1.0 -> not installed"]

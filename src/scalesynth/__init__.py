@@ -17,7 +17,7 @@ import functools
 import importlib
 import sys
 import types
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 __version__ = "0.1.0"
 
@@ -56,15 +56,6 @@ __all__ = [  # the same names as _EXPORTS (tests/test_api.py checks)
     "ScalesynthError",
     "ConfigError",
 ]
-
-if TYPE_CHECKING:  # for type checkers and IDEs; at run time the names come from __getattr__
-    from scalesynth.api import evaluate, evaluate_config, get_mechanism, load_config, load_result, mechanisms, optimize
-    from scalesynth.config import RunConfig
-    from scalesynth.errors import ConfigError, ScalesynthError
-    from scalesynth.evaluate import Grid, WorkspaceReport
-    from scalesynth.mechanisms.base import Mechanism
-    from scalesynth.optimize import RunResult
-
 
 def __getattr__(name: str) -> Any:
     module = _EXPORTS.get(name)

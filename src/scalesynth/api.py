@@ -77,6 +77,16 @@ def evaluate(
     Returns:
         A :class:`WorkspaceReport`; ``report.metrics`` holds the measure (volume or area), ``gci``, ``fci``,
         ``min_lci``, ``max_lci``, ``voxels`` and the band shares and measures. An empty workspace gives 0, never NaN.
+
+        With ``keep_grid=True`` it also carries the per-voxel arrays:
+
+        - ``report.lci_grid``: float64 array of shape ``report.grid.shape`` = (nx, ny, nz), nz = 1 for planar
+          mechanisms: the LCI in [0, 1] at each cell centre; **-1 marks an unreachable cell** (no inverse solution
+          in the selected working mode, or a joint or box limit violated); a reachable singular cell has LCI 0.
+        - ``report.grid``: the :class:`Grid`; cell (i, j, k) has its centre at
+          ``(grid.axis(0)[i], grid.axis(1)[j], grid.axis(2)[k])`` in the units of ``Mechanism.task_axes``, and
+          ``grid.cell_measure`` is the measure of one cell, so ``(lci_grid >= 0).sum() * grid.cell_measure`` is the
+          workspace measure and the mean of the reachable cells is the GCI.
     """
     mech = _get(mechanism) if isinstance(mechanism, str) else mechanism
     return _evaluate(

@@ -156,17 +156,6 @@ def _versions() -> dict[str, str]:
     return out
 
 
-def version_differences(recorded: dict[str, str] | None) -> list[str]:
-    """'name recorded -> installed' for every package (and Python) whose version in a manifest's ``versions``
-    differs from this environment's. Byte-identical results are only expected when this list is empty (and the
-    machine type is the same)."""
-    if not recorded:
-        return ["the manifest records no versions"]
-    now = _versions()
-    return [f"{name} {was} -> {now.get(name, 'not installed')}" for name, was in recorded.items()
-            if now.get(name, "not installed") != was]
-
-
 def _pareto_frame(problem: SynthesisProblem, algorithm) -> tuple[pd.DataFrame, pd.DataFrame, int]:
     """(pareto, population, number of objective-space duplicates dropped from the front)."""
     from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
@@ -326,12 +315,10 @@ def _numba_threads() -> int:
 
 
 def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
-    """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes.
-    ``version_differences`` in the answer lists the dependency versions that differ from the recorded ones."""
+    """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes."""
     from scalesynth.config import config_from_dict
 
     original = results.load(run_dir)
-    differences = version_differences(original.manifest.get("versions"))
     cfg = config_from_dict(original.manifest["config"])
     result = run(cfg, out_dir, plots=False)
     same = (Path(run_dir) / results.PARETO).read_bytes() == (Path(out_dir) / results.PARETO).read_bytes()
@@ -342,5 +329,4 @@ def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
         "wall_seconds": result.manifest["wall_seconds"],
         "hypervolume": result.manifest["hypervolume"],
         "original_hypervolume": original.manifest["hypervolume"],
-        "version_differences": differences,
     }

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import SetOpt, _warn, app, handles_errors
+from scalesynth.cliapp import SetOpt, app, handles_errors
 
 
 @app.command("optimize")
@@ -110,13 +110,13 @@ def reproduce_cmd(
     """Re-run a finished run from its manifest (config and seed) and check pareto.csv is byte-identical."""
     import tempfile
 
-    from scalesynth import results
-    from scalesynth.optimize import reproduce, version_differences
+    from scalesynth.optimize import reproduce
+    from scalesynth.versions import recorded_versions, version_differences
 
-    differences = version_differences(results.load(run_dir).manifest.get("versions"))
+    differences = version_differences(recorded_versions(run_dir))
     if differences:  # said before the re-run, which may take long
-        _warn(f"dependency versions differ from the recorded run ({'; '.join(differences)}): byte-identical results "
-              "are expected only with the same versions and machine type")
+        typer.echo(f"warning: dependency versions differ from the recorded run ({'; '.join(differences)}): "
+                   "byte-identical results are expected only with the same versions and machine type", err=True)
     with tempfile.TemporaryDirectory() as tmp:
         info = reproduce(run_dir, out if out is not None else Path(tmp) / "rerun")
     verdict = "identical" if info["identical"] else "DIFFERENT"

@@ -1,0 +1,44 @@
+"""Dependency versions: compare those recorded in a run's manifest with the installed ones.
+
+Byte-identical results are promised only for the same machine type and the same versions of scalesynth's
+dependencies, so ``scalesynth reproduce`` warns first when they differ. The recorded set is written by
+``optimize._versions`` into ``manifest.json["versions"]``.
+"""
+
+from __future__ import annotations
+
+
+def installed_versions() -> dict[str, str]:
+    """{package: version} of scalesynth, Python and every dependency that a manifest records."""
+    from scalesynth.optimize import _versions
+
+    return _versions()
+
+
+def version_differences(recorded: dict[str, str] | None) -> list[str]:
+    """'name recorded -> installed' for every package (and Python) of a manifest's ``versions`` whose installed
+    version differs ('not installed' when it is missing); ``[]`` when all agree."""
+    if not recorded:
+        return ["the manifest records no versions"]
+    now = installed_versions()
+    return [f"{name} {was} -> {now.get(name, 'not installed')}" for name, was in recorded.items()
+            if now.get(name, "not installed") != was]
+
+
+def recorded_versions(run_dir) -> dict[str, str] | None:
+    """``versions`` of a finished run's manifest.json (None when the manifest has none); a directory without a
+    readable manifest raises ConfigError, as for every command that reads a results directory."""
+    import json
+    from pathlib import Path
+
+    from scalesynth.errors import ConfigError
+
+    path = Path(run_dir) / "manifest.json"
+    try:
+        manifest = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"{run_dir}: not a finished scalesynth run (no manifest.json)") from None
+    except (OSError, json.JSONDecodeError) as err:
+        raise ConfigError(f"{path}: unreadable manifest ({err})") from None
+    versions = manifest.get("versions") if isinstance(manifest, dict) else None
+    return versions if isinstance(versions, dict) else None

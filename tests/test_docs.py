@@ -1,0 +1,150 @@
+"""The documentation in docs/: a page with a figure for every mechanism naming every parameter and option, a config
+reference naming every key, links that resolve, the figure script, and the API example script, which runs."""
+
+import json
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from scalesynth.config import RunConfig
+from scalesynth.mechanisms import available, get
+
+from conftest import EXACT_VOLUME, ROOT
+
+DOCS = ROOT / "docs"
+# owned by the metric catalogue (issue 10), generated there; linked from here before it lands
+NOT_YET = {DOCS / "metrics.md"}
+
+
+@pytest.mark.parametrize("name", available())
+def test_every_mechanism_has_a_page_with_its_figure_parameters_and_options(name):
+    page = (DOCS / "mechanisms" / f"{name}.md").read_text()
+    assert f"](../figures/{name}.png)" in page
+    assert (DOCS / "figures" / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    mech = get(name)
+    missing = [p.name for p in (*mech.parameters, *mech.options) if f"`{p.name}`" not in page]
+    assert missing == []
+    assert f"seed paper {mech.seed}" in page.lower() or f"seed {mech.seed}" in page.lower()
+    assert f"[{name}.md](mechanisms/{name}.md)" in (DOCS / "README.md").read_text()
+
+
+def _keys(model, prefix=""):
+    """Leaf keys of a pydantic model, dotted; items of a list of models as `name[].field`."""
+    out = []
+    for field, info in model.model_fields.items():
+        path = f"{prefix}{field}"
+        sub = info.annotation
+        origin = getattr(sub, "__origin__", None)
+        args = getattr(sub, "__args__", (sub,))
+        models = [a for a in args if isinstance(a, type) and hasattr(a, "model_fields")]
+        if origin is list and models:
+            out += _keys(models[0], path + "[].")
+        elif models:
+            out += _keys(models[0], path + ".")
+        else:
+            out.append(path)
+    return out
+
+
+def test_config_reference_names_every_key():
+    text = (DOCS / "config.md").read_text()
+    keys = _keys(RunConfig)
+    assert {"grid.resolution", "task.path_samples", "algorithm.prob_mutation", "objectives[].sense"} <= set(keys)
+    assert [k for k in keys if f"`{k}`" not in text] == []
+
+
+def test_relative_links_resolve():
+    broken = []
+    for page in [ROOT / "README.md", *DOCS.rglob("*.md")]:
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text()):
+            if "://" in target:
+                continue
+            path = (page.parent / target).resolve()
+            if not path.exists() and path not in NOT_YET:
+                broken.append(f"{page.relative_to(ROOT)} -> {target}")
+    assert broken == []
+
+
+def _draw_module():
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        import draw_mechanisms
+    finally:
+        sys.path.pop(0)
+    return draw_mechanisms
+
+
+def _expected_lengths(name, mech, design, options):
+    """{link label: length} that the drawing must show: design lengths and the inverse kinematics' joint values."""
+    if name == "2pauu-ppap":
+        return {"l1, theta1": design["l1"], "l1, theta2": design["l1"], "l2": design["l2"], "e (A1B1)": 2 * design["c"]}
+    if name == "planar-fivebar":
+        return {"l1, alpha1": design["l1"], "l1, alpha2": design["l1"], "l2": design["l2"]}
+    if name == "pprs-rprs":
+        q = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, 200.0))
+             if s.label == mech.kernel_branch(options)][0]
+        return {"L1": design["L1"], "L2": design["L2"], "L3": design["L3"], "s1": q[3], "s2": q[4], "s3, beta": q[5]}
+    if name.startswith("rps-upu"):
+        pose = (79.37, 0.307, 0.113)
+        q = mech.inverse_kinematics(design, options, pose if name == "rps-upu" else
+                                    mech.tool_point(design, options, pose))[0].values
+        out = {"q1": q[0], "q2": q[1], "q3": q[2]}
+        if name == "rps-upu-tool":
+            out[f"tool offset d = {options['tool_offset']:g}"] = options["tool_offset"]
+        return out
+    if name == "ups-sspr":
+        (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.2, 0.15, 10.0))]
+        return {"c (SR link A0B1)": design["c"], "l1 (SPR)": q[0], "l2": q[1], "l3": q[2]}
+    raise AssertionError(f"no expected lengths for {name}")
+
+
+@pytest.mark.parametrize("name", available())
+def test_drawing_is_the_kinematics_not_a_sketch(name):
+    """Every labelled link of the figure has the length of its design parameter or of its joint value from the
+    inverse kinematics at the drawn pose (a link labelled twice, e.g. both l2 links, is checked each time)."""
+    dm = _draw_module()
+    mech = get(name)
+    design = mech.resolve_design({"m": 0.857, "n": 0.706, "l1": 1.499, "l2": 1.5, "c": 0.1}
+                                 if name == "2pauu-ppap" else {})
+    options = mech.resolve_options({})
+    lk = dm.LINKAGES[name](mech, design, options)
+    expected = _expected_lengths(name, mech, design, options)
+    labelled = [(label, float(np.linalg.norm(end - start))) for start, end, label in lk.links if label in expected]
+    assert {label for label, _ in labelled} == set(expected)
+    for label, length in labelled:
+        assert length == pytest.approx(expected[label], rel=1e-9), label
+
+
+def test_figure_script_draws_every_mechanism(tmp_path):
+    assert set(_draw_module().LINKAGES) == set(available())
+    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "draw_mechanisms.py"), str(tmp_path)],
+                       capture_output=True, text=True, timeout=600, env={**_env(), "MPLBACKEND": "Agg"})
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == sorted(f"{n}.png" for n in available())
+
+
+def _env():
+    import os
+
+    return {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+
+
+def test_api_example_script_runs(tmp_path):
+    script = ROOT / "examples" / "api_tour.py"
+    assert "examples/api_tour.py" in (DOCS / "api.md").read_text()
+    code = (f"import json, runpy, sys; sys.argv = ['x', {str(tmp_path)!r}]; "
+            f"m = runpy.run_path({str(script)!r}); print(json.dumps(m['main'](sys.argv)))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=900,
+                       env={**_env(), "MPLBACKEND": "Agg"})
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout.splitlines()[-1])
+    ev = summary["evaluate"]
+    assert ev["volume_m3"] == pytest.approx(EXACT_VOLUME[1], rel=0.01)  # 32^3 cells vs the exact volume
+    assert ev["mean_lci_of_voxels"] == pytest.approx(ev["gci"], rel=1e-9)
+    assert summary["optimize"]["status"] == "finished"
+    res = summary["results"]
+    assert res["designs_on_front"] >= 2 and res["hypervolume"] > 0 and "m_minus_n" in res["columns"]
+    assert (tmp_path / "workspace_lci.png").stat().st_size > 0 and (tmp_path / "quick" / "manifest.json").exists()
