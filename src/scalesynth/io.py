@@ -47,6 +47,7 @@ def write_atomic(path: Path, writer: Callable[[Any], None], mode: str = "w") -> 
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.fchmod(fd, 0o666 & ~current_umask())  # mkstemp makes 0600; results are shared like any other file
         text_args = {} if "b" in mode else {"encoding": "utf-8", "newline": ""}
         with os.fdopen(fd, mode, **text_args) as fh:
             writer(fh)
@@ -59,6 +60,20 @@ def write_atomic(path: Path, writer: Callable[[Any], None], mode: str = "w") -> 
     finally:
         if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def current_umask() -> int:
+    """The process umask (read without changing it where /proc allows; else set and restored at once)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 # write_atomic's temp names: '.' + target name + '.' + mkstemp's 8 random characters + '.tmp'
@@ -95,6 +110,34 @@ def write_pickle(path: Path, obj: Any) -> None:
 def read_pickle(path: Path) -> Any:
     with open(path, "rb") as fh:
         return pickle.load(fh)
+
+
+CHECKPOINT_KEYS = ("algorithm", "history", "elapsed", "digest", "started")
+
+
+def read_checkpoint(path: Path) -> dict[str, Any]:
+    """A checkpoint written by ``optimize.run``; ConfigError (one line) if it is empty, truncated or foreign.
+
+    Checkpoints are pickles: resume only checkpoints you wrote yourself (unpickling runs code)."""
+    from scalesynth.errors import ConfigError
+
+    hint = "start without --resume to discard it"
+    try:
+        with open(path, "rb") as fh:
+            state = pickle.load(fh)
+    except OSError as err:
+        raise RunError(f"{path}: cannot read ({err.strerror or err})") from None
+    except EOFError:
+        raise ConfigError(f"{path}: empty or truncated checkpoint ({hint})") from None
+    except Exception as err:  # UnpicklingError, AttributeError/ImportError of a foreign class, ...
+        raise ConfigError(f"{path}: not a scalesynth checkpoint ({err.__class__.__name__}; {hint})") from None
+    if not isinstance(state, dict) or any(k not in state for k in CHECKPOINT_KEYS):
+        raise ConfigError(f"{path}: not a scalesynth checkpoint (unexpected content; {hint})")
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+
+    if not isinstance(state["algorithm"], NSGA2) or not isinstance(state["history"], list):
+        raise ConfigError(f"{path}: not a scalesynth checkpoint (no NSGA-II state; {hint})")
+    return state
 
 
 def write_csv(path: Path, frame) -> None:

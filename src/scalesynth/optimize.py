@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from scalesynth import __version__
+from scalesynth import __version__, rundir
 from scalesynth import io as rio
 from scalesynth.config import RunConfig, dump_config
 from scalesynth.errors import ConfigError, RunError
@@ -178,37 +178,50 @@ def run(
     """
     if seed is not None:
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
-    out = Path(out_dir) if out_dir is not None else cfg.output_dir()
-    rio.ensure_dir(out)
-    rio.remove_stale_temps(out)  # a run killed mid-write leaves its temp file behind
-    ckpt_path = out / rio.CHECKPOINT
-    problem = SynthesisProblem(cfg)
+    target = Path(out_dir) if out_dir is not None else cfg.output_dir()
+    problem = SynthesisProblem(cfg)  # validates everything (bounds, objectives) before anything is written
     ref = problem.hv_reference()
     digest = config_digest(cfg)
     history: list[dict[str, Any]] = []
     elapsed_before = 0.0
     started = datetime.now(UTC).isoformat(timespec="seconds")
+    fresh_algorithm = make_algorithm(cfg, problem)
+    fresh_algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
     algorithm = None
-    if resume and ckpt_path.exists():
-        state = rio.read_pickle(ckpt_path)
-        if state.get("digest") != digest:
-            raise ConfigError(
-                f"{out}: cannot resume: the config differs from the checkpoint's (start without --resume)"
-            )
-        algorithm = state["algorithm"]
-        algorithm.problem = problem
-        algorithm.evaluator.evaluate_values_of = ["F", "G", "M"]
-        history = state["history"]
-        elapsed_before = state["elapsed"]
-        started = state["started"]
-    elif resume and _finished(out, digest):
-        return load_result(out)
-    if algorithm is None:
-        # a fresh run: an old checkpoint in this directory belongs to another run
-        if ckpt_path.exists():
-            ckpt_path.unlink()
-        algorithm = make_algorithm(cfg, problem)
-        algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
+    # ---- run directory (scalesynth.rundir, issue 11): lock the target, write into its staging directory -------
+    with rundir.claim(target) as claimed:
+        out = claimed.continued() if resume else None
+        ckpt_path = claimed.work / rio.CHECKPOINT
+        if out is not None and ckpt_path.exists():
+            state = rio.read_checkpoint(ckpt_path)
+            if state.get("digest") != digest:
+                raise ConfigError(
+                    f"{target}: cannot resume: the config differs from the checkpoint's (start without --resume)"
+                )
+            algorithm = state["algorithm"]
+            algorithm.problem = problem
+            algorithm.evaluator.evaluate_values_of = ["F", "G", "M"]
+            history = state["history"]
+            elapsed_before = state["elapsed"]
+            started = state["started"]
+        elif out is not None and _finished(out, digest):  # killed after its last write, before the swap
+            claimed.commit()
+            return load_result(target)
+        elif resume and _finished(target, digest):
+            return load_result(target)
+        if algorithm is None:
+            out = claimed.fresh()  # a fresh run: an abandoned staging directory belongs to another run
+            algorithm = fresh_algorithm
+        result = _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, history, elapsed_before,
+                                  started, progress, plots, stop_after)
+        claimed.commit()
+    # ---- end of the run-directory block ------------------------------------------------------------------------
+    return RunResult(out_dir=target, pareto=result.pareto, history=result.history, manifest=result.manifest)
+
+
+def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, history, elapsed_before, started,
+                     progress, plots, stop_after) -> RunResult:
+    """The NSGA-II loop from ``algorithm``'s state; writes checkpoints and the results into ``out``."""
     # compile the kernels before the clock starts on the first generation
     problem.metrics(np.atleast_2d((problem.xl + problem.xu) / 2))
     t0 = time.perf_counter()
@@ -312,6 +325,9 @@ def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
     """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes."""
     from scalesynth.config import config_from_dict
 
+    run_real, out_real = Path(run_dir).resolve(), Path(out_dir).resolve()
+    if out_real == run_real or run_real in out_real.parents:
+        raise ConfigError(f"--out: {out_dir} is the run being checked (or inside it); re-run somewhere else")
     original = load_result(run_dir)
     cfg = config_from_dict(original.manifest["config"])
     result = run(cfg, out_dir, plots=False)
