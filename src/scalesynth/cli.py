@@ -131,6 +131,9 @@ def evaluate_cmd(
     if resolution is not None:
         overrides.append(f"grid.resolution={resolution}")
     cfg = load_config(config, overrides)
+    from scalesynth import memory
+
+    memory.check(memory.evaluate_estimates(cfg))
     mech = cfg.mech
     design = cfg.resolved_design()
     for key, (lo, hi) in cfg.bounds.items():

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from scalesynth import __version__, rundir
+from scalesynth import __version__, memory, rundir
 from scalesynth import io as rio
 from scalesynth.config import RunConfig, dump_config
 from scalesynth.errors import ConfigError, RunError
@@ -180,6 +180,7 @@ def run(
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
     target = Path(out_dir) if out_dir is not None else cfg.output_dir()
     problem = SynthesisProblem(cfg)  # validates everything (bounds, objectives) before anything is written
+    memory.check(memory.run_estimates(cfg, plots))  # refuse what cannot fit before allocating (issue 11)
     ref = problem.hv_reference()
     digest = config_digest(cfg)
     history: list[dict[str, Any]] = []

@@ -57,6 +57,9 @@ def task_map(cfg, resolution: int | None = None) -> TaskMap:
     res = resolution or cfg.task.resolution or cfg.grid.resolution
     if res < 2:
         raise ConfigError(f"--resolution: need at least 2 cells per axis, got {res}")
+    from scalesynth import memory
+
+    memory.check(memory.task_map_estimate(res, "--resolution" if resolution else "task.resolution"))
     lo, step = np.zeros(3), np.ones(3)
     for a, name in enumerate(mech.task_axes):  # config validation guarantees both axes are in the box
         lo[a], hi = cfg.task.box[name]
