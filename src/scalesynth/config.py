@@ -51,7 +51,18 @@ class GridConfig(_Strict):
         for axis, (lo, hi) in v.items():
             if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+            _magnitude(axis, lo, hi)
         return v
+
+
+def _magnitude(key: str, *values: float) -> None:
+    """ValueError naming ``key`` for a value beyond MAX_MAGNITUDE (mechanisms.base: where arithmetic overflows)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
+    for v in values:
+        if abs(v) > MAX_MAGNITUDE:
+            raise ValueError(f"{key}: {v:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth "
+                             "computes with (products of such values overflow)")
 
 
 class DexterityConfig(_Strict):
@@ -83,6 +94,7 @@ class TaskConfig(_Strict):
         for axis, (lo, hi) in v.items():
             if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+            _magnitude(axis, lo, hi)
         return v
 
     @field_validator("path")
@@ -97,6 +109,8 @@ class TaskConfig(_Strict):
             raise ValueError("every point needs the same 2 or 3 coordinates")
         if not all(math.isfinite(c) for p in v for c in p):
             raise ValueError("coordinates must be finite")
+        for i, p in enumerate(v):
+            _magnitude(str(i), *p)
         return v
 
 
@@ -114,6 +128,10 @@ class ConstraintConfig(_Strict):
 
     @model_validator(mode="after")
     def _one_side(self):
+        for side in ("min", "max"):
+            value = getattr(self, side)
+            if value is not None and not math.isfinite(value):
+                raise ValueError(f"{side}: must be finite, got {value}")
         if self.min is None and self.max is None:
             raise ValueError("give min, max or both")
         if self.min is not None and self.max is not None and not self.min <= self.max:
@@ -178,6 +196,7 @@ class RunConfig(_Strict):
                 raise ValueError(f"{key}: bounds must be finite, got [{lo}, {hi}]")
             if not lo < hi:
                 raise ValueError(f"{key}: lower bound {lo} must be below upper bound {hi}")
+            _magnitude(key, lo, hi)
         return v
 
     @model_validator(mode="after")

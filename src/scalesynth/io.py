@@ -141,7 +141,13 @@ def read_checkpoint(path: Path) -> dict[str, Any]:
 
 
 def write_csv(path: Path, frame) -> None:
-    """CSV with a fixed float format so equal numbers always give equal bytes."""
+    """CSV with a fixed float format so equal numbers always give equal bytes; every number must be finite."""
+    import numpy as np
+
+    numeric = frame.select_dtypes(include="number")
+    bad = [c for c in numeric.columns if not np.isfinite(numeric[c].to_numpy(dtype=float)).all()]
+    if bad:
+        raise RunError(f"{path}: column {bad[0]} has a non-finite value (not written); please report it")
     write_text(path, frame.to_csv(index=False, float_format="%.12g", lineterminator="\n"))
 
 
