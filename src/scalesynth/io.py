@@ -153,3 +153,49 @@ def write_csv(path: Path, frame) -> None:
 
 def save_figure(fig, path: Path, dpi: int = 130) -> None:
     write_atomic(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi, bbox_inches="tight"), mode="wb")
+
+
+# ----- reading a results directory that may have been damaged: one-line ConfigError, never a traceback ----------
+
+def read_results_csv(path: Path, required: tuple[str, ...] | list[str] = ()):
+    """A results CSV as a DataFrame; ConfigError naming the file if it is empty, not CSV, lacks a ``required``
+    column or has a non-numeric or non-finite value in one."""
+    import numpy as np
+    import pandas as pd
+
+    from scalesynth.errors import ConfigError
+
+    try:
+        frame = pd.read_csv(path)
+    except OSError as err:
+        raise RunError(f"{path}: cannot read ({err.strerror or err})") from None
+    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
+        raise ConfigError(f"{path}: not a scalesynth results table ({err.__class__.__name__})") from None
+    for col in required:
+        if col not in frame.columns:
+            raise ConfigError(f"{path}: column {col!r} is missing (damaged or not written by this version)")
+        values = pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float)
+        if not np.isfinite(values).all():
+            row = int(np.nonzero(~np.isfinite(values))[0][0])
+            raise ConfigError(f"{path}: column {col!r}, row {row + 1}: not a finite number")
+        frame[col] = values
+    return frame
+
+
+def read_manifest(path: Path) -> dict[str, Any]:
+    """manifest.json as a dict with its resolved config; ConfigError naming the file if damaged."""
+    from scalesynth.errors import ConfigError
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as err:
+        raise RunError(f"{path}: cannot read ({err.strerror or err})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: not valid JSON ({err.__class__.__name__})") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: expected a JSON object, got {type(data).__name__}")
+    for key, kind in (("config", dict), ("status", str), ("hypervolume", (int, float)), ("wall_seconds", (int, float))):
+        if not isinstance(data.get(key), kind):
+            raise ConfigError(f"{path}: field {key!r} is missing or of the wrong type")
+    return data
+

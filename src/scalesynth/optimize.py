@@ -313,11 +313,14 @@ def load_result(out: Path) -> RunResult:
     manifest_path = out / "manifest.json"
     if not manifest_path.exists():
         raise ConfigError(f"{out}: not a finished scalesynth run (no manifest.json)")
-    manifest = json.loads(manifest_path.read_text())
+    manifest = rio.read_manifest(manifest_path)
+    for name in ("pareto.csv", "history.csv"):
+        if not (out / name).is_file():
+            raise ConfigError(f"{out}: not a finished scalesynth run (no {name})")
     return RunResult(
         out_dir=out,
-        pareto=pd.read_csv(out / "pareto.csv"),
-        history=pd.read_csv(out / "history.csv"),
+        pareto=rio.read_results_csv(out / "pareto.csv"),
+        history=rio.read_results_csv(out / "history.csv", ("generation", "hypervolume")),
         manifest=manifest,
     )
 
@@ -330,7 +333,10 @@ def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
     if out_real == run_real or run_real in out_real.parents:
         raise ConfigError(f"--out: {out_dir} is the run being checked (or inside it); re-run somewhere else")
     original = load_result(run_dir)
-    cfg = config_from_dict(original.manifest["config"])
+    try:
+        cfg = config_from_dict(original.manifest["config"])
+    except ConfigError as err:
+        raise ConfigError(f"{Path(run_dir) / 'manifest.json'}: config: {err}") from None
     result = run(cfg, out_dir, plots=False)
     same = (Path(run_dir) / "pareto.csv").read_bytes() == (Path(out_dir) / "pareto.csv").read_bytes()
     return {

@@ -24,10 +24,17 @@ def load_run(run_dir: Path) -> tuple[RunConfig, pd.DataFrame, pd.DataFrame, pd.D
         if not (run_dir / name).is_file():
             raise ConfigError(f"{run_dir}: not a scalesynth results directory (missing {name})")
     cfg = load_config(run_dir / "config.yaml")
-    pareto = pd.read_csv(run_dir / "pareto.csv")
-    history = pd.read_csv(run_dir / "history.csv")
+    # damaged files give one line naming the file and column (issue 11), never a pandas traceback
+    problem = SynthesisProblem(cfg)
+    nb = len(cfg.dexterity.band_edges) - 1
+    needed = [*problem.var_names, *problem.objective_keys, cfg.mech.measure_key(cfg.units.length),
+              *(f"band{b}_share" for b in range(nb))]
+    pareto = rio.read_results_csv(run_dir / "pareto.csv", list(dict.fromkeys(needed)))
+    history = rio.read_results_csv(run_dir / "history.csv", ("generation", "evaluations", "hypervolume"))
+    if not len(history):
+        raise ConfigError(f"{run_dir / 'history.csv'}: no generations")
     pop_path = run_dir / "population.csv"
-    population = pd.read_csv(pop_path) if pop_path.is_file() else None
+    population = rio.read_results_csv(pop_path, problem.objective_keys) if pop_path.is_file() else None
     return cfg, pareto, history, population
 
 

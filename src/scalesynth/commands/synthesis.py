@@ -15,7 +15,9 @@ from scalesynth.cli import SetOpt, app, handles_errors
 def optimize_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML)")],
     out: Annotated[Path | None, typer.Option("--out", help="results directory (default results/<name>)")] = None,
-    seed: Annotated[int | None, typer.Option("--seed", min=0, help="random seed (overrides algorithm.seed)")] = None,
+    seed: Annotated[
+        int | None, typer.Option("--seed", min=0, max=2**32 - 1, help="random seed (overrides algorithm.seed)")
+    ] = None,
     resume: Annotated[bool, typer.Option("--resume", help="continue from the directory's checkpoint")] = False,
     sets: SetOpt = None,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="skip plots and report.md")] = False,
