@@ -195,6 +195,11 @@ def test_bad_input_writes_nothing_and_keeps_an_unfinished_run(tmp_path):
     with pytest.raises(ConfigError):
         run(config_from_dict({**small(), "bounds": {}}), out, plots=False)
     assert (staging_path(out) / "checkpoint.pkl").read_bytes() == ckpt
+    from scalesynth.memory import MemoryLimitError
+
+    with pytest.raises(MemoryLimitError, match="algorithm.pop_size"):  # the late check of issue 11 item 11
+        run(config_from_dict(small(algorithm={"pop_size": 100_000})), out, plots=False)
+    assert (staging_path(out) / "checkpoint.pkl").read_bytes() == ckpt
 
 
 def test_reproduce_refuses_an_out_inside_the_run(tmp_path):
