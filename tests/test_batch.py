@@ -22,6 +22,7 @@ from scalesynth.cli import app
 from scalesynth.config import config_from_dict
 from scalesynth.errors import RunError
 from scalesynth.optimize import run
+from scalesynth.rundir import staging_path
 
 from conftest import SMALL as SMALL_RUN
 
@@ -84,7 +85,7 @@ def first_batch(tmp_path_factory, cluster):
     (out / "blocked").write_text("a file where the batch wants a directory\n")
     with pytest.raises(RunError):
         run(config_from_dict(copy.deepcopy(ALPHA)), out / "alpha" / "seed4", seed=4, plots=False, stop_after=2)
-    assert (out / "alpha" / "seed4" / "checkpoint.pkl").exists()
+    assert (staging_path(out / "alpha" / "seed4") / "checkpoint.pkl").exists()
     args = ["batch", *map(str, paths), "--seeds", "2", "--out", str(out), "--scheduler", cluster]
     result = CliRunner().invoke(app, args)
     return {"out": out, "args": args, "result": result, "summary": json.loads((out / "batch.json").read_text())}
@@ -130,6 +131,7 @@ def test_batch_results_equal_sequential_runs_byte_for_byte(first_batch, sequenti
         h_ref = pd.read_csv(ref_dir / "history.csv")
         pd.testing.assert_frame_equal(h_batch.drop(columns="seconds"), h_ref.drop(columns="seconds"))
         assert not (out / name / f"seed{seed}" / "checkpoint.pkl").exists()
+        assert not staging_path(out / name / f"seed{seed}").exists()
         assert not list((out / name / f"seed{seed}").glob(".*.tmp"))
 
 

@@ -33,10 +33,11 @@ OPTION_CASES = [
 ]
 
 
+@pytest.mark.parametrize("resolution", [23, 24])  # odd: a node on every symmetry plane; even: none
 @pytest.mark.parametrize("options", OPTION_CASES)
 @pytest.mark.parametrize("group", [1, 4])
-def test_kernel_matches_numpy_twin(group, options):
-    g, lci_twin, ref = _twin(TABLE4[group], options, 24)
+def test_kernel_matches_numpy_twin(group, options, resolution):
+    g, lci_twin, ref = _twin(TABLE4[group], options, resolution)
     design = M.resolve_design(TABLE4[group])
     opts = M.resolve_options(options)
     lci = kgrid.sample_grid(M.point_kernel, M.pack(design, opts), g.lo, g.step, g.shape)
@@ -51,13 +52,16 @@ def test_kernel_matches_numpy_twin(group, options):
     assert reach.sum() > 100
     np.testing.assert_allclose(fields[reach][:, 1:], twin[reach][:, 1:], rtol=1e-7)
     assert (fields[~reach][:, 1:] == 0).all()
-    rep = evaluate(M, design, opts, resolution=24, band_edges=EDGES)
+    rep = evaluate(M, design, opts, resolution=resolution, band_edges=EDGES)
     assert rep.metrics["voxels"] == ref["count"]
     assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
     assert rep.gci == pytest.approx(ref["gci"], rel=1e-9)
     assert rep.metrics["fci"] == pytest.approx(ref["fci"], rel=1e-7)
     for b in range(3):
         assert rep.metrics[f"band{b}_share"] == pytest.approx(ref["shares"][b], abs=1e-12)
+    # min and max LCI too (a wrong min/max sentinel or reduction passes every other check)
+    assert rep.metrics["min_lci"] == pytest.approx(ref["min_lci"], rel=1e-7, abs=1e-10)
+    assert rep.metrics["max_lci"] == pytest.approx(ref["max_lci"], rel=1e-7, abs=1e-10)
 
 
 def test_population_call_equals_single_calls():
@@ -76,19 +80,27 @@ def test_deterministic_bitwise():
         assert np.array_equal(a[key], b[key])
 
 
-@pytest.mark.parametrize("resolution", [64, "paper"])
+# Volume error of the cell-centred grid against the exact volumes of spec §1.9, measured on the six Table-4
+# designs (2026-12-01): at most 0.145 % (N = 55), 0.195 % (56), 0.145 % (63), 0.110 % (64), 0.087 % (96),
+# 0.052 % (111), 0.046 % (112), 0.027 % (126), 0.054 % (128); always positive. The tolerances below are about
+# 1.3x (N <= 64) and 2x (N >= 96) those, so a 0.4 % bias of either sign fails the fine-grid check.
+COARSE_VOLUME_TOL = 0.0025  # N in 56..64
+FINE_VOLUME_TOL = 0.0010  # N >= 112
+
+
+@pytest.mark.parametrize("resolution", [64, "paper", 63])  # 63: odd, a node on each symmetry plane
 @pytest.mark.parametrize("group", sorted(TABLE4))
 def test_default_resolution_accuracy(group, resolution, root):
-    """Issue 2: evaluate's default resolution (64) and the paper config's are within 0.5 % of the exact volume
-    (spec §1.9) and within 0.002 GCI of a 2x finer grid."""
+    """Issue 2: evaluate's default resolution (64), the paper config's (56) and an odd one are within 0.25 % of
+    the exact volume (spec §1.9), a 2x finer grid within 0.1 %, and GCI within 0.002 of the finer grid."""
     from scalesynth.config import load_config
 
     if resolution == "paper":
         resolution = load_config(root / "configs" / "paper_2pauu_ppap.yaml").grid.resolution
     coarse = evaluate(M, TABLE4[group], resolution=resolution)
     fine = evaluate(M, TABLE4[group], resolution=2 * resolution)
-    assert abs(coarse.measure / EXACT_VOLUME[group] - 1) < 0.005
-    assert abs(fine.measure / EXACT_VOLUME[group] - 1) < 0.005
+    assert abs(coarse.measure / EXACT_VOLUME[group] - 1) < COARSE_VOLUME_TOL
+    assert abs(fine.measure / EXACT_VOLUME[group] - 1) < FINE_VOLUME_TOL
     assert abs(coarse.gci - fine.gci) < 0.002
     assert fine.gci == pytest.approx(SPEC_GCI[group], abs=1e-3)  # spec grid error about 5e-4
 
@@ -96,13 +108,13 @@ def test_default_resolution_accuracy(group, resolution, root):
 def test_half_space_holds_half_volume():
     """Spec §1.9: z >= e holds exactly V/2."""
     rep = evaluate(M, TABLE4[1], {"z_min": 0.2}, resolution=96)
-    assert rep.measure == pytest.approx(30.591591, rel=0.005)
+    assert rep.measure == pytest.approx(30.591591, rel=0.001)  # measured +0.023 % (2026-12-01)
 
 
 def test_torus_special_case():
     """m = n, l1 = l2 = 1.5: V = 2 pi^2 l1 l2^2 = 66.619830 (spec §1.9)."""
     rep = evaluate(M, dict(m=0.5, n=0.5, l1=1.5, l2=1.5, c=0.1), resolution=96)
-    assert rep.measure == pytest.approx(2 * np.pi**2 * 1.5**3, rel=0.005)
+    assert rep.measure == pytest.approx(2 * np.pi**2 * 1.5**3, rel=0.0015)  # measured +0.055 % (2026-12-01)
 
 
 def test_empty_workspace_is_data_not_nan():
@@ -130,7 +142,7 @@ def test_closed_form_conditioning_matches_svd():
     [{}, {"mode": "+-"}, {"mode": "--", "z_min": 0.3}, {"theta1_limits": [-1.5, 0.2], "theta2_limits": [-1.5, 0.2]},
      {"theta1_limits": [-1.5, 0.2]}, {"stroke_limits": [-0.3, 0.9]}, {"stroke_limits": [-0.5, 0.5]}],
 )
-@pytest.mark.parametrize("resolution", [17, 24])  # odd and even: a middle cell on the mirror planes or not
+@pytest.mark.parametrize("resolution", [17, 24, 56])  # odd, even, and the paper config's production grid
 def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     """The column-interval/symmetry kernel counts exactly the generic kernel's voxels, with the same sums."""
     from scalesynth.mechanisms.pauu_ppap import population_stats_fast
@@ -156,6 +168,9 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     assert np.array_equal(generic[:, bands], fast[:, bands])
     # every field's sums (summed in another order: the fast path weights mirrored cells) and extremes
     np.testing.assert_allclose(fast, generic, rtol=1e-10, atol=1e-12)
+    reachable = generic[:, kgrid.COL_COUNT] > 0
+    assert reachable.any()
+    np.testing.assert_array_equal(fast[reachable, kgrid.COL_MIN] <= fast[reachable, kgrid.COL_MAX], True)
 
 
 def test_exact_volume_quadrature_reproduces_spec():
@@ -174,4 +189,4 @@ def test_grid_volume_converges_to_exact_on_random_designs():
                     l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)) for _ in range(8)]
     vol = evaluate_population(M, designs, resolution=96)["volume_m3"]
     exact = np.array([exact_volume(**d) for d in designs])
-    np.testing.assert_allclose(vol, exact, rtol=0.01)
+    np.testing.assert_allclose(vol, exact, rtol=0.0015)  # measured errors -0.005 % .. +0.073 % (2026-12-01)

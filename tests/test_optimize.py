@@ -15,6 +15,7 @@ import yaml
 from scalesynth.config import config_from_dict, load_config
 from scalesynth.errors import RunError
 from scalesynth.optimize import run
+from scalesynth.rundir import staging_path
 
 from conftest import SMALL
 
@@ -98,7 +99,8 @@ def test_same_seed_gives_identical_bytes(small_run, tmp_path):
 def test_resume_after_interruption_gives_same_front(small_run, tmp_path):
     with pytest.raises(RunError):
         run(small_cfg(), tmp_path, plots=False, stop_after=3)
-    assert (tmp_path / "checkpoint.pkl").exists() and not (tmp_path / "pareto.csv").exists()
+    # the unfinished run lives in the staging directory beside the target (scalesynth.rundir)
+    assert (staging_path(tmp_path) / "checkpoint.pkl").exists() and not (tmp_path / "pareto.csv").exists()
     resumed = run(small_cfg(), tmp_path, resume=True, plots=False)
     assert (tmp_path / "pareto.csv").read_bytes() == (small_run.out_dir / "pareto.csv").read_bytes()
     assert list(resumed.history["generation"]) == list(range(1, 7))
@@ -144,7 +146,7 @@ def test_kill_9_then_resume_gives_same_front(tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.Popen([sys.executable, "-m", "scalesynth", "optimize", str(cfg_path), "--out", str(out),
                              "--no-plots", "-q"], env=env)
-    ckpt = out / "checkpoint.pkl"
+    ckpt = staging_path(out) / "checkpoint.pkl"
     deadline = time.time() + 120
     while not ckpt.exists() and time.time() < deadline and proc.poll() is None:
         time.sleep(0.01)

@@ -30,6 +30,7 @@ from scalesynth.errors import RunError
 from scalesynth.evaluate import evaluate, evaluate_population
 from scalesynth.mechanisms import available, get
 from scalesynth.optimize import run
+from scalesynth.rundir import staging_path
 
 from conftest import SMALL
 
@@ -146,7 +147,7 @@ def test_sigkill_at_random_generations_then_resume(tmp_path):
     cfg_path.write_text(yaml.safe_dump(data))
     ref = run(config_from_dict(data), tmp_path / "ref", plots=False)
     out = tmp_path / "killed"
-    ckpt = out / rio.CHECKPOINT
+    ckpt = staging_path(out) / rio.CHECKPOINT  # an unfinished run lives beside its target
     rng = random.Random(2026)
     env = dict(os.environ, MPLBACKEND="Agg")
     cmd = [sys.executable, "-m", "scalesynth", "optimize", str(cfg_path), "--out", str(out), "--no-plots", "-q"]
@@ -179,16 +180,19 @@ def test_sigkill_at_random_generations_then_resume(tmp_path):
 
 
 def test_temp_files_of_an_interrupted_write_are_removed_by_resume(tmp_path):
-    """A SIGKILL during a write leaves '.<name>.<random>.tmp' next to the file: the resumed run removes it."""
+    """A SIGKILL during a write leaves '.<name>.<random>.tmp' next to the file (in the staging directory, and in
+    the target from older versions): the resumed run removes them; a user's file in the target is kept."""
     cfg = config_from_dict(small())
     with pytest.raises(RunError):
         run(cfg, tmp_path, plots=False, stop_after=3)
-    for name in (".checkpoint.pkl.x1y2z3_4.tmp", ".pareto.csv.abc123de.tmp"):
-        (tmp_path / name).write_bytes(b"half a fi")
-    (tmp_path / "plots").mkdir()
-    (tmp_path / "plots" / ".front.png.q9w8e7r6.tmp").write_bytes(b"\x89PN")
+    for where in (tmp_path, staging_path(tmp_path)):
+        for name in (".checkpoint.pkl.x1y2z3_4.tmp", ".pareto.csv.abc123de.tmp"):
+            (where / name).write_bytes(b"half a fi")
+        (where / "plots").mkdir()
+        (where / "plots" / ".front.png.q9w8e7r6.tmp").write_bytes(b"\x89PN")
     (tmp_path / "notes.tmp").write_text("not ours: kept\n")
     run(cfg, tmp_path, resume=True, plots=False)
+    assert (tmp_path / "notes.tmp").read_text() == "not ours: kept\n"
     assert sorted(p.name for p in tmp_path.rglob("*.tmp")) == ["notes.tmp"]
     (tmp_path / "notes.tmp").unlink()
     _assert_results_intact(tmp_path)
@@ -265,14 +269,15 @@ def test_disk_full_is_a_clear_error_and_earlier_results_survive(finished_run, mo
     out, snapshot = finished_run
     cfg_path = out.parent / "cfg.yaml"
     cfg_path.write_text(yaml.safe_dump(small()))
-    _disk_full_inside(monkeypatch, out)
+    _disk_full_inside(monkeypatch, out.parent)  # the file system is full: the staging directory beside it too
     r = CliRunner().invoke(app, ["optimize", str(cfg_path), "--out", str(out), "--seed", "8", "--no-plots", "-q"])
     assert r.exit_code == 1, r.output
     lines = r.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and "No space left on device" in lines[0], lines
-    assert str(out) in lines[0]
+    assert str(staging_path(out) / rio.CHECKPOINT) in lines[0]  # the file that could not be written
     after = {p.name: p.read_bytes() for p in out.iterdir()}
     assert after == snapshot
+    assert not list(out.parent.rglob("*.tmp"))
 
 
 def test_disk_full_while_writing_results_keeps_every_earlier_file(finished_run, monkeypatch):
@@ -282,15 +287,15 @@ def test_disk_full_while_writing_results_keeps_every_earlier_file(finished_run, 
     real_replace = os.replace
 
     def replace(src, dst, *args, **kwargs):
-        if Path(dst).name != rio.CHECKPOINT and Path(dst).parent.resolve() == out.resolve():
+        if Path(dst).name != rio.CHECKPOINT and Path(dst).parent.resolve() == staging_path(out).resolve():
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(dst))
         return real_replace(src, dst, *args, **kwargs)
 
     monkeypatch.setattr(os, "replace", replace)
     with pytest.raises(RunError, match="No space left on device"):
         run(config_from_dict(small()), out, seed=8, plots=False)
-    after = {p.name: p.read_bytes() for p in out.iterdir() if p.name != rio.CHECKPOINT}
-    assert after == snapshot and (out / rio.CHECKPOINT).exists()
+    after = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert after == snapshot and (staging_path(out) / rio.CHECKPOINT).exists()
     monkeypatch.setattr(os, "replace", real_replace)
     resumed = run(config_from_dict(small()), out, seed=8, resume=True, plots=False)
     assert resumed.manifest["seed"] == 8

@@ -251,6 +251,9 @@ def test_kernel_matches_numpy_twin(design, options):
     assert rep.metrics["voxels"] == ref["count"]
     assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
     assert rep.gci == pytest.approx(ref["gci"], rel=1e-9)
+    # min and max LCI too (a wrong min/max sentinel or reduction passes every other check)
+    assert rep.metrics["min_lci"] == pytest.approx(ref["min_lci"], rel=1e-7, abs=1e-10)
+    assert rep.metrics["max_lci"] == pytest.approx(ref["max_lci"], rel=1e-7, abs=1e-10)
 
 
 @pytest.mark.parametrize("options", [P_OPT, PLANE, UPU], ids=["P", "plane", "upu"])

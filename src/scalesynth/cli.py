@@ -5,6 +5,7 @@ Exit codes: 0 ok, 1 run failed, 2 bad input (one line on stderr naming what is w
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -70,6 +71,9 @@ def evaluate_cmd(
     if resolution is not None:
         overrides.append(f"grid.resolution={resolution}")
     cfg = load_config(config, overrides)
+    from scalesynth import memory
+
+    memory.check(memory.evaluate_estimates(cfg))
     mech = cfg.mech
     design = cfg.resolved_design()
     for key, (lo, hi) in cfg.bounds.items():
@@ -160,5 +164,36 @@ def _load_commands() -> None:
 _load_commands()
 
 
-def main() -> None:
-    app()
+def main(argv: list[str] | None = None) -> None:
+    """The console entry point: usage errors (unknown option, bad value, missing argument) become one line on
+    stderr with exit code 2, like every other bad input, instead of click's framed box."""
+    try:  # typer >= 0.22 vendors click
+        from typer._click import exceptions as click_errors
+    except ImportError:  # pragma: no cover - older typer on upstream click
+        from click import exceptions as click_errors
+
+    try:
+        rv = app(args=argv, prog_name="scalesynth", standalone_mode=False)
+    except click_errors.NoArgsIsHelpError as err:
+        typer.echo(err.ctx.get_help() if err.ctx is not None else str(err), err=True)
+        sys.exit(2)
+    except click_errors.UsageError as err:
+        from scalesynth.config import _one_line
+
+        hint = f" (try `{err.ctx.command_path} --help`)" if err.ctx is not None else ""
+        typer.echo(f"error: {_one_line(err.format_message())}{hint}", err=True)
+        sys.exit(2)
+    except typer.Abort:
+        typer.echo("error: interrupted", err=True)
+        sys.exit(1)
+    except Exception as err:  # a bug: still one line, never a traceback (SCALESYNTH_DEBUG=1 shows it)
+        import os
+
+        if os.environ.get("SCALESYNTH_DEBUG"):
+            raise
+        from scalesynth.config import _one_line
+
+        typer.echo(f"error: internal error ({err.__class__.__name__}: {_one_line(str(err))}); please report it",
+                   err=True)
+        sys.exit(1)
+    sys.exit(rv if isinstance(rv, int) else 0)

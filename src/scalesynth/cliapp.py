@@ -63,10 +63,20 @@ def _parse_vector(what: str, text: str, n: int) -> list[float]:
     try:
         values = [float(t) for t in text.split(",")]
     except ValueError:
-        raise InvalidPose(f"{what}: expected {n} comma-separated numbers, got {text!r}") from None
+        raise InvalidPose(f"{what}: expected {n} comma-separated numbers, got {_quote(text)}") from None
     if len(values) != n or any(v != v or v in (float("inf"), float("-inf")) for v in values):
-        raise InvalidPose(f"{what}: expected {n} finite comma-separated numbers, got {text!r}")
+        raise InvalidPose(f"{what}: expected {n} finite comma-separated numbers, got {_quote(text)}")
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
+    if any(abs(v) > MAX_MAGNITUDE for v in values):
+        raise InvalidPose(f"{what}: values beyond +-{MAX_MAGNITUDE:g} (the largest magnitude scalesynth computes "
+                          f"with), got {_quote(text)}")
     return values
+
+
+def _quote(text: str, limit: int = 80) -> str:
+    """repr of a user's text, cut to ``limit`` characters so that an error message stays one short line."""
+    return repr(text if len(text) <= limit else text[:limit] + "...")
 
 
 def _mech_inputs(mech_name: str, sets: list[str] | None):
@@ -84,4 +94,12 @@ def _mech_inputs(mech_name: str, sets: list[str] | None):
 
 
 def _print_json(obj: Any) -> None:
-    sys.stdout.write(json.dumps(obj, indent=None, sort_keys=False) + "\n")
+    """One JSON object on stdout; strict JSON (a non-finite number is a bug: exit 1 instead of printing NaN)."""
+    try:
+        text = json.dumps(obj, indent=None, sort_keys=False, allow_nan=False)
+    except ValueError:
+        from scalesynth.errors import RunError
+
+        raise RunError("internal error: a result is not a finite number (nothing printed); please report it") from None
+    sys.stdout.write(text + "\n")
+

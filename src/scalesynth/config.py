@@ -37,7 +37,18 @@ class GridConfig(_Strict):
         for axis, (lo, hi) in v.items():
             if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+            _magnitude(axis, lo, hi)
         return v
+
+
+def _magnitude(key: str, *values: float) -> None:
+    """ValueError naming ``key`` for a value beyond MAX_MAGNITUDE (mechanisms.base: where arithmetic overflows)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
+    for v in values:
+        if abs(v) > MAX_MAGNITUDE:
+            raise ValueError(f"{key}: {v:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth "
+                             "computes with (products of such values overflow)")
 
 
 class DexterityConfig(_Strict):
@@ -69,6 +80,7 @@ class TaskConfig(_Strict):
         for axis, (lo, hi) in v.items():
             if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+            _magnitude(axis, lo, hi)
         return v
 
     @field_validator("path")
@@ -83,6 +95,8 @@ class TaskConfig(_Strict):
             raise ValueError("every point needs the same 2 or 3 coordinates")
         if not all(math.isfinite(c) for p in v for c in p):
             raise ValueError("coordinates must be finite")
+        for i, p in enumerate(v):
+            _magnitude(str(i), *p)
         return v
 
 
@@ -107,6 +121,10 @@ class ConstraintConfig(_Strict):
 
     @model_validator(mode="after")
     def _one_side(self):
+        for side in ("min", "max"):
+            value = getattr(self, side)
+            if value is not None and not math.isfinite(value):
+                raise ValueError(f"{side}: must be finite, got {value}")
         if self.min is None and self.max is None:
             raise ValueError("give min, max or both")
         if self.min is not None and self.max is not None and not self.min <= self.max:
@@ -155,6 +173,23 @@ class RunConfig(_Strict):
     algorithm: AlgorithmConfig = Field(default_factory=AlgorithmConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
 
+    @field_validator("design", "bounds", "references", mode="before")
+    @classmethod
+    def _no_booleans(cls, v):
+        """YAML true/false would pass as 1.0/0.0: refuse them where numbers are expected."""
+        def walk(node, where):
+            if isinstance(node, bool):
+                raise ValueError(f"{where}: expected a number, got {str(node).lower()}")
+            if isinstance(node, dict):
+                for key, child in node.items():
+                    walk(child, f"{where}.{key}" if where else str(key))
+            elif isinstance(node, (list, tuple)):
+                for child in node:
+                    walk(child, where)
+
+        walk(v, "")
+        return v
+
     @field_validator("design")
     @classmethod
     def _design_finite(cls, v):
@@ -171,6 +206,7 @@ class RunConfig(_Strict):
                 raise ValueError(f"{key}: bounds must be finite, got [{lo}, {hi}]")
             if not lo < hi:
                 raise ValueError(f"{key}: lower bound {lo} must be below upper bound {hi}")
+            _magnitude(key, lo, hi)
         return v
 
     @model_validator(mode="after")
@@ -207,6 +243,13 @@ class RunConfig(_Strict):
                 raise ValueError(f"task.path: points need {len(mech.task_axes)} coordinates for {mech.name}")
         if len(self.objectives) < 1:
             raise ValueError("objectives: need at least one")
+        seen: dict[tuple, int] = {}
+        for i, obj in enumerate(self.objectives):
+            key = (obj.metric, obj.band)
+            if key in seen:
+                raise ValueError(f"objectives[{i}]: duplicate of objectives[{seen[key]}] ({obj.metric}"
+                                 + (f", band {obj.band}" if obj.band is not None else "") + ")")
+            seen[key] = i
         return self
 
     def _check_metrics(self, mech) -> None:
@@ -258,16 +301,111 @@ def _format_validation_error(err: ValidationError) -> str:
     return f"{loc}: {msg}" if loc else msg
 
 
+# ----- YAML: the safe loader, plus what a hostile document must not get through ----------------------------------
+MAX_YAML_NODES = 100_000  # nodes after alias expansion (a config has a few hundred; an alias bomb billions)
+MAX_YAML_BYTES = 1_000_000
+MAX_QUOTED = 200  # characters of a key or value quoted in an error message
+
+# YAML 1.2 floats: PyYAML (YAML 1.1) reads 2e-1 or 1E5 as strings; configs and --set take them as numbers
+_FLOAT = re.compile(
+    r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+    |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+    |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+    |[-+]?\.(?:inf|Inf|INF)
+    |\.(?:nan|NaN|NAN))$""",
+    re.X,
+)
+
+
+class _ConfigLoader(yaml.SafeLoader):
+    """SafeLoader (no object construction) that refuses duplicate keys and reads YAML 1.2 floats."""
+
+
+_ConfigLoader.yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_ConfigLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT, list("-+0123456789."))
+
+
+def _mapping_without_duplicates(loader: yaml.SafeLoader, node: yaml.MappingNode, deep: bool = False):
+    seen = set()
+    for key_node, _ in node.value:
+        if key_node.tag == "tag:yaml.org,2002:merge":
+            continue
+        key = loader.construct_object(key_node, deep=True)
+        try:
+            duplicate = key in seen
+        except TypeError:  # an unhashable key: SafeLoader refuses it below
+            break
+        if duplicate:
+            raise ConfigError(f"line {key_node.start_mark.line + 1}: duplicate key {_quote(key)}")
+        seen.add(key)
+    return loader.construct_mapping(node, deep=deep)
+
+
+_ConfigLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _mapping_without_duplicates)
+
+
+def _expanded_size(node, memo: dict[int, int]) -> int:
+    """Number of nodes once every alias is expanded (memoised on the node graph, so a bomb is counted fast)."""
+    key = id(node)
+    if key in memo:
+        return memo[key]
+    memo[key] = 1  # a recursive alias: SafeLoader refuses it later
+    if isinstance(node, yaml.SequenceNode):
+        size = 1 + sum(_expanded_size(child, memo) for child in node.value)
+    elif isinstance(node, yaml.MappingNode):
+        size = 1 + sum(_expanded_size(k, memo) + _expanded_size(v, memo) for k, v in node.value)
+    else:
+        size = 1
+    memo[key] = size
+    return size
+
+
+def safe_yaml(text: str, what: str) -> Any:
+    """Parse YAML text with the safe loader; ConfigError (one line, naming ``what``) for invalid YAML, duplicate
+    keys, documents that expand beyond MAX_YAML_NODES nodes or nest too deep."""
+    if len(text) > MAX_YAML_BYTES:
+        raise ConfigError(f"{what}: {len(text)} characters, more than the {MAX_YAML_BYTES} a config may have")
+    loader = _ConfigLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        size = _expanded_size(node, {})
+        if size > MAX_YAML_NODES:
+            raise ConfigError(f"{what}: the document expands to {size:.3g} nodes (aliases), more than the "
+                              f"{MAX_YAML_NODES} a config may have")
+        return loader.construct_document(node)
+    except ConfigError as err:
+        raise ConfigError(f"{what}: {err}" if str(err).startswith("line ") else str(err)) from None
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise ConfigError(f"{what}: invalid YAML{where}") from None
+    except RecursionError:
+        raise ConfigError(f"{what}: nested too deeply") from None
+    finally:
+        loader.dispose()
+
+
+def _quote(value: Any) -> str:
+    """repr of a key or value for an error message, cut to MAX_QUOTED characters."""
+    text = repr(value) if not isinstance(value, str) or len(value) <= MAX_QUOTED else repr(value[:MAX_QUOTED])
+    return text if len(text) <= MAX_QUOTED + 2 else text[:MAX_QUOTED] + "..."
+
+
 def _parse_scalar(text: str) -> Any:
     try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError:
-        return text
+        return safe_yaml(text, "--set value")
+    except ConfigError as err:
+        if "invalid YAML" in str(err):
+            return text
+        raise
 
 
 def apply_overrides(data: dict, overrides: list[str] | None, design_keys: set[str] | None = None) -> dict:
-    """Apply ``key=value`` overrides. A bare key naming a design parameter sets ``design.<key>``; a bare key
-    naming an option sets ``options.<key>``; a dotted key sets that path."""
+    """Apply ``key=value`` overrides. A bare key naming a design parameter sets ``design.<key>``, one naming a
+    top-level section sets it (``objectives=[...]``), any other bare key sets ``options.<key>``; a dotted key sets
+    that path."""
     for item in overrides or []:
         if "=" not in item:
             raise ConfigError(f"--set {item}: expected key=value")
@@ -277,9 +415,13 @@ def apply_overrides(data: dict, overrides: list[str] | None, design_keys: set[st
             raise ConfigError(f"--set {item}: empty key")
         value = _parse_scalar(raw.strip())
         path = key.split(".")
+        if any(not part.strip() for part in path):
+            raise ConfigError(f"--set {_quote(key)}: empty field name in the dotted path")
         if len(path) == 1:
             if design_keys is not None and key in design_keys:
                 path = ["design", key]
+            elif key in RunConfig.model_fields:  # a top-level section: objectives=[...], bounds={...}
+                path = [key]
             else:
                 path = ["options", key]
         node = data
@@ -317,8 +459,14 @@ def config_from_dict(data: Any, overrides: list[str] | None = None) -> RunConfig
 _LINE_BREAKS = {ord(c): repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"}
 
 
+MAX_MESSAGE = 400  # characters: an error quoting a huge value stays a short line
+
+
 def _one_line(message: str) -> str:
-    """The message with line breaks (from keys or values it quotes) escaped, so errors stay one line."""
+    """The message with line breaks (from keys or values it quotes) escaped and its length bounded, so errors stay
+    one short line."""
+    if len(message) > MAX_MESSAGE:
+        message = message[:MAX_MESSAGE] + "..."
     return message.translate(_LINE_BREAKS)
 
 
@@ -328,14 +476,10 @@ def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConf
     if not path.is_file():
         raise ConfigError(f"{path}: no such config file")
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise ConfigError(f"{path}: invalid YAML{where}") from None
+        text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
         raise ConfigError(f"{path}: cannot read ({err.__class__.__name__})") from None
-    return config_from_dict(data, overrides)
+    return config_from_dict(safe_yaml(text, str(path)), overrides)
 
 
 def dump_config(cfg: RunConfig) -> str:

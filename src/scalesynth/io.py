@@ -47,6 +47,7 @@ def write_atomic(path: Path, writer: Callable[[Any], None], mode: str = "w") -> 
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.fchmod(fd, 0o666 & ~current_umask())  # mkstemp makes 0600; results are shared like any other file
         text_args = {} if "b" in mode else {"encoding": "utf-8", "newline": ""}
         with os.fdopen(fd, mode, **text_args) as fh:
             writer(fh)
@@ -59,6 +60,20 @@ def write_atomic(path: Path, writer: Callable[[Any], None], mode: str = "w") -> 
     finally:
         if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def current_umask() -> int:
+    """The process umask (read without changing it where /proc allows; else set and restored at once)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 # write_atomic's temp names: '.' + target name + '.' + mkstemp's 8 random characters + '.tmp'
@@ -97,10 +112,90 @@ def read_pickle(path: Path) -> Any:
         return pickle.load(fh)
 
 
+CHECKPOINT_KEYS = ("algorithm", "history", "elapsed", "digest", "started")
+
+
+def read_checkpoint(path: Path) -> dict[str, Any]:
+    """A checkpoint written by ``optimize.run``; ConfigError (one line) if it is empty, truncated or foreign.
+
+    Checkpoints are pickles: resume only checkpoints you wrote yourself (unpickling runs code)."""
+    from scalesynth.errors import ConfigError
+
+    hint = "start without --resume to discard it"
+    try:
+        with open(path, "rb") as fh:
+            state = pickle.load(fh)
+    except OSError as err:
+        raise RunError(f"{path}: cannot read ({err.strerror or err})") from None
+    except EOFError:
+        raise ConfigError(f"{path}: empty or truncated checkpoint ({hint})") from None
+    except Exception as err:  # UnpicklingError, AttributeError/ImportError of a foreign class, ...
+        raise ConfigError(f"{path}: not a scalesynth checkpoint ({err.__class__.__name__}; {hint})") from None
+    if not isinstance(state, dict) or any(k not in state for k in CHECKPOINT_KEYS):
+        raise ConfigError(f"{path}: not a scalesynth checkpoint (unexpected content; {hint})")
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+
+    if not isinstance(state["algorithm"], NSGA2) or not isinstance(state["history"], list):
+        raise ConfigError(f"{path}: not a scalesynth checkpoint (no NSGA-II state; {hint})")
+    return state
+
+
 def write_csv(path: Path, frame) -> None:
-    """CSV with a fixed float format so equal numbers always give equal bytes."""
+    """CSV with a fixed float format so equal numbers always give equal bytes; every number must be finite."""
+    import numpy as np
+
+    numeric = frame.select_dtypes(include="number")
+    bad = [c for c in numeric.columns if not np.isfinite(numeric[c].to_numpy(dtype=float)).all()]
+    if bad:
+        raise RunError(f"{path}: column {bad[0]} has a non-finite value (not written); please report it")
     write_text(path, frame.to_csv(index=False, float_format="%.12g", lineterminator="\n"))
 
 
 def save_figure(fig, path: Path, dpi: int = 130) -> None:
     write_atomic(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi, bbox_inches="tight"), mode="wb")
+
+
+# ----- reading a results directory that may have been damaged: one-line ConfigError, never a traceback ----------
+
+def read_results_csv(path: Path, required: tuple[str, ...] | list[str] = ()):
+    """A results CSV as a DataFrame; ConfigError naming the file if it is empty, not CSV, lacks a ``required``
+    column or has a non-numeric or non-finite value in one."""
+    import numpy as np
+    import pandas as pd
+
+    from scalesynth.errors import ConfigError
+
+    try:
+        frame = pd.read_csv(path)
+    except OSError as err:
+        raise RunError(f"{path}: cannot read ({err.strerror or err})") from None
+    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
+        raise ConfigError(f"{path}: not a scalesynth results table ({err.__class__.__name__})") from None
+    for col in required:
+        if col not in frame.columns:
+            raise ConfigError(f"{path}: column {col!r} is missing (damaged or not written by this version)")
+        values = pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float)
+        if not np.isfinite(values).all():
+            row = int(np.nonzero(~np.isfinite(values))[0][0])
+            raise ConfigError(f"{path}: column {col!r}, row {row + 1}: not a finite number")
+        frame[col] = values
+    return frame
+
+
+def read_manifest(path: Path) -> dict[str, Any]:
+    """manifest.json as a dict with its resolved config; ConfigError naming the file if damaged."""
+    from scalesynth.errors import ConfigError
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as err:
+        raise RunError(f"{path}: cannot read ({err.strerror or err})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: not valid JSON ({err.__class__.__name__})") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: expected a JSON object, got {type(data).__name__}")
+    for key, kind in (("config", dict), ("status", str), ("hypervolume", (int, float)), ("wall_seconds", (int, float))):
+        if not isinstance(data.get(key), kind):
+            raise ConfigError(f"{path}: field {key!r} is missing or of the wrong type")
+    return data
+

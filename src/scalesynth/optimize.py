@@ -7,6 +7,7 @@ uninterrupted run with the same seed.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -21,7 +22,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from scalesynth import __version__, results
+from scalesynth import __version__, memory, results, rundir
 from scalesynth import io as rio
 from scalesynth.config import ConstraintConfig, RunConfig
 from scalesynth.errors import ConfigError, RunError
@@ -208,37 +209,51 @@ def run(
     """
     if seed is not None:
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
-    out = Path(out_dir) if out_dir is not None else cfg.output_dir()
-    rio.ensure_dir(out)
-    rio.remove_stale_temps(out)  # a run killed mid-write leaves its temp file behind
-    ckpt_path = out / rio.CHECKPOINT
-    problem = SynthesisProblem(cfg)
+    target = Path(out_dir) if out_dir is not None else cfg.output_dir()
+    problem = SynthesisProblem(cfg)  # validates everything (bounds, objectives) before anything is written
+    memory.check(memory.run_estimates(cfg, plots))  # refuse what cannot fit before allocating (issue 11)
     ref = problem.hv_reference()
     digest = config_digest(cfg)
     history: list[dict[str, Any]] = []
     elapsed_before = 0.0
     started = datetime.now(UTC).isoformat(timespec="seconds")
+    fresh_algorithm = make_algorithm(cfg, problem)
+    fresh_algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
     algorithm = None
-    if resume and ckpt_path.exists():
-        state = rio.read_pickle(ckpt_path)
-        if state.get("digest") != digest:
-            raise ConfigError(
-                f"{out}: cannot resume: the config differs from the checkpoint's (start without --resume)"
-            )
-        algorithm = state["algorithm"]
-        algorithm.problem = problem
-        algorithm.evaluator.evaluate_values_of = ["F", "G", "M"]
-        history = state["history"]
-        elapsed_before = state["elapsed"]
-        started = state["started"]
-    elif resume and results.finished(out, digest):
-        return results.load(out)
-    if algorithm is None:
-        # a fresh run: an old checkpoint in this directory belongs to another run
-        if ckpt_path.exists():
-            ckpt_path.unlink()
-        algorithm = make_algorithm(cfg, problem)
-        algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
+    # ---- run directory (scalesynth.rundir, issue 11): lock the target, write into its staging directory -------
+    with rundir.claim(target) as claimed:
+        out = claimed.continued() if resume else None
+        ckpt_path = claimed.work / rio.CHECKPOINT
+        if out is not None and ckpt_path.exists():
+            state = rio.read_checkpoint(ckpt_path)
+            if state.get("digest") != digest:
+                raise ConfigError(
+                    f"{target}: cannot resume: the config differs from the checkpoint's (start without --resume)"
+                )
+            algorithm = state["algorithm"]
+            algorithm.problem = problem
+            algorithm.evaluator.evaluate_values_of = ["F", "G", "M"]
+            history = state["history"]
+            elapsed_before = state["elapsed"]
+            started = state["started"]
+        elif out is not None and results.finished(out, digest):  # killed after its last write, before the swap
+            claimed.commit()
+            return results.load(target)
+        elif resume and results.finished(target, digest):
+            return results.load(target)
+        if algorithm is None:
+            out = claimed.fresh()  # a fresh run: an abandoned staging directory belongs to another run
+            algorithm = fresh_algorithm
+        result = _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, history, elapsed_before,
+                                  started, progress, plots, stop_after)
+        claimed.commit()
+    # ---- end of the run-directory block ------------------------------------------------------------------------
+    return dataclasses.replace(result, out_dir=target)  # the same run, now at its target
+
+
+def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, history, elapsed_before, started,
+                     progress, plots, stop_after) -> RunResult:
+    """The NSGA-II loop from ``algorithm``'s state; writes checkpoints and the results into ``out``."""
     # compile the kernels before the clock starts on the first generation
     problem.metrics(np.atleast_2d((problem.xl + problem.xu) / 2))
     t0 = time.perf_counter()
@@ -314,12 +329,27 @@ def _numba_threads() -> int:
     return int(numba.get_num_threads())
 
 
-def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
-    """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes."""
-    from scalesynth.config import config_from_dict
+def reproduce(
+    run_dir: Path, out_dir: Path, on_versions: Callable[[list[str]], None] | None = None
+) -> dict[str, Any]:
+    """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes.
 
+    ``on_versions`` is called, once the run has been read and checked and before the re-run starts, with the
+    recorded dependency versions that differ from the installed ones (``versions.version_differences``)."""
+    from scalesynth.config import config_from_dict
+    from scalesynth.versions import version_differences
+
+    run_real, out_real = Path(run_dir).resolve(), Path(out_dir).resolve()
+    if out_real == run_real or run_real in out_real.parents:
+        raise ConfigError(f"--out: {out_dir} is the run being checked (or inside it); re-run somewhere else")
     original = results.load(run_dir)
-    cfg = config_from_dict(original.manifest["config"])
+    try:
+        cfg = config_from_dict(original.manifest["config"])
+    except ConfigError as err:
+        raise ConfigError(f"{Path(run_dir) / 'manifest.json'}: config: {err}") from None
+    differences = version_differences(original.manifest.get("versions"))
+    if on_versions is not None:
+        on_versions(differences)
     result = run(cfg, out_dir, plots=False)
     same = (Path(run_dir) / results.PARETO).read_bytes() == (Path(out_dir) / results.PARETO).read_bytes()
     return {
@@ -329,4 +359,5 @@ def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
         "wall_seconds": result.manifest["wall_seconds"],
         "hypervolume": result.manifest["hypervolume"],
         "original_hypervolume": original.manifest["hypervolume"],
+        "version_differences": differences,
     }

@@ -14,7 +14,8 @@ import numpy as np
 from scalesynth import io as rio
 from scalesynth import plotting
 from scalesynth.config import RunConfig
-from scalesynth.evaluate import evaluate_config
+from scalesynth.evaluate import evaluate_config, make_grid
+from scalesynth.kernels.grid import sample_grid
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
@@ -103,22 +104,32 @@ def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, A
     """Mid-plane sections of the LCI grid: (axis0, axis2) at the middle of axis1 and (axis0, axis1) at the middle
     of axis2 (for seed 000: xz at y = 0 and xy at the centre height); one map for planar mechanisms."""
     res = max(cfg.grid.resolution, SECTION_RESOLUTION)
-    cfg = cfg.model_copy(update={"grid": cfg.grid.model_copy(update={"resolution": res + res % 2 + 1})})
-    rep = evaluate_config(cfg, design, keep_grid=True)
-    g, lci = rep.grid, rep.field("lci")
-    names = cfg.mech.task_axes
+    res = res + res % 2 + 1
+    mech, options = cfg.mech, cfg.resolved_options()
+    design = mech.resolve_design(design)
+    g = make_grid(mech, design, options, res, cfg.grid.region)
+    packed = mech.pack(design, options)
+
+    def plane(axis: int, index: int) -> np.ndarray:
+        """LCI on the grid's plane ``index`` of ``axis`` only (never the whole res^3 grid: issue 11)."""
+        lo, shape = g.lo.copy(), g.shape.copy()
+        lo[axis] += index * g.step[axis]
+        shape[axis] = 1
+        return sample_grid(mech.point_kernel, packed, lo, g.step, shape)
+
+    names = mech.task_axes
     ext = [(g.lo[a], g.lo[a] + g.shape[a] * g.step[a]) for a in range(3)]
     if len(names) == 2:
-        return [{"lci": lci[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": names[0], "ylabel": names[1],
-                 "title": f"{names[0]}{names[1]} workspace"}]
+        return [{"lci": plane(2, 0)[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": names[0],
+                 "ylabel": names[1], "title": f"{names[0]}{names[1]} workspace"}]
     j = int(g.shape[1]) // 2
     k = int(g.shape[2]) // 2
     yj = g.lo[1] + (j + 0.5) * g.step[1]
     zk = g.lo[2] + (k + 0.5) * g.step[2]
     return [
-        {"lci": lci[:, j, :], "extent": (*ext[0], *ext[2]), "xlabel": names[0], "ylabel": names[2],
+        {"lci": plane(1, j)[:, 0, :], "extent": (*ext[0], *ext[2]), "xlabel": names[0], "ylabel": names[2],
          "title": f"{names[0]}{names[2]} section at {names[1]} = {yj:.4g}"},
-        {"lci": lci[:, :, k], "extent": (*ext[0], *ext[1]), "xlabel": names[0], "ylabel": names[1],
+        {"lci": plane(2, k)[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": names[0], "ylabel": names[1],
          "title": f"{names[0]}{names[1]} section at {names[2]} = {zk:.4g}"},
     ]
 

@@ -100,26 +100,31 @@ def finished(out_dir: Path, digest: str | None = None) -> bool:
 
 
 def load(out_dir: Path, *, require_finished: bool = True) -> RunResult:
-    """Read a results directory into a RunResult; ConfigError (exit 2) naming the missing or broken file.
+    """Read a results directory into a RunResult; ConfigError (exit 2) naming the missing or damaged file (and
+    column), never a pandas or JSON traceback.
 
     ``require_finished``: the manifest must exist (a finished run); otherwise the tables and config suffice
     (plots of a directory whose manifest was lost)."""
     out = Path(out_dir)
-    manifest = read_manifest(out)
+    manifest = rio.read_manifest(out / MANIFEST) if (out / MANIFEST).is_file() else None
     if require_finished and manifest is None:
-        raise ConfigError(f"{out}: not a finished scalesynth run (no readable {MANIFEST})")
+        raise ConfigError(f"{out}: not a finished scalesynth run (no {MANIFEST})")
     for name in (CONFIG, PARETO, HISTORY):
         if not (out / name).is_file():
             raise ConfigError(f"{out}: not a scalesynth results directory (missing {name})")
     cfg = load_config(out / CONFIG)
-    try:
-        pareto = pd.read_csv(out / PARETO)
-        history = pd.read_csv(out / HISTORY)
-        population = pd.read_csv(out / POPULATION) if (out / POPULATION).is_file() else None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
-        raise ConfigError(f"{out}: unreadable results table ({err.__class__.__name__})") from None
+    problem = SynthesisProblem(cfg)
+    nb = len(cfg.dexterity.band_edges) - 1
+    needed = [*problem.var_names, *problem.objective_keys, cfg.mech.measure_key(cfg.units.length),
+              *(f"band{b}_share" for b in range(nb))]
+    pareto = rio.read_results_csv(out / PARETO, list(dict.fromkeys(needed)))
+    history = rio.read_results_csv(out / HISTORY, ("generation", "evaluations", "hypervolume"))
+    if not len(history):
+        raise ConfigError(f"{out / HISTORY}: no generations")
+    population = (rio.read_results_csv(out / POPULATION, problem.objective_keys)
+                  if (out / POPULATION).is_file() else None)
     return RunResult(out_dir=out, cfg=cfg, pareto=pareto, history=history, manifest=manifest or {},
-                     population=population)
+                     population=population, problem=problem)
 
 
 def infeasibility_lines(manifest: dict[str, Any]) -> list[str]:

@@ -23,22 +23,3 @@ def version_differences(recorded: dict[str, str] | None) -> list[str]:
     now = installed_versions()
     return [f"{name} {was} -> {now.get(name, 'not installed')}" for name, was in recorded.items()
             if now.get(name, "not installed") != was]
-
-
-def recorded_versions(run_dir) -> dict[str, str] | None:
-    """``versions`` of a finished run's manifest.json (None when the manifest has none); a directory without a
-    readable manifest raises ConfigError, as for every command that reads a results directory."""
-    import json
-    from pathlib import Path
-
-    from scalesynth.errors import ConfigError
-
-    path = Path(run_dir) / "manifest.json"
-    try:
-        manifest = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise ConfigError(f"{run_dir}: not a finished scalesynth run (no manifest.json)") from None
-    except (OSError, json.JSONDecodeError) as err:
-        raise ConfigError(f"{path}: unreadable manifest ({err})") from None
-    versions = manifest.get("versions") if isinstance(manifest, dict) else None
-    return versions if isinstance(versions, dict) else None

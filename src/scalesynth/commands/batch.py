@@ -2,12 +2,25 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
+
+_ADDRESS = re.compile(r"^(?:(?:tcp|tls|ucx|ws|wss|inproc)://)?(?:\[[0-9a-fA-F:.]+\]|[A-Za-z0-9_.-]+)(?::[0-9]{1,5})?/?$")
+
+
+def check_scheduler_address(address: str) -> None:
+    """ConfigError (exit 2) unless ``address`` looks like a dask scheduler address: [protocol://]host[:port]."""
+    from scalesynth.config import _quote
+    from scalesynth.errors import ConfigError
+
+    port = address.rstrip("/").rsplit(":", 1)[-1]
+    if not _ADDRESS.match(address) or (port.isdigit() and not 0 < int(port) < 65536):
+        raise ConfigError(f"--scheduler: not a scheduler address such as tcp://host:8786, got {_quote(address)}")
 
 
 @app.command("batch")
@@ -32,6 +45,8 @@ def batch_cmd(
     from scalesynth.batch import format_table, run_batch
     from scalesynth.config import load_config
 
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
     loaded = [(str(path), load_config(path, sets)) for path in configs]  # all validated before any task starts
     summary = run_batch(loaded, out, seeds=seeds, scheduler=scheduler, echo=lambda line: typer.echo(line, err=True))
     if as_json:

@@ -7,8 +7,6 @@ over the box (the nodes ``task_coverage`` / ``task_gci`` use); unreachable cells
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated
@@ -57,6 +55,9 @@ def task_map(cfg, resolution: int | None = None) -> TaskMap:
     res = resolution or cfg.task.resolution or cfg.grid.resolution
     if res < 2:
         raise ConfigError(f"--resolution: need at least 2 cells per axis, got {res}")
+    from scalesynth import memory
+
+    memory.check(memory.task_map_estimate(res, "--resolution" if resolution else "task.resolution"))
     lo, step = np.zeros(3), np.ones(3)
     for a, name in enumerate(mech.task_axes):  # config validation guarantees both axes are in the box
         lo[a], hi = cfg.task.box[name]
@@ -105,16 +106,11 @@ def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
 
 
 def _save_atomic(fig, out: Path) -> None:
-    """Write the PNG to a temporary file next to ``out`` and rename it, so a reader never sees half a file."""
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".png", dir=out.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=130)
-        os.replace(tmp, out)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    """Write the PNG atomically (io.write_atomic): a reader never sees half a file, an error names ``out``."""
+    from scalesynth import io as rio
+
+    rio.ensure_dir(out.parent)
+    rio.write_atomic(out, lambda fh: fig.savefig(fh, format="png", dpi=130), mode="wb")
 
 
 @app.command("plot-task")

@@ -15,6 +15,8 @@ import typer
 from scalesynth.cliapp import JsonOpt, SetOpt, _mech_inputs, _print_json, app, handles_errors
 from scalesynth.errors import InvalidParameter
 
+MAX_SAMPLES = 10_000  # each sample is a random feasible configuration and an SVD: 10 000 take about a minute
+
 
 @app.command("mobility")
 @handles_errors
@@ -30,8 +32,8 @@ def mobility_cmd(
     """Mobility: G-K counts from the joint list, screw-theory rank at random feasible configurations."""
     from scalesynth.mobility import mobility_report
 
-    if samples < 1:
-        raise InvalidParameter(f"--samples: expected an integer >= 1, got {samples}")
+    if not 1 <= samples <= MAX_SAMPLES:
+        raise InvalidParameter(f"--samples: expected an integer in [1, {MAX_SAMPLES}], got {samples}")
     mech, design, options = _mech_inputs(mechanism, sets)
     report = mobility_report(mech, design, options, samples=samples, seed=seed)
     out = report.to_dict()

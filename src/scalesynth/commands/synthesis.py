@@ -15,7 +15,9 @@ from scalesynth.cliapp import SetOpt, app, handles_errors
 def optimize_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML)")],
     out: Annotated[Path | None, typer.Option("--out", help="results directory (default results/<name>)")] = None,
-    seed: Annotated[int | None, typer.Option("--seed", min=0, help="random seed (overrides algorithm.seed)")] = None,
+    seed: Annotated[
+        int | None, typer.Option("--seed", min=0, max=2**32 - 1, help="random seed (overrides algorithm.seed)")
+    ] = None,
     resume: Annotated[bool, typer.Option("--resume", help="continue from the directory's checkpoint")] = False,
     sets: SetOpt = None,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="skip plots and report.md")] = False,
@@ -111,14 +113,14 @@ def reproduce_cmd(
     import tempfile
 
     from scalesynth.optimize import reproduce
-    from scalesynth.versions import recorded_versions, version_differences
 
-    differences = version_differences(recorded_versions(run_dir))
-    if differences:  # said before the re-run, which may take long
-        typer.echo(f"warning: dependency versions differ from the recorded run ({'; '.join(differences)}): "
-                   "byte-identical results are expected only with the same versions and machine type", err=True)
+    def warn_versions(differences: list[str]) -> None:
+        if differences:  # said before the re-run, which may take long
+            typer.echo(f"warning: dependency versions differ from the recorded run ({'; '.join(differences)}): "
+                       "byte-identical results are expected only with the same versions and machine type", err=True)
+
     with tempfile.TemporaryDirectory() as tmp:
-        info = reproduce(run_dir, out if out is not None else Path(tmp) / "rerun")
+        info = reproduce(run_dir, out if out is not None else Path(tmp) / "rerun", on_versions=warn_versions)
     verdict = "identical" if info["identical"] else "DIFFERENT"
     typer.echo(f"pareto.csv {verdict}: HV {info['hypervolume']:.6g} (original {info['original_hypervolume']:.6g}), "
                f"re-run took {info['wall_seconds']:.1f} s")

@@ -173,6 +173,8 @@ class Mechanism(ABC):
                 raise InvalidParameter(f"options.{key}: unknown option of {self.name} (known: {known})")
             options[key] = value
         self.check_options(options)
+        for key, value in options.items():
+            _check_magnitudes(f"options.{key}", value)
         return options
 
     def check_options(self, options: dict[str, Any]) -> None:  # noqa: B027 - optional hook, no options by default
@@ -259,6 +261,9 @@ class Mechanism(ABC):
         arr = np.asarray(values, dtype=float)
         if arr.shape != (expected,) or not np.all(np.isfinite(arr)):
             raise InvalidPose(f"{what}: expected {expected} finite numbers, got {values!r}")
+        if np.any(np.abs(arr) > MAX_MAGNITUDE):
+            raise InvalidPose(f"{what}: values beyond +-{MAX_MAGNITUDE:g} (the largest magnitude scalesynth "
+                              "computes with)")
         return arr
 
 
@@ -309,6 +314,28 @@ def svd_lci(matrix) -> float:
     return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
 
 
+# Every number a user gives (design values, bounds, options, grid region, task, poses) is refused above this
+# magnitude (config units): the kernels multiply up to a few lengths together and take powers up to 8 of them, and
+# 1e12 keeps every such product far inside float64 (1e96 < 1.8e308), so every number written stays finite.
+MAX_MAGNITUDE = 1e12
+
+
+def check_magnitude(field_name: str, value: float) -> float:
+    """``value``, or InvalidParameter naming the field if |value| > MAX_MAGNITUDE (the caller checks finiteness)."""
+    if abs(value) > MAX_MAGNITUDE:
+        raise InvalidParameter(f"{field_name}: {value:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude "
+                               "scalesynth computes with (products of such values overflow)")
+    return value
+
+
+def _check_magnitudes(field_name: str, value: Any) -> None:
+    if isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            _check_magnitudes(f"{field_name}[{i}]", v)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+        check_magnitude(field_name, float(value))
+
+
 def _finite_float(field_name: str, value: Any) -> float:
     if isinstance(value, bool):
         raise InvalidParameter(f"{field_name}: expected a number, got {value!r}")
@@ -318,7 +345,7 @@ def _finite_float(field_name: str, value: Any) -> float:
         raise InvalidParameter(f"{field_name}: expected a number, got {value!r}") from None
     if not math.isfinite(out):
         raise InvalidParameter(f"{field_name}: must be finite, got {value!r}")
-    return out
+    return check_magnitude(field_name, out)
 
 
 def parse_range(name: str, value: Any) -> tuple[float, float] | None:

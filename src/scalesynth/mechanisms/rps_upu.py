@@ -883,6 +883,8 @@ def tool_point_fields(p, x, y, z, out):
 def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
     """([min, max] of sin, [min, max] of cos) over the angle interval [lo, hi]: the ends and every multiple of
     pi/2 inside."""
+    if hi - lo >= 2 * math.pi:  # a whole turn: both reach [-1, 1] (and a wide range must not list its multiples)
+        return (-1.0, 1.0), (-1.0, 1.0)
     pts = [lo, hi] + [k * math.pi / 2 for k in range(math.ceil(lo / (math.pi / 2)), math.floor(hi / (math.pi / 2)) + 1)]
     s = [math.sin(a) for a in pts]
     c = [math.cos(a) for a in pts]
