@@ -42,8 +42,14 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
+from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 MODES = ("++", "+-", "-+", "--")
+FOREARMS = ("single", "parallelogram")
+JOINT_MODELS = ("ideal", "bonded")
+LINK_GROUPS = ("arm", "forearm", "arm_link", "forearm_link")
+# default actuator stiffness: 1e5 N m/rad (a servo with a stiff precision reducer), in N mm/rad
+ACTUATOR_STIFFNESS = 1e8
 TWO_PI = 2.0 * math.pi
 
 # packed-parameter layout (see PlanarFivebar.pack); arm limit i occupies 6 slots from _LIM[i]:
@@ -120,6 +126,25 @@ def point_lci(p, x, y, z):
     return lci_2x2(w2y * g1, -w1y * g2, -w2x * g1, w1x * g2)
 
 
+def check_fivebar_stiffness_options(options: dict[str, Any]) -> None:
+    if options["forearm"] not in FOREARMS:
+        raise InvalidParameter(f"options.forearm: must be one of {', '.join(FOREARMS)}, got {options['forearm']!r}")
+    if options["joint_model"] not in JOINT_MODELS:
+        raise InvalidParameter(
+            f"options.joint_model: must be one of {', '.join(JOINT_MODELS)}, got {options['joint_model']!r}")
+    d = options["parallelogram_spacing"]
+    if isinstance(d, bool) or not isinstance(d, (int, float)) or not (math.isfinite(d) and d > 0):
+        raise InvalidParameter(f"options.parallelogram_spacing: must be a finite number > 0 (mm), got {d!r}")
+    options["parallelogram_spacing"] = float(d)
+    offs = options["parallelogram_offsets"]
+    if (not isinstance(offs, (list, tuple)) or len(offs) != 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in offs)):
+        raise InvalidParameter(f"options.parallelogram_offsets: expected [angle arm link, angle forearm link] rad, "
+                               f"got {offs!r}")
+    options["parallelogram_offsets"] = [float(v) for v in offs]
+    check_stiffness_options(options, 2, LINK_GROUPS)
+
+
 class PlanarFivebar(Mechanism):
     """Seed-004 mechanism; see module docstring."""
 
@@ -128,6 +153,7 @@ class PlanarFivebar(Mechanism):
             raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
         for name in ("alpha1_limits", "alpha2_limits"):
             options[name] = parse_range(name, options[name])
+        check_fivebar_stiffness_options(options)
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(N_PACKED)
@@ -279,6 +305,74 @@ class PlanarFivebar(Mechanism):
         j = self.jacobians(design, options, pose, branches[self.kernel_branch(options)])["J"]
         return math.inf if j is None else float(np.linalg.norm(j @ dq))
 
+    # ----- stiffness (scalesynth.stiffness) -------------------------------------------------------
+    def stiffness_model(self, design, options, pose):
+        """Frame model (scalesynth.stiffness.FrameModel, planar, mm, N) at pose P = (x, y) in the kernel's working
+        mode; raises InvalidPose when P is outside the workspace (out of reach or outside the arm limits).
+
+        forearm 'single': the symmetric five-bar 5R (paper Fig. 7a, parallelograms removed); the platform is the pin
+        P. 'parallelogram': the right chain as built (paper §1): arm parallelogram (arm + arm link, offset
+        parallelogram_spacing along the fixed direction parallelogram_offsets[0]) carrying a rigid hinge plate, then
+        the forearm parallelogram (forearm + forearm link, offset along parallelogram_offsets[1]) carrying the rigid
+        platform; the left chain stays arm + forearm. Actuators: torsional springs at B1, B2 between arm and base."""
+        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.sections import tube_section
+
+        p = self.check_vector("pose", pose, 2)
+        branches = {s.label: s.values for s in self.inverse_kinematics(design, options, p)}
+        q = branches.get(self.kernel_branch(options))
+        packed = self.pack(design, options)
+        if q is None or point_lci(packed, p[0], p[1], 0.0) < 0.0:
+            raise InvalidPose(f"pose: ({p[0]:g}, {p[1]:g}) is outside the workspace (mode {options['mode']}, "
+                              "arm limits included)")
+        r = design["r"]
+        q1, q2 = self.elbows(design, q)
+        b1, b2 = np.array([r, 0.0]), np.array([-r, 0.0])
+        z = np.array([0.0, 0.0, 1.0])
+        k = options["actuator_stiffness"]
+        sec = {g: tube_section(options, g, "mm") for g in LINK_GROUPS}
+
+        def link(name, group, a, b):
+            s = sec[group]
+            return Link(name, group, np.asarray(a, float), np.asarray(b, float), s.EA, s.EI, s.EI, s.GJ)
+
+        bonded = options["joint_model"] == "bonded"
+
+        def rev(name, at, a, b, stiffness=None):
+            if bonded and stiffness is None:  # a passive joint welded shut (moment-carrying)
+                return Joint(name, "fixed", np.asarray(at, float), (a, b))
+            return Joint(name, "revolute", np.asarray(at, float), (a, b), (z,), stiffness)
+
+        links = [link("arm1", "arm", b1, q1), link("forearm1", "forearm", q1, p),
+                 link("arm2", "arm", b2, q2), link("forearm2", "forearm", q2, p)]
+        joints = [rev("actuator1", b1, "arm1.a", "base", k), rev("elbow1", q1, "arm1.b", "forearm1.a"),
+                  rev("actuator2", b2, "arm2.a", "base", k), rev("elbow2", q2, "arm2.b", "forearm2.a"),
+                  rev("wrist2", p, "forearm2.b", "platform")]
+        notes = ["planar frame in the xy plane; revolute axes along z; the load acts at P"]
+        if bonded:
+            notes.append("joint_model bonded: every passive joint welded (carries moments), actuators stay springs")
+        if options["forearm"] == "single":
+            joints.append(rev("wrist1", p, "forearm1.b", "platform"))
+            bodies = [Body("base", np.zeros(2)), Body("platform", p.copy(), "rigid" if bonded else "point")]
+        else:
+            d = options["parallelogram_spacing"]
+            phi_a, phi_f = options["parallelogram_offsets"]
+            na = d * np.array([math.cos(phi_a), math.sin(phi_a)])
+            nf = d * np.array([math.cos(phi_f), math.sin(phi_f)])
+            links += [link("arm_link1", "arm_link", b1 + na, q1 + na),
+                      link("forearm_link1", "forearm_link", q1 + nf, p + nf)]
+            joints = [j for j in joints if j.name != "elbow1"]
+            joints += [rev("elbow1", q1, "arm1.b", "plate1"), rev("plate_forearm1", q1, "forearm1.a", "plate1"),
+                       rev("arm_link_base1", b1 + na, "arm_link1.a", "base"),
+                       rev("arm_link_plate1", q1 + na, "arm_link1.b", "plate1"),
+                       rev("forearm_link_plate1", q1 + nf, "forearm_link1.a", "plate1"),
+                       rev("wrist1", p, "forearm1.b", "platform"),
+                       rev("forearm_link_platform1", p + nf, "forearm_link1.b", "platform")]
+            bodies = [Body("base", np.zeros(2)), Body("plate1", q1.copy()), Body("platform", p.copy())]
+            notes.append("right chain: arm and forearm parallelograms (paper §1); hinge plate and platform rigid")
+        return FrameModel(2, "mm", tuple(links), tuple(joints), tuple(bodies), "platform",
+                          np.asarray(options["load"], float), tuple(notes))
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of paper §1 (planar, each parallelogram counted as one 1-DOF joint): the right chain
@@ -337,6 +431,16 @@ MECHANISM = PlanarFivebar(
         Option("mode", "+-", "working mode sigma1 sigma2: '+-' = elbows out (operating mode), '++', '-+', '--'"),
         Option("alpha1_limits", None, "[lo, hi] rad for alpha1 modulo 2 pi, null = none (spec: [-4pi/9, 7pi/36])"),
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
+        Option("forearm", "single", "stiffness: 'single' (five-bar 5R) or 'parallelogram' (right chain PaPa, §1)"),
+        Option("joint_model", "ideal", "stiffness: 'ideal' passive joints (moment-free) or 'bonded' (welded, as in an "
+               "FE model with bonded contacts); actuators are springs in both"),
+        Option("parallelogram_spacing", 60.0, "stiffness: bar spacing of the parallelograms, mm"),
+        Option("parallelogram_offsets", [1.1780972450961724, -0.75],
+               "stiffness: directions (rad from +x) of the arm-link and forearm-link offsets: perpendicular to the "
+               "arm and forearm at mid-range over the packing rectangle (67.5 deg, -43 deg)"),
+        *stiffness_options("mm", ACTUATOR_STIFFNESS, "torsional stiffness of each arm actuator, N mm/rad (1e5 N m/rad)",
+                           [0.0, -150.0], "default 150 N along -y, the gravity direction (the workspace is below "
+                           "the base)"),
     ),
     default_length_unit="mm",
 )
