@@ -56,7 +56,12 @@ TWO_PI = 2.0 * math.pi
 # has, cos lo, sin lo, cos hi, sin hi, wide (1 if hi - lo > pi)
 _R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
 _LIM1, _LIM2 = 5, 11
-N_PACKED = 17
+# stiffness slots (point_stiffness): arm EA (N), arm EI (N mm^2), forearm EA (N), actuator stiffness (N mm/rad),
+# load Fx, Fy (N)
+_EA1, _EI1, _EA2, _KACT, _FX, _FY = 17, 18, 19, 20, 21, 22
+N_PACKED = 23
+# Jacobi-scaled eigenvalue ratio under which the platform stiffness counts as singular (as stiffness.solve)
+SINGULAR_RTOL = 1e-11
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -145,6 +150,53 @@ def check_fivebar_stiffness_options(options: dict[str, Any]) -> None:
     check_stiffness_options(options, 2, LINK_GROUPS)
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_compliance(p, u, y, c, s):
+    """Compliance (mm/N) of one RRR chain along its forearm, ideal joints: the forearm (a pinned bar) stretches,
+    and the arm tip Q moves as a cantilever on a torsional actuator spring under the forearm force. Returns the
+    forearm unit vector (ex, ey) and the compliance. (u, y) = P - B_i, (c, s) = cos, sin of the arm angle."""
+    l1 = p[_L1]
+    l2 = p[_L2]
+    ex = (u - l1 * c) / l2
+    ey = (y - l1 * s) / l2
+    along = ex * c + ey * s  # forearm direction . arm direction
+    across = ey * c - ex * s  # forearm direction . arm normal
+    bend = l1 * l1 * l1 / (3.0 * p[_EI1]) + l1 * l1 / p[_KACT]
+    return ex, ey, l2 / p[_EA2] + along * along * l1 / p[_EA1] + across * across * bend
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_stiffness(p, x, y, z):
+    """(ok, stiffness_min N/mm, deflection mm) at P = (x, y) in the packed working mode, ideal joints: platform
+    stiffness K = sum_i u_i u_i^T / c_i (u_i forearm unit vector, c_i its chain's compliance), the deflection
+    |K^-1 F| under the packed load F and the smallest eigenvalue of K. Under ideal joints the parallelograms carry no
+    force from a load at P (moment balance about P), so this holds for both forearm options. ok is False where P is
+    unreachable; at a singular pose (K singular after Jacobi scaling) stiffness_min = 0 and deflection = inf."""
+    r = p[_R]
+    u1 = x - r
+    u2 = x + r
+    ok1, c1, s1, g1 = _arm(u1, y, p[_L1], p[_L2], p[_S1])
+    ok2, c2, s2, g2 = _arm(u2, y, p[_L1], p[_L2], p[_S2])
+    if not ok1 or not ok2 or not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
+        return False, 0.0, math.inf
+    e1x, e1y, cc1 = _leg_compliance(p, u1, y, c1, s1)
+    e2x, e2y, cc2 = _leg_compliance(p, u2, y, c2, s2)
+    kxx = e1x * e1x / cc1 + e2x * e2x / cc2
+    kxy = e1x * e1y / cc1 + e2x * e2y / cc2
+    kyy = e1y * e1y / cc1 + e2y * e2y / cc2
+    scale = math.sqrt(kxx * kyy)
+    rho = abs(kxy) / scale if scale > 0.0 else 1.0
+    if not (1.0 - rho) > SINGULAR_RTOL * (1.0 + rho):
+        return True, 0.0, math.inf if (p[_FX] != 0.0 or p[_FY] != 0.0) else 0.0
+    det = kxx * kyy - kxy * kxy
+    dx = (kyy * p[_FX] - kxy * p[_FY]) / det
+    dy = (kxx * p[_FY] - kxy * p[_FX]) / det
+    half = 0.5 * (kxx + kyy)
+    diff = 0.5 * (kxx - kyy)
+    kmin = det / (half + math.sqrt(diff * diff + kxy * kxy))  # = lambda_min, without cancellation
+    return True, kmin, math.sqrt(dx * dx + dy * dy)
+
+
 class PlanarFivebar(Mechanism):
     """Seed-004 mechanism; see module docstring."""
 
@@ -168,6 +220,12 @@ class PlanarFivebar(Mechanism):
             if lim is not None and lim[1] - lim[0] < TWO_PI:  # a full turn or more restricts nothing
                 lo, hi = lim
                 p[k : k + 6] = (1.0, math.cos(lo), math.sin(lo), math.cos(hi), math.sin(hi), hi - lo > math.pi)
+        from scalesynth.stiffness.sections import tube_section
+
+        arm, fore = tube_section(options, "arm", "mm"), tube_section(options, "forearm", "mm")
+        p[_EA1], p[_EI1], p[_EA2] = arm.EA, arm.EI, fore.EA
+        p[_KACT] = options["actuator_stiffness"]
+        p[_FX], p[_FY] = options["load"]
         return p
 
     @property
