@@ -60,7 +60,7 @@ _LIM1, _LIM2 = 5, 11
 # load Fx, Fy (N)
 _EA1, _EI1, _EA2, _KACT, _FX, _FY = 17, 18, 19, 20, 21, 22
 N_PACKED = 23
-# Jacobi-scaled eigenvalue ratio under which the platform stiffness counts as singular (as stiffness.solve)
+# eigenvalue ratio (smallest / largest) at or below which the platform stiffness is singular (as stiffness.solve)
 SINGULAR_RTOL = 1e-11
 
 
@@ -171,7 +171,7 @@ def point_stiffness(p, x, y, z):
     stiffness K = sum_i u_i u_i^T / c_i (u_i forearm unit vector, c_i its chain's compliance), the deflection
     |K^-1 F| under the packed load F and the smallest eigenvalue of K. Under ideal joints the parallelograms carry no
     force from a load at P (moment balance about P), so this holds for both forearm options. ok is False where P is
-    unreachable; at a singular pose (K singular after Jacobi scaling) stiffness_min = 0 and deflection = inf."""
+    unreachable; at a singular pose (lambda_min(K) <= 1e-11 lambda_max(K)) stiffness_min = 0 and deflection = inf."""
     r = p[_R]
     u1 = x - r
     u2 = x + r
@@ -184,16 +184,15 @@ def point_stiffness(p, x, y, z):
     kxx = e1x * e1x / cc1 + e2x * e2x / cc2
     kxy = e1x * e1y / cc1 + e2x * e2y / cc2
     kyy = e1y * e1y / cc1 + e2y * e2y / cc2
-    scale = math.sqrt(kxx * kyy)
-    rho = abs(kxy) / scale if scale > 0.0 else 1.0
-    if not (1.0 - rho) > SINGULAR_RTOL * (1.0 + rho):
-        return True, 0.0, math.inf if (p[_FX] != 0.0 or p[_FY] != 0.0) else 0.0
     det = kxx * kyy - kxy * kxy
-    dx = (kyy * p[_FX] - kxy * p[_FY]) / det
-    dy = (kxx * p[_FY] - kxy * p[_FX]) / det
     half = 0.5 * (kxx + kyy)
     diff = 0.5 * (kxx - kyy)
-    kmin = det / (half + math.sqrt(diff * diff + kxy * kxy))  # = lambda_min, without cancellation
+    kmax = half + math.sqrt(diff * diff + kxy * kxy)
+    kmin = det / kmax  # = lambda_min, without cancellation
+    if not kmin > SINGULAR_RTOL * kmax:
+        return True, 0.0, math.inf if (p[_FX] != 0.0 or p[_FY] != 0.0) else 0.0
+    dx = (kyy * p[_FX] - kxy * p[_FY]) / det
+    dy = (kxx * p[_FY] - kxy * p[_FX]) / det
     return True, kmin, math.sqrt(dx * dx + dy * dy)
 
 

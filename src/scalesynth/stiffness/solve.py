@@ -19,7 +19,7 @@ import numpy as np
 
 from scalesynth.stiffness.model import FrameModel, Link
 
-# relative eigenvalue below which a (Jacobi-scaled) stiffness is treated as singular
+# eigenvalue ratio (smallest / largest) at or below which a platform stiffness is singular
 SINGULAR_RTOL = 1e-11
 
 
@@ -178,13 +178,15 @@ def _assemble(model: FrameModel, lay: _Layout) -> tuple[np.ndarray, np.ndarray]:
     return K, A
 
 
-def scaled_singular(K: np.ndarray, rtol: float = SINGULAR_RTOL) -> bool:
-    """True when the symmetric stiffness K is singular after Jacobi scaling (scale- and unit-free test)."""
-    d = np.sqrt(np.abs(np.diag(K)))
-    if not np.all(np.isfinite(K)) or np.any(d == 0):
+def is_singular(K: np.ndarray, dim: int, length: float, rtol: float = SINGULAR_RTOL) -> bool:
+    """True when the platform stiffness K (translations first, then rotations) is singular: its smallest
+    eigenvalue is at most rtol times its largest once rotations are measured as arc lengths at the characteristic
+    length ``length`` (so every entry is in N/length and the test is unit-free)."""
+    if not np.all(np.isfinite(K)):
         return True
-    ks = K / np.outer(d, d)
-    w = np.linalg.eigvalsh(0.5 * (ks + ks.T))
+    t = np.ones(K.shape[0])
+    t[dim:] = 1.0 / length
+    w = np.linalg.eigvalsh(K * np.outer(t, t))
     return bool(w[0] <= rtol * w[-1])
 
 
@@ -230,7 +232,7 @@ def solve(model: FrameModel) -> StiffnessResult:
             K = 0.5 * (K + K.T)
         except np.linalg.LinAlgError:
             K = None
-    if K is None or scaled_singular(K):
+    if K is None or is_singular(K, dim, max(link.length for link in model.links)):
         defl = np.full(dim, math.inf) if np.any(load != 0) else np.zeros(dim)
         Kout = np.zeros((len(names), len(names))) if K is None else K
         return StiffnessResult(Kout, None, None, defl, 0.0, True, names)
