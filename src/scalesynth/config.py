@@ -29,6 +29,15 @@ METRICS = (
     "task_fci",
     "task_min_lci",
     "path_min_lci",
+    # stiffness (issue 12, scalesynth.stiffness.fields): length unit and N
+    "deflection_max",
+    "deflection_mean",
+    "stiffness_min",
+    "stiffness_mean",
+    "task_deflection_max",
+    "task_deflection_mean",
+    "task_stiffness_min",
+    "task_stiffness_mean",
 )
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
@@ -211,6 +220,10 @@ class RunConfig(_Strict):
                     raise ValueError(f"{where}[{i}].metric: {item.metric} needs a task section")
                 if item.metric.startswith("path_") and (self.task is None or self.task.path is None):
                     raise ValueError(f"{where}[{i}].metric: {item.metric} needs task.path")
+                if item.metric.removeprefix("task_").startswith(("deflection_", "stiffness_")):
+                    from scalesynth.stiffness.fields import check_field_available
+
+                    check_field_available(mech, self.resolved_options(), f"{where}[{i}].metric")
         axes = ", ".join(mech.task_axes)
         for axis in self.grid.region or {}:
             if axis not in mech.task_axes:

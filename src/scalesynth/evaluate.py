@@ -157,6 +157,8 @@ def evaluate(
     metrics = {k: v[0].item() for k, v in stats_to_metrics(stats, np.array([g.cell_measure]), names).items()}
     if task is not None:
         metrics.update({k: v[0].item() for k, v in task_metrics(mech, packed, task, resolution, band_edges).items()})
+    metrics.update({k: v[0].item() for k, v in _stiffness(mech, options, packed, g.lo[None], g.step[None],
+                                                            g.shape, task, resolution, always=False).items()})
     lci = _grid.sample_grid(mech.point_kernel, packed[0], g.lo, g.step, g.shape) if keep_grid else None
     return WorkspaceReport(
         mechanism=mech.name,
@@ -243,6 +245,18 @@ def task_metrics(
     return out
 
 
+def _stiffness(mech, options, packed, lo, step, shape, task, resolution, always: bool) -> dict[str, np.ndarray]:
+    """Stiffness metrics (issue 12) where the mechanism has per-voxel fields for these options; with ``always``
+    raise when it has none, else return {}."""
+    from scalesynth.stiffness import fields
+
+    if not always and fields.field_or_none(mech, options) is None:
+        return {}
+    box = None if task is None else task.box
+    res = None if task is None else (task.resolution or resolution)
+    return fields.stiffness_metrics(mech, options, packed, lo, step, shape, box, res)
+
+
 def evaluate_population(
     mech: Mechanism,
     designs: Sequence[Mapping[str, float]],
@@ -253,9 +267,10 @@ def evaluate_population(
     band_edges: Sequence[float] = DEFAULT_BAND_EDGES,
     length_unit: str | None = None,
     task: Any = None,
+    stiffness: bool = False,
 ) -> dict[str, np.ndarray]:
     """Metrics of many designs in one parallel kernel call (no Python work per voxel); with ``task`` (a
-    config TaskConfig) also the task-box and path metrics."""
+    config TaskConfig) also the task-box and path metrics; with ``stiffness`` the stiffness metrics."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
@@ -273,6 +288,8 @@ def evaluate_population(
     out = stats_to_metrics(stats, cell, names)
     if task is not None:
         out.update(task_metrics(mech, packed, task, resolution, band_edges))
+    if stiffness:
+        out.update(_stiffness(mech, options, packed, lo, step, grids[0].shape, task, resolution, always=True))
     return out
 
 
@@ -291,8 +308,10 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
     )
 
 
-def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> dict[str, np.ndarray]:
-    """All metrics of many designs under one config, in one parallel kernel call per metric family."""
+def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]], *, stiffness: bool = False
+                               ) -> dict[str, np.ndarray]:
+    """All metrics of many designs under one config, in one parallel kernel call per metric family (the
+    stiffness ones with ``stiffness``)."""
     return evaluate_population(
         cfg.mech,
         designs,
@@ -302,4 +321,5 @@ def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> d
         band_edges=cfg.dexterity.band_edges,
         length_unit=cfg.units.length,
         task=cfg.task,
+        stiffness=stiffness,
     )

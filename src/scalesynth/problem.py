@@ -54,6 +54,13 @@ class SynthesisProblem(Problem):
             names += ["task_coverage", "task_gci", "task_fci", "task_min_lci"]
             if cfg.task.path is not None:
                 names += ["path_reachable", "path_min_lci", "path_mean_lci"]
+        # stiffness metrics (issue 12) only when an objective or constraint asks for them (their kernels cost)
+        from scalesynth.stiffness.fields import TASK_METRICS, WORKSPACE_METRICS
+
+        used = set(self.objective_keys) | set(self.constraint_keys)
+        self.stiffness = bool(used & set(WORKSPACE_METRICS + TASK_METRICS))
+        if self.stiffness:
+            names += list(WORKSPACE_METRICS) + (list(TASK_METRICS) if cfg.task is not None else [])
         self.metric_columns = names
         n_constr = sum((c.min is not None) + (c.max is not None) for c in cfg.constraints)
         xl = np.array([cfg.bounds[k][0] for k in self.var_names], dtype=float)
@@ -70,7 +77,7 @@ class SynthesisProblem(Problem):
 
     def metrics(self, X: np.ndarray) -> np.ndarray:
         """All metrics, shape (n, len(metric_columns))."""
-        values = evaluate_config_population(self.cfg, self.designs(X))
+        values = evaluate_config_population(self.cfg, self.designs(X), stiffness=self.stiffness)
         return np.column_stack([np.asarray(values[k], dtype=float) for k in self.metric_columns])
 
     def objectives_from_metrics(self, M: np.ndarray) -> np.ndarray:

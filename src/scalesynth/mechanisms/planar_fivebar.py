@@ -363,6 +363,14 @@ class PlanarFivebar(Mechanism):
         return math.inf if j is None else float(np.linalg.norm(j @ dq))
 
     # ----- stiffness (scalesynth.stiffness) -------------------------------------------------------
+    def stiffness_field(self, options):
+        """The per-voxel field kernel (scalesynth.stiffness.fields contract): point_stiffness, ideal joints (for
+        which both forearm options give the same translational stiffness at P)."""
+        if options["joint_model"] != "ideal":
+            raise InvalidParameter("options.joint_model: per-voxel stiffness fields need 'ideal' joints; 'bonded' "
+                                   "is solved at single poses only (scalesynth stiffness)")
+        return point_stiffness
+
     def stiffness_model(self, design, options, pose):
         """Frame model (scalesynth.stiffness.FrameModel, planar, mm, N) at pose P = (x, y) in the kernel's working
         mode; raises InvalidPose when P is outside the workspace (out of reach or outside the arm limits).

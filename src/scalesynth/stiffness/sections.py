@@ -45,10 +45,20 @@ def stiffness_options(length_unit: str, actuator_stiffness: float, actuator_doc:
     )
 
 
-def _positive(name: str, value: Any) -> float:
+def _number(name: str, value: Any) -> float:
+    """A float from a number or a numeric string (YAML 1.1 reads 5e8 as a string)."""
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            pass
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InvalidParameter(f"options.{name}: expected a number, got {value!r}")
-    v = float(value)
+    return float(value)
+
+
+def _positive(name: str, value: Any) -> float:
+    v = _number(name, value)
     if not (v > 0 and math.isfinite(v)):
         raise InvalidParameter(f"options.{name}: must be a finite number > 0, got {value!r}")
     return v
@@ -67,10 +77,11 @@ def _tube(name: str, value: Any) -> list[float]:
 def check_stiffness_options(options: dict[str, Any], dim: int, groups: tuple[str, ...]) -> None:
     """Validate (and normalise in place) the shared stiffness options; raise InvalidParameter naming the field."""
     options["youngs_modulus"] = _positive("youngs_modulus", options["youngs_modulus"])
-    nu = options["poisson_ratio"]
-    if isinstance(nu, bool) or not isinstance(nu, (int, float)) or not -1.0 < float(nu) < 0.5:
-        raise InvalidParameter(f"options.poisson_ratio: must be a number in (-1, 0.5), got {nu!r}")
-    options["poisson_ratio"] = float(nu)
+    nu = _number("poisson_ratio", options["poisson_ratio"])
+    if not -1.0 < nu < 0.5:
+        raise InvalidParameter(
+            f"options.poisson_ratio: must be a number in (-1, 0.5), got {options['poisson_ratio']!r}")
+    options["poisson_ratio"] = nu
     options["tube"] = _tube("tube", options["tube"])
     sections = options["sections"] or {}
     if not isinstance(sections, Mapping):
@@ -83,11 +94,10 @@ def check_stiffness_options(options: dict[str, Any], dim: int, groups: tuple[str
     load = options["load"]
     if not isinstance(load, (list, tuple)) or len(load) != dim:
         raise InvalidParameter(f"options.load: expected {dim} force components (N), got {load!r}")
-    out = []
-    for i, v in enumerate(load):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
-            raise InvalidParameter(f"options.load[{i}]: expected a finite number (N), got {v!r}")
-        out.append(float(v))
+    out = [_number(f"load[{i}]", v) for i, v in enumerate(load)]
+    for i, v in enumerate(out):
+        if not math.isfinite(v):
+            raise InvalidParameter(f"options.load[{i}]: expected a finite number (N), got {load[i]!r}")
     options["load"] = out
 
 
