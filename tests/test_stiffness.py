@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from scalesynth.cli import app
 from scalesynth.mechanisms import get
-from scalesynth.mechanisms.planar_fivebar import point_stiffness
+from scalesynth.mechanisms.planar_fivebar import DEFLECTION_CAP, point_fields
 from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
 from scalesynth.stiffness.sections import tube_section
 from scalesynth.stiffness.solve import solve
@@ -33,6 +33,10 @@ VARIANTS = [(f, j) for f in ("single", "parallelogram") for j in ("ideal", "bond
 
 def options(**kw):
     return M.resolve_options(kw)
+
+
+def model(opt, pose, joints="ideal", design=DESIGN):
+    return M.stiffness_model(design, opt, pose, joints)
 
 
 def rel(a, b):
@@ -145,9 +149,8 @@ def hand_fivebar(opt, pose):
 def test_pinned_fivebar_by_hand(pose):
     opt = options()
     K, defl = hand_fivebar(opt, pose)
-    model = M.stiffness_model(DESIGN, opt, pose)
-    assert rel(solve_model(model.to_dict()), defl) < 1e-9  # the checker
-    res = solve(model)
+    assert rel(solve_model(model(opt, pose).to_dict()), defl) < 1e-9  # the checker
+    res = solve(model(opt, pose))
     assert rel(res.deflection, defl) < 1e-9
     assert rel(res.K, K) < 1e-9
 
@@ -156,17 +159,16 @@ def test_pinned_fivebar_by_hand(pose):
 @pytest.mark.parametrize("forearm,joints", VARIANTS)
 @pytest.mark.parametrize("pose", POSES)
 def test_fivebar_against_pynite(pose, forearm, joints):
-    opt = options(forearm=forearm, joint_model=joints)
-    model = M.stiffness_model(DESIGN, opt, pose).to_dict()
-    fe = solve_model(model)
-    ours = solve(M.stiffness_model(DESIGN, opt, pose)).deflection
+    opt = options(forearm=forearm)
+    fe = solve_model(model(opt, pose, joints).to_dict())
+    ours = solve(model(opt, pose, joints)).deflection
     assert rel(ours, fe) < 1e-3  # issue 12: 0.1 %; measured <= 1e-4 (PyNite's rigid members are a penalty)
 
 
 def test_cli_model_rebuilds_in_pynite():
     """The model printed by `scalesynth stiffness --json` is complete: PyNite rebuilt from it gives its deflection."""
     out = CliRunner().invoke(app, ["stiffness", "planar-fivebar", "--pose=-500,-850", "--set", "forearm=parallelogram",
-                                   "--set", "joint_model=bonded", "--load=20,-150", "--json"])
+                                   "--joints=bonded", "--load=20,-150", "--json"])
     assert out.exit_code == 0, out.output
     data = json.loads(out.output)
     assert data["model"]["load"]["force"] == [20.0, -150.0]
@@ -177,9 +179,9 @@ def test_cli_model_rebuilds_in_pynite():
 # ----- properties -------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("forearm,joints", VARIANTS)
 def test_stiffness_symmetric_positive_definite(forearm, joints):
-    opt = options(forearm=forearm, joint_model=joints)
+    opt = options(forearm=forearm)
     for pose in POSES:
-        res = solve(M.stiffness_model(DESIGN, opt, pose))
+        res = solve(model(opt, pose, joints))
         assert not res.singular
         assert rel(res.K, res.K.T) < 1e-12
         assert np.linalg.eigvalsh(res.K)[0] > 0
@@ -196,8 +198,7 @@ def test_rigid_links_give_the_jacobian_model(forearm):
     cj = J @ J.T / k
     gaps = []
     for e in (1e3, 1e4, 1e5):
-        res = solve(M.stiffness_model(DESIGN, options(forearm=forearm, youngs_modulus=70 * e, actuator_stiffness=k),
-                                      pose))
+        res = solve(model(options(forearm=forearm, youngs_modulus=70 * e, actuator_stiffness=k), pose))
         gaps.append(rel(res.C_t, cj))
     assert gaps[2] < 1e-4
     assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
@@ -208,8 +209,7 @@ def test_deflection_linear_in_the_load():
     for forearm, joints in VARIANTS:
         d = {}
         for name, f in (("1", f1), ("2", f2), ("sum", 2.5 * f1 - 3 * f2)):
-            d[name] = solve(M.stiffness_model(DESIGN, options(forearm=forearm, joint_model=joints, load=list(f)),
-                                              (-200.0, -800.0))).deflection
+            d[name] = solve(model(options(forearm=forearm, load=list(f)), (-200.0, -800.0), joints)).deflection
         assert rel(d["sum"], 2.5 * d["1"] - 3 * d["2"]) < 1e-12
 
 
@@ -225,22 +225,29 @@ def test_singular_pose_is_infinite_never_nan():
     opt = options(mode=mode)
     assert M.singularity(SING, opt, (0.0, Y0), {s.label: s.values for s in M.inverse_kinematics(
         SING, opt, (0.0, Y0))}[mode], tol=1e-9) in ("forward", "both")
-    res = solve(M.stiffness_model(SING, opt, (0.0, Y0)))
+    res = solve(model(opt, (0.0, Y0), design=SING))
     assert res.singular and res.C is None and math.isinf(res.deflection_norm) and res.stiffness_min == 0.0
-    ok, kmin, defl = point_stiffness(M.pack(SING, opt), 0.0, Y0, 0.0)
-    assert ok and kmin == 0.0 and math.isinf(defl)
+    out = fields(M.pack(SING, opt), 0.0, Y0)  # the field contract has no inf: capped
+    assert out[0] >= 0 and out[3] == 0.0 and out[4] == DEFLECTION_CAP == 1e12
     out = CliRunner().invoke(app, ["stiffness", "planar-fivebar", "--set", "l2=500", "--set", f"mode={mode}",
                                    f"--pose=0,{Y0!r}", "--json"])
     assert out.exit_code == 0 and "NaN" not in out.output
     data = json.loads(out.output)
     assert data["singular"] and data["deflection_norm"] == "inf" and data["compliance"][0][0] == "inf"
     # 1 mm away the pose is regular, with a large but finite deflection
-    near = solve(M.stiffness_model(SING, opt, (0.0, Y0 - 1.0)))
-    assert not near.singular and 10 * solve(M.stiffness_model(SING, opt, (0.0, Y0 - 100.0))).deflection_norm < \
+    near = solve(model(opt, (0.0, Y0 - 1.0), design=SING))
+    assert not near.singular and 10 * solve(model(opt, (0.0, Y0 - 100.0), design=SING)).deflection_norm < \
         near.deflection_norm < math.inf
 
 
 # ----- the per-voxel Numba field equals the NumPy reference --------------------------------------------------------
+def fields(packed, x, y):
+    out = np.zeros(M.n_fields)
+    point_fields(packed, float(x), float(y), 0.0, out)
+    assert M.field_names[3:] == ("stiffness_min", "deflection")
+    return out
+
+
 def test_numba_field_equals_reference():
     rng = np.random.default_rng(12)
     opt = options(**LIMITS, tube=[30.0, 2.0], sections={"arm": [50.0, 4.0]}, actuator_stiffness=3e7,
@@ -248,12 +255,13 @@ def test_numba_field_equals_reference():
     packed = M.pack(DESIGN, opt)
     checked = 0
     for x, y in zip(rng.uniform(-700, 700, 400), rng.uniform(-1300, -300, 400), strict=True):
-        ok, kmin, defl = point_stiffness(packed, x, y, 0.0)
-        assert ok == (M.point_kernel(packed, x, y, 0.0) >= 0)
-        if not ok:
+        out = fields(packed, x, y)
+        if out[0] < 0:
+            assert out[3] == 0 and out[4] == 0
             continue
+        kmin, defl = out[3], out[4]
         for forearm in ("single", "parallelogram"):  # ideal joints: the parallelograms carry nothing (docs)
-            res = solve(M.stiffness_model(DESIGN, {**opt, "forearm": forearm}, (x, y)))
+            res = solve(model({**opt, "forearm": forearm}, (x, y)))
             assert kmin == pytest.approx(res.stiffness_min, rel=1e-8)
             assert defl == pytest.approx(res.deflection_norm, rel=1e-8)
         checked += 1
@@ -263,13 +271,11 @@ def test_numba_field_equals_reference():
 # ----- seed 004: parallelogram forearms stiffer vertically (paper §4.3), figures in docs/stiffness.md ----------------
 def test_seed004_parallelograms_stiffer_vertically_with_bonded_joints():
     for pose in [*CORNERS, (0.0, -725.0)]:
-        dy = {f: solve(M.stiffness_model(DESIGN, options(forearm=f, joint_model="bonded"), pose)).deflection[1]
-              for f in ("single", "parallelogram")}
+        dy = {f: solve(model(options(forearm=f), pose, "bonded")).deflection[1] for f in ("single", "parallelogram")}
         assert dy["single"] < 0 and dy["parallelogram"] < 0
         assert abs(dy["parallelogram"]) < abs(dy["single"])
         # ideal (moment-free) joints: a force at P puts no load in the parallelograms' second bars
-        ideal = {f: solve(M.stiffness_model(DESIGN, options(forearm=f), pose)).deflection for f in ("single",
-                                                                                                  "parallelogram")}
+        ideal = {f: solve(model(options(forearm=f), pose)).deflection for f in ("single", "parallelogram")}
         assert rel(ideal["parallelogram"], ideal["single"]) < 1e-8
 
 
@@ -285,6 +291,7 @@ def test_seed004_parallelograms_stiffer_vertically_with_bonded_joints():
     (["--set", "load=[1,2,3]"], "options.load"),
     (["--load=1,2,3"], "--load"),
     (["--set", "forearm=double"], "options.forearm"),
+    (["--joints=glued"], "--joints"),
     (["--set", "parallelogram_spacing=0"], "options.parallelogram_spacing"),
 ])
 def test_bad_input_exit_2(args, field):

@@ -15,6 +15,8 @@ def stiffness_cmd(
     mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
     pose: Annotated[str, typer.Option("--pose", help="task coordinates, comma-separated")],
     load: Annotated[str | None, typer.Option("--load", help="force on the platform, N: Fx,Fy(,Fz)")] = None,
+    joints: Annotated[str, typer.Option("--joints", help="ideal (moment-free passive joints) or bonded (welded)")]
+    = "ideal",
     sets: SetOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
@@ -27,12 +29,13 @@ def stiffness_cmd(
     if load is not None:
         n = len(options["load"]) if "load" in options else 3
         options = mech.resolve_options({**options, "load": _parse_vector("--load", load, n)})
-    out = pose_stiffness(mech, design, options, p)
+    out = pose_stiffness(mech, design, options, p, joints)
     if as_json:
         _print_json(out)
         return
     u = out["units"]["length"]
     typer.echo(f"{mech.name} at pose {', '.join(f'{v:g}' for v in out['pose'])} ({u}), mode {out['branch']}, "
+               f"{joints} joints, "
                f"load {out['load']} N")
     fmt = "{:.6g}".format
 

@@ -30,13 +30,17 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
-from scalesynth.kernels.conditioning import lci_2x2
+from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.conditioning import SIGMA_CAP, sv_2x2
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
+    DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
     Solution,
+    base_fields,
     parse_range,
     singularity_label,
     svd_lci,
@@ -46,7 +50,6 @@ from scalesynth.stiffness.sections import check_stiffness_options, stiffness_opt
 
 MODES = ("++", "+-", "-+", "--")
 FOREARMS = ("single", "parallelogram")
-JOINT_MODELS = ("ideal", "bonded")
 LINK_GROUPS = ("arm", "forearm", "arm_link", "forearm_link")
 # default actuator stiffness: 1e5 N m/rad (a servo with a stiff precision reducer), in N mm/rad
 ACTUATOR_STIFFNESS = 1e8
@@ -56,12 +59,13 @@ TWO_PI = 2.0 * math.pi
 # has, cos lo, sin lo, cos hi, sin hi, wide (1 if hi - lo > pi)
 _R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
 _LIM1, _LIM2 = 5, 11
-# stiffness slots (point_stiffness): arm EA (N), arm EI (N mm^2), forearm EA (N), actuator stiffness (N mm/rad),
+# stiffness slots (point_fields slots 3, 4): arm EA (N), arm EI (N mm^2), forearm EA (N), actuator stiffness (N mm/rad),
 # load Fx, Fy (N)
 _EA1, _EI1, _EA2, _KACT, _FX, _FY = 17, 18, 19, 20, 21, 22
 N_PACKED = 23
 # eigenvalue ratio (smallest / largest) at or below which the platform stiffness is singular (as stiffness.solve)
 SINGULAR_RTOL = 1e-11
+DEFLECTION_CAP = SIGMA_CAP  # mm: the per-voxel deflection at a singular pose (the field contract has no inf)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -104,22 +108,20 @@ def _arc_ok(p, k, c, s):
     return after_lo and before_hi
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def point_lci(p, x, y, z):
-    """LCI (sigma_min/sigma_max of J) at P = (x, y) in the packed working mode, or -1 if unreachable; z unused."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _kinematics(p, x, y, out):
+    """Slots 0-2 at P = (x, y) in the packed working mode: LCI (sigma_min/sigma_max of J), sigma_min and sigma_max
+    of J = dx/dq (mm/rad); unreachable: write_unreachable. Returns (ok, cos, sin of alpha1, cos, sin of alpha2)."""
     r = p[_R]
     l1 = p[_L1]
     l2 = p[_L2]
     u1 = x - r
     u2 = x + r
     ok1, c1, s1, g1 = _arm(u1, y, l1, l2, p[_S1])
-    if not ok1:
-        return -1.0
     ok2, c2, s2, g2 = _arm(u2, y, l1, l2, p[_S2])
-    if not ok2:
-        return -1.0
-    if not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
-        return -1.0
+    if not ok1 or not ok2 or not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
+        _grid.write_unreachable(out)
+        return False, 0.0, 0.0, 0.0, 0.0
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1
@@ -128,26 +130,24 @@ def point_lci(p, x, y, z):
     # J = Jx^-1 Jq = adj(Jx) Jq / det(Jx) with Jx rows w_i / l2 and Jq = diag(-sigma_i g_i) / (2 l2) (spec §2.4).
     # LCI ignores the common scale and the column signs, so adj(Jx) diag(g1, g2) suffices; it stays finite at a
     # forward singularity (det Jx = 0), where its rank drops to 1 and the LCI is 0, the limit of J's.
-    return lci_2x2(w2y * g1, -w1y * g2, -w2x * g1, w1x * g2)
+    # With W the matrix of rows w_i, J = adj(W) diag(-sigma_i g_i) / (2 det W): sigma(J) = sigma(B) / (2 |det W|).
+    lci, smin, smax = sv_2x2(w2y * g1, -w1y * g2, -w2x * g1, w1x * g2)
+    out[0] = lci
+    det2 = 2.0 * abs(w1x * w2y - w1y * w2x)
+    if not det2 * SIGMA_CAP > smax:  # forward singularity: J unbounded
+        out[1] = 0.0
+        out[2] = SIGMA_CAP
+    else:
+        out[1] = smin / det2
+        out[2] = smax / det2
+    return True, c1, s1, c2, s2
 
 
-def check_fivebar_stiffness_options(options: dict[str, Any]) -> None:
-    if options["forearm"] not in FOREARMS:
-        raise InvalidParameter(f"options.forearm: must be one of {', '.join(FOREARMS)}, got {options['forearm']!r}")
-    if options["joint_model"] not in JOINT_MODELS:
-        raise InvalidParameter(
-            f"options.joint_model: must be one of {', '.join(JOINT_MODELS)}, got {options['joint_model']!r}")
-    d = options["parallelogram_spacing"]
-    if isinstance(d, bool) or not isinstance(d, (int, float)) or not (math.isfinite(d) and d > 0):
-        raise InvalidParameter(f"options.parallelogram_spacing: must be a finite number > 0 (mm), got {d!r}")
-    options["parallelogram_spacing"] = float(d)
-    offs = options["parallelogram_offsets"]
-    if (not isinstance(offs, (list, tuple)) or len(offs) != 2
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in offs)):
-        raise InvalidParameter(f"options.parallelogram_offsets: expected [angle arm link, angle forearm link] rad, "
-                               f"got {offs!r}")
-    options["parallelogram_offsets"] = [float(v) for v in offs]
-    check_stiffness_options(options, 2, LINK_GROUPS)
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, x, y, z, out):
+    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
+    the LCI alone) and the stiffness twin tests."""
+    _kinematics(p, x, y, out)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -165,22 +165,16 @@ def _leg_compliance(p, u, y, c, s):
     return ex, ey, l2 / p[_EA2] + along * along * l1 / p[_EA1] + across * across * bend
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def point_stiffness(p, x, y, z):
-    """(ok, stiffness_min N/mm, deflection mm) at P = (x, y) in the packed working mode, ideal joints: platform
-    stiffness K = sum_i u_i u_i^T / c_i (u_i forearm unit vector, c_i its chain's compliance), the deflection
-    |K^-1 F| under the packed load F and the smallest eigenvalue of K. Under ideal joints the parallelograms carry no
-    force from a load at P (moment balance about P), so this holds for both forearm options. ok is False where P is
-    unreachable; at a singular pose (lambda_min(K) <= 1e-11 lambda_max(K)) stiffness_min = 0 and deflection = inf."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _stiffness(p, x, y, c1, s1, c2, s2):
+    """(stiffness_min N/mm, deflection mm) at a reachable P, ideal joints: platform stiffness
+    K = sum_i u_i u_i^T / c_i (u_i forearm unit vector, c_i its chain's compliance: a per-leg condensation), its
+    smallest eigenvalue and |K^-1 F| under the packed load F. Under ideal joints the parallelograms carry no force
+    from a load at P (moment balance about P), so this holds for both forearm options. At a singular pose
+    (lambda_min(K) <= 1e-11 lambda_max(K)): (0, DEFLECTION_CAP) for a non-zero load (the field contract has no inf)."""
     r = p[_R]
-    u1 = x - r
-    u2 = x + r
-    ok1, c1, s1, g1 = _arm(u1, y, p[_L1], p[_L2], p[_S1])
-    ok2, c2, s2, g2 = _arm(u2, y, p[_L1], p[_L2], p[_S2])
-    if not ok1 or not ok2 or not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
-        return False, 0.0, math.inf
-    e1x, e1y, cc1 = _leg_compliance(p, u1, y, c1, s1)
-    e2x, e2y, cc2 = _leg_compliance(p, u2, y, c2, s2)
+    e1x, e1y, cc1 = _leg_compliance(p, x - r, y, c1, s1)
+    e2x, e2y, cc2 = _leg_compliance(p, x + r, y, c2, s2)
     kxx = e1x * e1x / cc1 + e2x * e2x / cc2
     kxy = e1x * e1y / cc1 + e2x * e2y / cc2
     kyy = e1y * e1y / cc1 + e2y * e2y / cc2
@@ -190,10 +184,51 @@ def point_stiffness(p, x, y, z):
     kmax = half + math.sqrt(diff * diff + kxy * kxy)
     kmin = det / kmax  # = lambda_min, without cancellation
     if not kmin > SINGULAR_RTOL * kmax:
-        return True, 0.0, math.inf if (p[_FX] != 0.0 or p[_FY] != 0.0) else 0.0
+        return 0.0, DEFLECTION_CAP if (p[_FX] != 0.0 or p[_FY] != 0.0) else 0.0
     dx = (kyy * p[_FX] - kxy * p[_FY]) / det
     dy = (kxx * p[_FY] - kxy * p[_FX]) / det
-    return True, kmin, math.sqrt(dx * dx + dy * dy)
+    return kmin, min(math.sqrt(dx * dx + dy * dy), DEFLECTION_CAP)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_fields(p, x, y, z, out):
+    """Fields at P = (x, y) in the packed working mode (kernels.grid contract): slots 0-2 LCI, sigma_min,
+    sigma_max of J = dx/dq (mm/rad); 3 stiffness_min (N/mm), 4 deflection (mm) under the packed load (ideal
+    joints, docs/stiffness.md); LCI -1 (and zeros) if unreachable; z unused."""
+    ok, c1, s1, c2, s2 = _kinematics(p, x, y, out)
+    if ok:
+        out[3], out[4] = _stiffness(p, x, y, c1, s1, c2, s2)
+
+
+DESIGN_METRICS = (
+    DesignMetric(
+        "link_length_sum", "{length}",
+        "arms and forearms of both chains: 2 (l1 + l2) (the parallelograms' second bars only keep the platform's "
+        "orientation and are not counted)",
+        lambda d, o: 2.0 * (d["l1"] + d["l2"]),
+    ),
+    DesignMetric(
+        "footprint_radius", "{length}",
+        "radius of the smallest circle in the base plane holding the active pivots B1, B2 = (+-r, 0): r",
+        lambda d, o: d["r"],
+    ),
+)
+
+
+def check_fivebar_stiffness_options(options: dict[str, Any]) -> None:
+    if options["forearm"] not in FOREARMS:
+        raise InvalidParameter(f"options.forearm: must be one of {', '.join(FOREARMS)}, got {options['forearm']!r}")
+    d = options["parallelogram_spacing"]
+    if isinstance(d, bool) or not isinstance(d, (int, float)) or not (math.isfinite(d) and d > 0):
+        raise InvalidParameter(f"options.parallelogram_spacing: must be a finite number > 0 (mm), got {d!r}")
+    options["parallelogram_spacing"] = float(d)
+    offs = options["parallelogram_offsets"]
+    if (not isinstance(offs, (list, tuple)) or len(offs) != 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in offs)):
+        raise InvalidParameter(f"options.parallelogram_offsets: expected [angle arm link, angle forearm link] rad, "
+                               f"got {offs!r}")
+    options["parallelogram_offsets"] = [float(v) for v in offs]
+    check_stiffness_options(options, 2, LINK_GROUPS)
 
 
 class PlanarFivebar(Mechanism):
@@ -228,8 +263,8 @@ class PlanarFivebar(Mechanism):
         return p
 
     @property
-    def point_kernel(self):
-        return point_lci
+    def field_kernel(self):
+        return point_fields
 
     def kernel_branch(self, options) -> str:
         return options["mode"]
@@ -363,17 +398,11 @@ class PlanarFivebar(Mechanism):
         return math.inf if j is None else float(np.linalg.norm(j @ dq))
 
     # ----- stiffness (scalesynth.stiffness) -------------------------------------------------------
-    def stiffness_field(self, options):
-        """The per-voxel field kernel (scalesynth.stiffness.fields contract): point_stiffness, ideal joints (for
-        which both forearm options give the same translational stiffness at P)."""
-        if options["joint_model"] != "ideal":
-            raise InvalidParameter("options.joint_model: per-voxel stiffness fields need 'ideal' joints; 'bonded' "
-                                   "is solved at single poses only (scalesynth stiffness)")
-        return point_stiffness
-
-    def stiffness_model(self, design, options, pose):
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
         """Frame model (scalesynth.stiffness.FrameModel, planar, mm, N) at pose P = (x, y) in the kernel's working
         mode; raises InvalidPose when P is outside the workspace (out of reach or outside the arm limits).
+        ``joints``: 'ideal' (the per-voxel fields' idealisation) or 'bonded' (every passive joint welded, as in an FE
+        model with bonded contacts; actuators stay springs).
 
         forearm 'single': the symmetric five-bar 5R (paper Fig. 7a, parallelograms removed); the platform is the pin
         P. 'parallelogram': the right chain as built (paper §1): arm parallelogram (arm + arm link, offset
@@ -387,7 +416,7 @@ class PlanarFivebar(Mechanism):
         branches = {s.label: s.values for s in self.inverse_kinematics(design, options, p)}
         q = branches.get(self.kernel_branch(options))
         packed = self.pack(design, options)
-        if q is None or point_lci(packed, p[0], p[1], 0.0) < 0.0:
+        if q is None or self.point_kernel(packed, p[0], p[1], 0.0) < 0.0:
             raise InvalidPose(f"pose: ({p[0]:g}, {p[1]:g}) is outside the workspace (mode {options['mode']}, "
                               "arm limits included)")
         r = design["r"]
@@ -401,7 +430,7 @@ class PlanarFivebar(Mechanism):
             s = sec[group]
             return Link(name, group, np.asarray(a, float), np.asarray(b, float), s.EA, s.EI, s.EI, s.GJ)
 
-        bonded = options["joint_model"] == "bonded"
+        bonded = joints == "bonded"
 
         def rev(name, at, a, b, stiffness=None):
             if bonded and stiffness is None:  # a passive joint welded shut (moment-carrying)
@@ -415,7 +444,7 @@ class PlanarFivebar(Mechanism):
                   rev("wrist2", p, "forearm2.b", "platform")]
         notes = ["planar frame in the xy plane; revolute axes along z; the load acts at P"]
         if bonded:
-            notes.append("joint_model bonded: every passive joint welded (carries moments), actuators stay springs")
+            notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
         if options["forearm"] == "single":
             joints.append(rev("wrist1", p, "forearm1.b", "platform"))
             bodies = [Body("base", np.zeros(2)), Body("platform", p.copy(), "rigid" if bonded else "point")]
@@ -497,8 +526,6 @@ MECHANISM = PlanarFivebar(
         Option("alpha1_limits", None, "[lo, hi] rad for alpha1 modulo 2 pi, null = none (spec: [-4pi/9, 7pi/36])"),
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
         Option("forearm", "single", "stiffness: 'single' (five-bar 5R) or 'parallelogram' (right chain PaPa, §1)"),
-        Option("joint_model", "ideal", "stiffness: 'ideal' passive joints (moment-free) or 'bonded' (welded, as in an "
-               "FE model with bonded contacts); actuators are springs in both"),
         Option("parallelogram_spacing", 60.0, "stiffness: bar spacing of the parallelograms, mm"),
         Option("parallelogram_offsets", [1.1780972450961724, -0.75],
                "stiffness: directions (rad from +x) of the arm-link and forearm-link offsets: perpendicular to the "
@@ -508,4 +535,12 @@ MECHANISM = PlanarFivebar(
                            "the base)"),
     ),
     default_length_unit="mm",
+    fields=(
+        *base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"),
+        Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness under a "
+              "pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
+        Field("deflection", "{length}", "magnitude of the platform's deflection under options.load (default 150 N "
+              "along -y); 1e12 at a singular pose", "min", (0.0, SIGMA_CAP)),
+    ),
+    design_metrics=DESIGN_METRICS,
 )

@@ -30,16 +30,23 @@ def _matrix(a: np.ndarray | None, n: int) -> list:
     return [[_num(v) for v in row] for row in a]
 
 
-def pose_stiffness(mech: Mechanism, design: Mapping[str, float], options: Mapping[str, Any], pose) -> dict:
+JOINT_MODELS = ("ideal", "bonded")
+
+
+def pose_stiffness(mech: Mechanism, design: Mapping[str, float], options: Mapping[str, Any], pose,
+                   joints: str = "ideal") -> dict:
     """Deflection under options['load'], compliance and stiffness of the platform DOFs, stiffness_min and the model
-    solved, every unit stated. Raises InvalidParameter for an unmodelled mechanism, InvalidPose outside the
-    workspace."""
+    solved, every unit stated. ``joints``: 'ideal' (moment-free passive joints, the per-voxel fields' model) or
+    'bonded' (passive joints welded). Raises InvalidParameter for an unmodelled mechanism or a bad ``joints``,
+    InvalidPose outside the workspace."""
+    if joints not in JOINT_MODELS:
+        raise InvalidParameter(f"--joints: must be one of {', '.join(JOINT_MODELS)}, got {joints!r}")
     if not modelled(mech):
         from scalesynth.mechanisms import available, get
 
         names = [n for n in available() if modelled(get(n))]
         raise InvalidParameter(f"mechanism: no stiffness model for {mech.name} yet (modelled: {', '.join(names)})")
-    model = mech.stiffness_model(design, options, pose)
+    model = mech.stiffness_model(design, options, pose, joints)
     res = solve(model)
     u = model.length_unit
     n = len(res.dofs)
@@ -47,6 +54,7 @@ def pose_stiffness(mech: Mechanism, design: Mapping[str, float], options: Mappin
         "mechanism": mech.name,
         "pose": [float(v) for v in pose],
         "branch": mech.kernel_branch(options),
+        "joints": joints,
         "units": {"length": u, "force": "N", "deflection": u, "compliance": f"{u}/N (translations), rad/(N*{u}) "
                   "(rotations)", "stiffness": f"N/{u} (translations), N*{u}/rad (rotations)",
                   "stiffness_min": f"N/{u}"},
