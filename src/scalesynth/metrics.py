@@ -152,7 +152,7 @@ def _field_entries(mech: Mechanism, f: Field, length_unit: str, family: str) -> 
         out.append(Metric(
             name=name, column=column, family=family, field=f.name, statistic=stat, unit=unit, range=rng,
             better=better, worst=rng[1] if math.isfinite(rng[1]) else None, needs=needs,
-            description=f"{_STAT_WORDS[stat]} of {f.name} over {region}: {f.description} ({unit})",
+            description=f"{_STAT_WORDS[stat]} of {f.name} over {region}" + (f" ({unit})" if unit != "1" else ""),
         ))
     return out
 
