@@ -6,17 +6,22 @@ import json
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from Pynite import FEModel3D
 from typer.testing import CliRunner
 
 from scalesynth.cli import app
+from scalesynth.config import load_config
+from scalesynth.evaluate import evaluate_config
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.planar_fivebar import DEFLECTION_CAP, point_fields
+from scalesynth.optimize import run
 from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
 from scalesynth.stiffness.sections import tube_section
 from scalesynth.stiffness.solve import solve
 
+from conftest import ROOT
 from fe_pynite import solve_model
 
 M = get("planar-fivebar")
@@ -307,3 +312,38 @@ def test_pose_outside_workspace_exit_2():
                                        "--set", f"alpha1_limits={LIMITS['alpha1_limits']}",
                                        "--set", f"alpha2_limits={LIMITS['alpha2_limits']}"])
         assert out.exit_code == 2 and out.output.strip().startswith("error: pose:"), out.output
+
+
+# ----- catalogue metrics: evaluate reports them, synthesis constrains them -------------------------------------------
+def test_evaluate_reports_stiffness_metrics_equal_to_reference():
+    """`evaluate configs/fivebar_packing.yaml` has the stiffness statistics; over the task box they equal the
+    NumPy reference solved at every cell centre."""
+    cfg = load_config(ROOT / "configs" / "fivebar_packing.yaml", ["grid.resolution=16", "task.resolution=8"])
+    rep = evaluate_config(cfg).to_dict()
+    opt = cfg.resolved_options()
+    defl, kmin = [], []
+    for x in -500 + (np.arange(8) + 0.5) * 125.0:
+        for y in -850 + (np.arange(8) + 0.5) * 250.0 / 8:
+            res = solve(model(opt, (x, y), design=cfg.resolved_design()))
+            defl.append(res.deflection_norm)
+            kmin.append(res.stiffness_min)
+    assert rep["task_coverage"] == 1.0
+    assert rep["task_max_deflection_mm"] == pytest.approx(max(defl), rel=1e-9)
+    assert rep["task_mean_deflection_mm"] == pytest.approx(np.mean(defl), rel=1e-9)
+    assert rep["task_min_stiffness_min_N_per_mm"] == pytest.approx(min(kmin), rel=1e-9)
+    for key in ("max_deflection_mm", "min_stiffness_min_N_per_mm", "mean_deflection_mm"):
+        assert math.isfinite(rep[key]) and rep[key] > 0
+
+
+def test_synthesis_with_a_deflection_constraint(tmp_path):
+    """configs/fivebar_stiffness.yaml (task_max_deflection <= 0.1 mm) runs; feasibility follows the constraint."""
+    cfg = load_config(ROOT / "configs" / "fivebar_stiffness.yaml",
+                      ["algorithm.pop_size=8", "algorithm.n_gen=2", "grid.resolution=16", "task.resolution=8",
+                       "design.r=200"])
+    run(cfg, tmp_path / "out", plots=False)
+    pop = pd.read_csv(tmp_path / "out" / "population.csv")
+    assert "task_max_deflection_mm" in pop.columns
+    ok = (pop["task_max_deflection_mm"] <= 0.1) & (pop["task_coverage"] >= 1.0) & (pop["path_min_lci"] >= 0.3)
+    assert (pop["feasible"].astype(bool) == ok).all()
+    front = pd.read_csv(tmp_path / "out" / "pareto.csv")
+    assert (front["task_max_deflection_mm"] <= 0.1).all()
