@@ -16,7 +16,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cli import SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 
 
