@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import JsonOpt, SetOpt, _mech_inputs, _parse_vector, _print_json, app, handles_errors
+from scalesynth.cliapp import JsonOpt, SetOpt, _mech_inputs, _parse_vector, _print_json, app, handles_errors
 
 
 @app.command("stiffness")
