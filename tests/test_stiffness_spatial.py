@@ -1,13 +1,20 @@
-"""The reference stiffness solver on spatial frames (6 DOFs per node) against closed forms, and PyNite on the space
-cantilever: the code paths the spatial mechanisms will use (arbitrary revolute axes, universal, spherical and
-prismatic joints, torsion)."""
+"""The reference stiffness solver on spatial frames (6 DOFs per node) against closed forms and PyNite (arbitrary
+revolute axes, universal, spherical and prismatic joints, torsion), then seed 003 (ups-sspr) against PyNite rebuilt
+from the reported model and against the mechanism's own Jacobian."""
+
+import json
 
 import numpy as np
 import pytest
 from Pynite import FEModel3D
+from typer.testing import CliRunner
 
+from scalesynth.cli import app
+from scalesynth.mechanisms import get
 from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
 from scalesynth.stiffness.solve import solve
+
+from fe_pynite import solve_model
 
 E, G = 70e3, 70e3 / 2.66  # N/mm^2
 A, IY, IZ, J = 348.7, 60066.0, 30000.0, 120132.0  # mm^2, mm^4 (unequal bending axes on purpose)
@@ -111,3 +118,68 @@ def test_prismatic_actuator_in_a_leg():
     # local y = up = global x: bending towards x uses EIz (deflection along local y)
     assert res.C[0, 0] == pytest.approx((2 * L) ** 3 / (3 * EIZ), rel=1e-10)
     assert res.C[1, 1] == pytest.approx((2 * L) ** 3 / (3 * EIY), rel=1e-10)
+
+
+# ----- seed 003 (ups-sspr): the spatial mechanism against PyNite and its Jacobian model --------------------------
+UPS = get("ups-sspr")
+UPS_DESIGN = UPS.resolve_design({})  # a = 100, b = 80 (placeholders), c = 120 mm
+# poses (alpha, beta, Y): the lowest-LCI cells of the default workspace (alpha at its bound 0.5, LCI 0.092), the
+# centre, a generic pose, the highest-LCI region (LCI 0.146), near the lowest Y (the l1 limit) and a box corner
+UPS_POSES = [(0.5, 0.25, 47.6), (0.5, -0.25, 47.6), (0.0, 0.0, 0.0), (0.1, 0.2, 10.0), (-0.3, 0.0, 3.97),
+             (0.0, 0.0, -35.0), (-0.5, -0.5, 20.0)]
+
+
+def ups_model(pose, joints="ideal", **opts):
+    return UPS.stiffness_model(UPS_DESIGN, UPS.resolve_options(opts), pose, joints)
+
+
+@pytest.mark.parametrize("joints", ["ideal", "bonded"])
+@pytest.mark.parametrize("pose", UPS_POSES)
+def test_ups_sspr_against_pynite(pose, joints):
+    m = ups_model(pose, joints, load=[10.0, 20.0, -150.0])
+    ours = solve(m).deflection
+    fe = solve_model(m.to_dict())
+    assert np.max(np.abs(fe - ours)) / np.linalg.norm(ours) < 1e-3  # issue 12: 0.1 %; measured <= 2e-5
+
+
+def test_ups_sspr_rigid_links_give_the_jacobian_model():
+    """Links e times stiffer: the translational compliance of B1 tends to T J K^-1 J^T T^T, J = d(alpha, beta, Y)/dl
+    of the mechanism's kinematics and T = dP/d(alpha, beta, Y), the gap ~ 1/e."""
+    pose = (0.1, 0.2, 10.0)
+    alpha, beta, yy = pose
+    c = UPS_DESIGN["c"]
+    rho = np.sqrt(c * c - yy * yy)
+    J = UPS.jacobians(UPS_DESIGN, UPS.resolve_options({}), pose)["J"]
+    T = np.array([[0.0, np.cos(beta) * rho, -np.sin(beta) * yy / rho], [0.0, 0.0, 1.0],
+                  [0.0, -np.sin(beta) * rho, -np.cos(beta) * yy / rho]])
+    k = 2e4
+    cj = T @ J @ J.T @ T.T / k
+    gaps = []
+    for e in (1e3, 1e4, 1e5):
+        C = solve(ups_model(pose, youngs_modulus=70 * e, actuator_stiffness=k)).C_t
+        gaps.append(np.max(np.abs(C - cj)) / np.max(np.abs(cj)))
+    assert gaps[2] < 1e-4
+    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+
+
+def test_ups_sspr_spd_and_linear():
+    for pose in UPS_POSES:
+        res = solve(ups_model(pose))
+        assert not res.singular and res.K.shape == (6, 6)
+        assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
+        assert np.linalg.eigvalsh(res.K)[0] > 0
+    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
+    d1, d2, d3 = (solve(ups_model(UPS_POSES[3], load=f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
+    assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+
+
+def test_ups_sspr_cli_model_rebuilds_in_pynite():
+    out = CliRunner().invoke(app, ["stiffness", "ups-sspr", "--pose=0.5,0.25,47.6", "--load=0,30,-150", "--json"])
+    assert out.exit_code == 0, out.output
+    data = json.loads(out.output)
+    assert data["dofs"] == ["x", "y", "z", "rx", "ry", "rz"]
+    assert np.max(np.abs(np.subtract(data["deflection"], solve_model(data["model"])))) < 1e-3 * data["deflection_norm"]
+    for args, field in ((["--pose=0.9,0,0"], "pose"), (["--pose=0,0,0", "--load=1,2"], "--load"),
+                        (["--pose=0,0,0", "--set", "sections={leg: [10, 6]}"], "options.sections.leg")):
+        bad = CliRunner().invoke(app, ["stiffness", "ups-sspr", *args])
+        assert bad.exit_code == 2 and bad.output.strip().startswith(f"error: {field}"), bad.output

@@ -34,7 +34,10 @@ def stiffness_cmd(
         _print_json(out)
         return
     u = out["units"]["length"]
-    typer.echo(f"{mech.name} at pose {', '.join(f'{v:g}' for v in out['pose'])} ({u}), mode {out['branch']}, "
+    units = {"length": u, "angle": "rad"}
+    where = ", ".join(f"{a}={v:g} {units[t]}" for a, t, v in zip(mech.task_axes, mech.task_units, out["pose"],
+                                                                     strict=True))
+    typer.echo(f"{mech.name} at {where}, mode {out['branch']}, "
                f"{joints} joints, "
                f"load {out['load']} N")
     fmt = "{:.6g}".format
