@@ -347,3 +347,18 @@ def test_synthesis_with_a_deflection_constraint(tmp_path):
     assert (pop["feasible"].astype(bool) == ok).all()
     front = pd.read_csv(tmp_path / "out" / "pareto.csv")
     assert (front["task_max_deflection_mm"] <= 0.1).all()
+
+
+def test_plot_task_maps_the_deflection(tmp_path):
+    """`plot-task --field deflection`: its extremes are the task-box statistics of evaluate; unknown field: exit 2."""
+    cfgp = str(ROOT / "configs" / "fivebar_stiffness.yaml")
+    out = CliRunner().invoke(app, ["plot-task", cfgp, "--field", "deflection", "--resolution", "16",
+                                   "--out", str(tmp_path / "d.png"), "--json"])
+    assert out.exit_code == 0, out.output
+    data = json.loads(out.output)
+    assert (tmp_path / "d.png").stat().st_size > 0
+    rep = evaluate_config(load_config(cfgp, ["task.resolution=16"])).to_dict()
+    assert data["task_max_deflection"] == pytest.approx(rep["task_max_deflection_mm"], rel=1e-12)
+    assert data["task_min_deflection"] == pytest.approx(rep["task_min_deflection_mm"], rel=1e-12)
+    bad = CliRunner().invoke(app, ["plot-task", cfgp, "--field", "bogus", "--out", str(tmp_path / "x.png")])
+    assert bad.exit_code == 2 and "--field" in bad.output and not (tmp_path / "x.png").exists()
