@@ -88,7 +88,7 @@ def evaluate_cmd(
         label = key
         if key.startswith("band") and key.endswith("_share"):
             b = int(key[4:-6])
-            label = f"{key} (LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}])"
+            label = f"{key} (band {b}: LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}])"
         typer.echo(f"  {label:<34} {value:.6g}")
     typer.echo(
         f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
