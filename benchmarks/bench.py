@@ -6,6 +6,7 @@
     python benchmarks/bench.py paper        # the paper-scale synthesis in a fresh process: wall time, peak memory
     python benchmarks/bench.py growth       # time against N and against population size
     python benchmarks/bench.py compile      # JIT: first call (empty cache) vs second process (cache)
+    python benchmarks/bench.py stiffness    # five-bar stiffness fields vs the kinematic fields alone, per voxel
     python benchmarks/bench.py fastpath     # seed 000's fast path: this tree vs a baseline git ref (default main)
 
 Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
@@ -212,6 +213,47 @@ def bench_compile() -> dict:
     return out
 
 
+def bench_stiffness(n_designs: int = 40, n: int = 256, repeat: int = 5) -> dict:
+    """Per-voxel cost of the five-bar's stiffness fields: the full field kernel (LCI, sigma_min, sigma_max,
+    stiffness_min, deflection) against the kinematic part alone (LCI, sigma_min, sigma_max), same designs, grids and
+    process, timed alternately (best of ``repeat``)."""
+    from scalesynth.mechanisms import planar_fivebar as pf
+
+    cfg = load_config(ROOT / "configs" / "fivebar_stiffness.yaml")
+    mech, opts = cfg.mech, cfg.resolved_options()
+    rng = np.random.default_rng(12)
+    designs = [mech.resolve_design({k: float(rng.uniform(*cfg.bounds[k])) for k in cfg.bounds}) for _ in range(n_designs)]
+    packed = np.stack([mech.pack(d, opts) for d in designs])
+    grids = [make_grid(mech, d, opts, n) for d in designs]
+    lo = np.stack([g.lo for g in grids])
+    step = np.stack([g.step for g in grids])
+    shape = grids[0].shape
+
+    def kinematic():
+        return kgrid.population_stats(pf.kinematic_fields, 3, packed, lo, step, shape, EDGES)
+
+    def full():
+        return kgrid.population_stats(pf.point_fields, 5, packed, lo, step, shape, EDGES)
+
+    kinematic()
+    full()
+    t_kin, t_full = [], []
+    for _ in range(repeat):
+        for fn, acc in ((kinematic, t_kin), (full, t_full)):
+            t0 = time.perf_counter()
+            fn()
+            acc.append(time.perf_counter() - t0)
+    voxels = n_designs * n * n
+    reachable = float(full()[:, 0].sum())
+    out = {"designs": n_designs, "N": n, "voxels": voxels, "reachable_voxels": reachable,
+           "kinematic_s": min(t_kin), "full_s": min(t_full), "ratio": min(t_full) / min(t_kin),
+           "ns_per_reachable_voxel_kinematic": 1e9 * min(t_kin) / reachable,
+           "ns_per_reachable_voxel_full": 1e9 * min(t_full) / reachable}
+    print(f"stiffness: kinematic {out['kinematic_s']:.4f} s, with stiffness {out['full_s']:.4f} s, "
+          f"ratio {out['ratio']:.2f}", flush=True)
+    return out
+
+
 # Throughput of seed 000's fast path (M.grid_stats) on the Table-4 designs, best of 7 after a warm-up, in CPU time
 # of the process (one Numba thread: on a shared, loaded machine wall time measures the other jobs); run in a
 # subprocess on either source tree (PYTHONPATH), so that the baseline and this tree are measured alike.
@@ -264,7 +306,7 @@ def bench_fastpath(baseline: str = "main", rounds: int = 3) -> dict:
 
 
 PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": bench_paper, "growth": bench_growth,
-         "compile": bench_compile, "fastpath": bench_fastpath}
+         "compile": bench_compile, "fastpath": bench_fastpath, "stiffness": bench_stiffness}
 
 
 def write_results_md() -> None:
@@ -275,7 +317,7 @@ def write_results_md() -> None:
             data[name] = json.loads(path.read_text())
     lines = ["# Benchmark results", "",
              "Rebuilt by `python benchmarks/bench.py all` (or one part: `evaluator`, `accuracy`, `paper`, `growth`,",
-             "`compile`). Each section states the machine and date it was measured on.", ""]
+             "`compile`, `fastpath`, `stiffness`). Each section states the machine and date it was measured on.", ""]
     lines += _targets(data)
     if "evaluator" in data:
         d = data["evaluator"]
@@ -329,6 +371,17 @@ def write_results_md() -> None:
                   "", "| process | import (s) | first evaluate, incl. compile or cache load (s) |", "|---|---|---|",
                   f"| first (empty cache) | {r['empty_cache']['import_s']:.2f} | {r['empty_cache']['first_evaluate_s']:.2f} |",
                   f"| second (cached) | {r['cached']['import_s']:.2f} | {r['cached']['first_evaluate_s']:.2f} |", ""]
+    if "stiffness" in data:
+        r = data["stiffness"]["result"]
+        lines += _header("Per-voxel cost of the stiffness fields (seed-004 five-bar)", data["stiffness"])
+        lines += [f"{r['designs']} random designs in the bounds of `configs/fivebar_stiffness.yaml`, {r['N']}^2 grids over",
+                  "their bounding boxes, the generic grid evaluator; best of 5, the two kernels timed alternately in one",
+                  "process. `kinematic` = LCI, sigma_min, sigma_max (the field kernel without stiffness); `with stiffness`",
+                  "adds stiffness_min and deflection (per-leg closed-form condensation, 2x2 platform stiffness).", "",
+                  "| kernel | seconds | ns per reachable voxel |", "|---|---|---|",
+                  f"| kinematic fields | {r['kinematic_s']:.4f} | {r['ns_per_reachable_voxel_kinematic']:.2f} |",
+                  f"| with stiffness | {r['full_s']:.4f} | {r['ns_per_reachable_voxel_full']:.2f} |",
+                  "", f"Ratio **{r['ratio']:.2f}** (target <= 3).", ""]
     if "fastpath" in data:
         r = data["fastpath"]["result"]
         lines += _header("Seed 000 fast path: before and after the multi-field kernels (issue 10)", data["fastpath"])
@@ -374,6 +427,9 @@ def _targets(data: dict) -> list[str]:
         c = data["compile"]["result"]
         rows.append(("second process reuses compiled code", f"{c['empty_cache']['first_evaluate_s']:.1f} s -> "
                      f"{c['cached']['first_evaluate_s']:.2f} s", c["cached"]["first_evaluate_s"] < c["empty_cache"]["first_evaluate_s"] / 5))
+    if "stiffness" in data:
+        r = data["stiffness"]["result"]
+        rows.append(("stiffness fields cost <= 3x the kinematic fields per voxel", f"{r['ratio']:.2f}x", r["ratio"] <= 3))
     if not rows:
         return []
     out = ["## Targets", "", "| target | measured | met |", "|---|---|---|"]

@@ -26,6 +26,9 @@ class TaskMap:
     ys: np.ndarray
     lci: np.ndarray
     path: np.ndarray | None  # (n, 2) vertices of the task path, or None
+    field: str = "lci"  # the field drawn (a name of mech.fields), its values (-1 unreachable) and colour-bar label
+    values: np.ndarray | None = None
+    label: str = "LCI"
 
     @property
     def coverage(self) -> float:
@@ -42,9 +45,10 @@ class TaskMap:
         return float(v.std()) if v.size else 0.0
 
 
-def task_map(cfg, resolution: int | None = None) -> TaskMap:
+def task_map(cfg, resolution: int | None = None, field: str = "lci") -> TaskMap:
     """Sample the config design's point kernel on the task box (``resolution`` cells per axis; default the
-    task's, else the grid's). Raises ConfigError for a non-planar mechanism or a config without a task."""
+    task's, else the grid's), and the field ``field`` of the mechanism's field kernel (e.g. 'deflection', a
+    stiffness map). Raises ConfigError for a non-planar mechanism, a config without a task or an unknown field."""
     from scalesynth.kernels.grid import sample_grid
 
     mech = cfg.mech
@@ -68,7 +72,18 @@ def task_map(cfg, resolution: int | None = None) -> TaskMap:
     xs = lo[0] + (np.arange(res) + 0.5) * step[0]
     ys = lo[1] + (np.arange(res) + 0.5) * step[1]
     path = None if cfg.task.path is None else np.asarray(cfg.task.path, dtype=float)
-    return TaskMap(xs=xs, ys=ys, lci=lci, path=path)
+    if field == "lci":
+        return TaskMap(xs=xs, ys=ys, lci=lci, path=path)
+    if field not in mech.field_names:
+        raise ConfigError(f"--field: unknown field {field!r} of {mech.name} (fields: {', '.join(mech.field_names)})")
+    from scalesynth.kernels.grid import sample_fields
+
+    slot = mech.field_names.index(field)
+    spec = mech.fields[slot]
+    vals = sample_fields(mech.field_kernel, mech.n_fields, packed, lo, step, shape)[:, :, 0, slot]
+    vals = np.where(lci >= 0, vals, -1.0)
+    label = f"{field} ({spec.unit.replace('{length}', cfg.units.length)})"
+    return TaskMap(xs=xs, ys=ys, lci=lci, path=path, field=field, values=vals, label=label)
 
 
 def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
@@ -83,10 +98,11 @@ def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
     extent = (tm.xs[0] - dx / 2, tm.xs[-1] + dx / 2, tm.ys[0] - dy / 2, tm.ys[-1] + dy / 2)
     width, height = extent[1] - extent[0], extent[3] - extent[2]
     fig, ax = plt.subplots(figsize=(9.0, float(np.clip(7.0 * height / width + 2.0, 3.5, 9.0))))
-    masked = np.ma.masked_less(tm.lci.T, 0.0)
+    shown = tm.lci if tm.values is None else tm.values
+    masked = np.ma.masked_where(tm.lci.T < 0.0, shown.T)
     img = ax.imshow(masked, origin="lower", extent=extent, cmap="viridis", aspect="equal", interpolation="nearest")
     # colour bar as tall as the (equal-aspect) map
-    fig.colorbar(img, ax=ax, label="LCI", fraction=0.046 * min(height / width, 1.0), pad=0.02)
+    fig.colorbar(img, ax=ax, label=tm.label, fraction=0.046 * min(height / width, 1.0), pad=0.02)
     if tm.path is not None:
         ax.plot(tm.path[:, 0], tm.path[:, 1], "-", c="C3", lw=1.5, marker="o", ms=5, zorder=4, label="task path")
         visits: dict[tuple[float, float], list[str]] = {}  # a pick-and-place path revisits its vertices
@@ -120,15 +136,18 @@ def plot_task_cmd(
     out: Annotated[Path | None, typer.Option("--out", help="PNG to write (default OUTDIR/plots/task_lci.png)")] = None,
     sets: SetOpt = None,
     resolution: Annotated[int | None, typer.Option(help="cells per axis (default task/grid resolution)")] = None,
+    field: Annotated[str, typer.Option("--field", help="field to map: lci or any of the mechanism's fields, e.g. "
+                                       "deflection or stiffness_min (see `scalesynth metrics MECH`)")] = "lci",
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
 ) -> None:
-    """LCI over the task box (unreachable cells blank) with the task path, as a PNG."""
+    """LCI (or another field, e.g. the deflection under the load) over the task box (unreachable cells blank) with
+    the task path, as a PNG."""
     import matplotlib.pyplot as plt
 
     from scalesynth.config import load_config
 
     cfg = load_config(config, list(sets or []))
-    tm = task_map(cfg, resolution)
+    tm = task_map(cfg, resolution, field)
     unit = cfg.units.length
     design = ", ".join(f"{k}={v:g}" for k, v in cfg.resolved_design().items())
     cells = f"{tm.lci.shape[0]}x{tm.lci.shape[1]} cells"
@@ -136,8 +155,11 @@ def plot_task_cmd(
         f"{cfg.mech.name} ({design} {unit}), mode {cfg.resolved_options().get('mode', '-')}\n"
         f"task coverage {tm.coverage:.4f}, GCI {tm.gci:.4f}, FCI {tm.fci:.4f} ({cells})"
     )
+    if tm.values is not None:
+        v = tm.values[tm.lci >= 0]
+        title += f"\n{tm.label}: {v.min():.4g} ... {v.max():.4g}" if v.size else ""
     fig = task_figure(tm, cfg.mech.task_axes[:2], unit, title)
-    target = out or cfg.output_dir() / "plots" / "task_lci.png"
+    target = out or cfg.output_dir() / "plots" / f"task_{field}.png"
     try:
         _save_atomic(fig, target)
     finally:

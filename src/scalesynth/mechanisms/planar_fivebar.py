@@ -35,6 +35,7 @@ from scalesynth.kernels.conditioning import SIGMA_CAP, sv_2x2
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -45,15 +46,26 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
+from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 MODES = ("++", "+-", "-+", "--")
+FOREARMS = ("single", "parallelogram")
+LINK_GROUPS = ("arm", "forearm", "arm_link", "forearm_link")
+# default actuator stiffness: 1e5 N m/rad (a servo with a stiff precision reducer), in N mm/rad
+ACTUATOR_STIFFNESS = 1e8
 TWO_PI = 2.0 * math.pi
 
 # packed-parameter layout (see PlanarFivebar.pack); arm limit i occupies 6 slots from _LIM[i]:
 # has, cos lo, sin lo, cos hi, sin hi, wide (1 if hi - lo > pi)
 _R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
 _LIM1, _LIM2 = 5, 11
-N_PACKED = 17
+# stiffness slots (point_fields slots 3, 4): arm EA (N), arm EI (N mm^2), forearm EA (N), actuator stiffness (N mm/rad),
+# load Fx, Fy (N)
+_EA1, _EI1, _EA2, _KACT, _FX, _FY = 17, 18, 19, 20, 21, 22
+N_PACKED = 23
+# eigenvalue ratio (smallest / largest) at or below which the platform stiffness is singular (as stiffness.solve)
+SINGULAR_RTOL = 1e-11
+DEFLECTION_CAP = SIGMA_CAP  # mm: the per-voxel deflection at a singular pose (the field contract has no inf)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -96,26 +108,20 @@ def _arc_ok(p, k, c, s):
     return after_lo and before_hi
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def point_fields(p, x, y, z, out):
-    """Fields at P = (x, y) in the packed working mode (kernels.grid contract): LCI (sigma_min/sigma_max of J),
-    sigma_min and sigma_max of J = dx/dq (mm/rad); LCI -1 if unreachable; z unused."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _kinematics(p, x, y, out):
+    """Slots 0-2 at P = (x, y) in the packed working mode: LCI (sigma_min/sigma_max of J), sigma_min and sigma_max
+    of J = dx/dq (mm/rad); unreachable: write_unreachable. Returns (ok, cos, sin of alpha1, cos, sin of alpha2)."""
     r = p[_R]
     l1 = p[_L1]
     l2 = p[_L2]
     u1 = x - r
     u2 = x + r
     ok1, c1, s1, g1 = _arm(u1, y, l1, l2, p[_S1])
-    if not ok1:
-        _grid.write_unreachable(out)
-        return
     ok2, c2, s2, g2 = _arm(u2, y, l1, l2, p[_S2])
-    if not ok2:
+    if not ok1 or not ok2 or not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
         _grid.write_unreachable(out)
-        return
-    if not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
-        _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1
@@ -131,9 +137,67 @@ def point_fields(p, x, y, z, out):
     if not det2 * SIGMA_CAP > smax:  # forward singularity: J unbounded
         out[1] = 0.0
         out[2] = SIGMA_CAP
-        return
-    out[1] = smin / det2
-    out[2] = smax / det2
+    else:
+        out[1] = smin / det2
+        out[2] = smax / det2
+    return True, c1, s1, c2, s2
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, x, y, z, out):
+    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
+    the LCI alone) and the stiffness twin tests."""
+    _kinematics(p, x, y, out)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_compliance(p, u, y, c, s):
+    """Compliance (mm/N) of one RRR chain along its forearm, ideal joints: the forearm (a pinned bar) stretches,
+    and the arm tip Q moves as a cantilever on a torsional actuator spring under the forearm force. Returns the
+    forearm unit vector (ex, ey) and the compliance. (u, y) = P - B_i, (c, s) = cos, sin of the arm angle."""
+    l1 = p[_L1]
+    l2 = p[_L2]
+    ex = (u - l1 * c) / l2
+    ey = (y - l1 * s) / l2
+    along = ex * c + ey * s  # forearm direction . arm direction
+    across = ey * c - ex * s  # forearm direction . arm normal
+    bend = l1 * l1 * l1 / (3.0 * p[_EI1]) + l1 * l1 / p[_KACT]
+    return ex, ey, l2 / p[_EA2] + along * along * l1 / p[_EA1] + across * across * bend
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _stiffness(p, x, y, c1, s1, c2, s2):
+    """(stiffness_min N/mm, deflection mm) at a reachable P, ideal joints: platform stiffness
+    K = sum_i u_i u_i^T / c_i (u_i forearm unit vector, c_i its chain's compliance: a per-leg condensation), its
+    smallest eigenvalue and |K^-1 F| under the packed load F. Under ideal joints the parallelograms carry no force
+    from a load at P (moment balance about P), so this holds for both forearm options. At a singular pose
+    (lambda_min(K) <= 1e-11 lambda_max(K)): (0, DEFLECTION_CAP) for a non-zero load (the field contract has no inf)."""
+    r = p[_R]
+    e1x, e1y, cc1 = _leg_compliance(p, x - r, y, c1, s1)
+    e2x, e2y, cc2 = _leg_compliance(p, x + r, y, c2, s2)
+    kxx = e1x * e1x / cc1 + e2x * e2x / cc2
+    kxy = e1x * e1y / cc1 + e2x * e2y / cc2
+    kyy = e1y * e1y / cc1 + e2y * e2y / cc2
+    det = kxx * kyy - kxy * kxy
+    half = 0.5 * (kxx + kyy)
+    diff = 0.5 * (kxx - kyy)
+    kmax = half + math.sqrt(diff * diff + kxy * kxy)
+    kmin = det / kmax  # = lambda_min, without cancellation
+    if not kmin > SINGULAR_RTOL * kmax:
+        return 0.0, DEFLECTION_CAP if (p[_FX] != 0.0 or p[_FY] != 0.0) else 0.0
+    dx = (kyy * p[_FX] - kxy * p[_FY]) / det
+    dy = (kxx * p[_FY] - kxy * p[_FX]) / det
+    return kmin, min(math.sqrt(dx * dx + dy * dy), DEFLECTION_CAP)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_fields(p, x, y, z, out):
+    """Fields at P = (x, y) in the packed working mode (kernels.grid contract): slots 0-2 LCI, sigma_min,
+    sigma_max of J = dx/dq (mm/rad); 3 stiffness_min (N/mm), 4 deflection (mm) under the packed load (ideal
+    joints, docs/stiffness.md); LCI -1 (and zeros) if unreachable; z unused."""
+    ok, c1, s1, c2, s2 = _kinematics(p, x, y, out)
+    if ok:
+        out[3], out[4] = _stiffness(p, x, y, c1, s1, c2, s2)
 
 
 DESIGN_METRICS = (
@@ -151,6 +215,22 @@ DESIGN_METRICS = (
 )
 
 
+def check_fivebar_stiffness_options(options: dict[str, Any]) -> None:
+    if options["forearm"] not in FOREARMS:
+        raise InvalidParameter(f"options.forearm: must be one of {', '.join(FOREARMS)}, got {options['forearm']!r}")
+    d = options["parallelogram_spacing"]
+    if isinstance(d, bool) or not isinstance(d, (int, float)) or not (math.isfinite(d) and d > 0):
+        raise InvalidParameter(f"options.parallelogram_spacing: must be a finite number > 0 (mm), got {d!r}")
+    options["parallelogram_spacing"] = float(d)
+    offs = options["parallelogram_offsets"]
+    if (not isinstance(offs, (list, tuple)) or len(offs) != 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in offs)):
+        raise InvalidParameter(f"options.parallelogram_offsets: expected [angle arm link, angle forearm link] rad, "
+                               f"got {offs!r}")
+    options["parallelogram_offsets"] = [float(v) for v in offs]
+    check_stiffness_options(options, 2, LINK_GROUPS)
+
+
 class PlanarFivebar(Mechanism):
     """Seed-004 mechanism; see module docstring."""
 
@@ -159,6 +239,7 @@ class PlanarFivebar(Mechanism):
             raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
         for name in ("alpha1_limits", "alpha2_limits"):
             options[name] = parse_range(name, options[name])
+        check_fivebar_stiffness_options(options)
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(N_PACKED)
@@ -173,6 +254,12 @@ class PlanarFivebar(Mechanism):
             if lim is not None and lim[1] - lim[0] < TWO_PI:  # a full turn or more restricts nothing
                 lo, hi = lim
                 p[k : k + 6] = (1.0, math.cos(lo), math.sin(lo), math.cos(hi), math.sin(hi), hi - lo > math.pi)
+        from scalesynth.stiffness.sections import tube_section
+
+        arm, fore = tube_section(options, "arm", "mm"), tube_section(options, "forearm", "mm")
+        p[_EA1], p[_EI1], p[_EA2] = arm.EA, arm.EI, fore.EA
+        p[_KACT] = options["actuator_stiffness"]
+        p[_FX], p[_FY] = options["load"]
         return p
 
     @property
@@ -310,6 +397,76 @@ class PlanarFivebar(Mechanism):
         j = self.jacobians(design, options, pose, branches[self.kernel_branch(options)])["J"]
         return math.inf if j is None else float(np.linalg.norm(j @ dq))
 
+    # ----- stiffness (scalesynth.stiffness) -------------------------------------------------------
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, planar, mm, N) at pose P = (x, y) in the kernel's working
+        mode; raises InvalidPose when P is outside the workspace (out of reach or outside the arm limits).
+        ``joints``: 'ideal' (the per-voxel fields' idealisation) or 'bonded' (every passive joint welded, as in an FE
+        model with bonded contacts; actuators stay springs).
+
+        forearm 'single': the symmetric five-bar 5R (paper Fig. 7a, parallelograms removed); the platform is the pin
+        P. 'parallelogram': the right chain as built (paper §1): arm parallelogram (arm + arm link, offset
+        parallelogram_spacing along the fixed direction parallelogram_offsets[0]) carrying a rigid hinge plate, then
+        the forearm parallelogram (forearm + forearm link, offset along parallelogram_offsets[1]) carrying the rigid
+        platform; the left chain stays arm + forearm. Actuators: torsional springs at B1, B2 between arm and base."""
+        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.sections import tube_section
+
+        p = self.check_vector("pose", pose, 2)
+        branches = {s.label: s.values for s in self.inverse_kinematics(design, options, p)}
+        q = branches.get(self.kernel_branch(options))
+        packed = self.pack(design, options)
+        if q is None or self.point_kernel(packed, p[0], p[1], 0.0) < 0.0:
+            raise InvalidPose(f"pose: ({p[0]:g}, {p[1]:g}) is outside the workspace (mode {options['mode']}, "
+                              "arm limits included)")
+        r = design["r"]
+        q1, q2 = self.elbows(design, q)
+        b1, b2 = np.array([r, 0.0]), np.array([-r, 0.0])
+        z = np.array([0.0, 0.0, 1.0])
+        k = options["actuator_stiffness"]
+        sec = {g: tube_section(options, g, "mm") for g in LINK_GROUPS}
+
+        def link(name, group, a, b):
+            s = sec[group]
+            return Link(name, group, np.asarray(a, float), np.asarray(b, float), s.EA, s.EI, s.EI, s.GJ)
+
+        bonded = joints == "bonded"
+
+        def rev(name, at, a, b, stiffness=None):
+            if bonded and stiffness is None:  # a passive joint welded shut (moment-carrying)
+                return Joint(name, "fixed", np.asarray(at, float), (a, b))
+            return Joint(name, "revolute", np.asarray(at, float), (a, b), (z,), stiffness)
+
+        links = [link("arm1", "arm", b1, q1), link("forearm1", "forearm", q1, p),
+                 link("arm2", "arm", b2, q2), link("forearm2", "forearm", q2, p)]
+        joints = [rev("actuator1", b1, "arm1.a", "base", k), rev("elbow1", q1, "arm1.b", "forearm1.a"),
+                  rev("actuator2", b2, "arm2.a", "base", k), rev("elbow2", q2, "arm2.b", "forearm2.a"),
+                  rev("wrist2", p, "forearm2.b", "platform")]
+        notes = ["planar frame in the xy plane; revolute axes along z; the load acts at P"]
+        if bonded:
+            notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
+        if options["forearm"] == "single":
+            joints.append(rev("wrist1", p, "forearm1.b", "platform"))
+            bodies = [Body("base", np.zeros(2)), Body("platform", p.copy(), "rigid" if bonded else "point")]
+        else:
+            d = options["parallelogram_spacing"]
+            phi_a, phi_f = options["parallelogram_offsets"]
+            na = d * np.array([math.cos(phi_a), math.sin(phi_a)])
+            nf = d * np.array([math.cos(phi_f), math.sin(phi_f)])
+            links += [link("arm_link1", "arm_link", b1 + na, q1 + na),
+                      link("forearm_link1", "forearm_link", q1 + nf, p + nf)]
+            joints = [j for j in joints if j.name != "elbow1"]
+            joints += [rev("elbow1", q1, "arm1.b", "plate1"), rev("plate_forearm1", q1, "forearm1.a", "plate1"),
+                       rev("arm_link_base1", b1 + na, "arm_link1.a", "base"),
+                       rev("arm_link_plate1", q1 + na, "arm_link1.b", "plate1"),
+                       rev("forearm_link_plate1", q1 + nf, "forearm_link1.a", "plate1"),
+                       rev("wrist1", p, "forearm1.b", "platform"),
+                       rev("forearm_link_platform1", p + nf, "forearm_link1.b", "platform")]
+            bodies = [Body("base", np.zeros(2)), Body("plate1", q1.copy()), Body("platform", p.copy())]
+            notes.append("right chain: arm and forearm parallelograms (paper §1); hinge plate and platform rigid")
+        return FrameModel(2, "mm", tuple(links), tuple(joints), tuple(bodies), "platform",
+                          np.asarray(options["load"], float), tuple(notes))
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of paper §1 (planar, each parallelogram counted as one 1-DOF joint): the right chain
@@ -368,8 +525,22 @@ MECHANISM = PlanarFivebar(
         Option("mode", "+-", "working mode sigma1 sigma2: '+-' = elbows out (operating mode), '++', '-+', '--'"),
         Option("alpha1_limits", None, "[lo, hi] rad for alpha1 modulo 2 pi, null = none (spec: [-4pi/9, 7pi/36])"),
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
+        Option("forearm", "single", "stiffness: 'single' (five-bar 5R) or 'parallelogram' (right chain PaPa, §1)"),
+        Option("parallelogram_spacing", 60.0, "stiffness: bar spacing of the parallelograms, mm"),
+        Option("parallelogram_offsets", [1.1780972450961724, -0.75],
+               "stiffness: directions (rad from +x) of the arm-link and forearm-link offsets: perpendicular to the "
+               "arm and forearm at mid-range over the packing rectangle (67.5 deg, -43 deg)"),
+        *stiffness_options("mm", ACTUATOR_STIFFNESS, "torsional stiffness of each arm actuator, N mm/rad (1e5 N m/rad)",
+                           [0.0, -150.0], "default 150 N along -y, the gravity direction (the workspace is below "
+                           "the base)"),
     ),
     default_length_unit="mm",
-    fields=base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"),
+    fields=(
+        *base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"),
+        Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness under a "
+              "pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
+        Field("deflection", "{length}", "magnitude of the platform's deflection under options.load (default 150 N "
+              "along -y); 1e12 at a singular pose", "min", (0.0, SIGMA_CAP)),
+    ),
     design_metrics=DESIGN_METRICS,
 )

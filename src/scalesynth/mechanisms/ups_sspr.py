@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from scalesynth.errors import InvalidParameter
+from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
@@ -43,8 +43,12 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     wrap_angle,
 )
+from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
+LINK_GROUPS = ("leg", "link")  # stiffness: the three actuated legs (cylinder and rod), the SR link A0B1
+# default actuator stiffness: 2e4 N/mm (a small ball-screw linear actuator; an assumption, the paper gives none)
+ACTUATOR_STIFFNESS = 2e4
 SQRT3_2 = math.sqrt(3.0) / 2.0
 INV_SQRT2 = 1.0 / math.sqrt(2.0)
 Y_OPEN = 0.999  # default Y box = +-0.999 c: Y = +-c (rho = 0) is singular (spec §3.5)
@@ -187,6 +191,7 @@ class UpsSspr(Mechanism):
             if not number or not (math.isfinite(value) and value > 0):
                 raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {value!r}")
             options["characteristic_length"] = float(value)
+        check_stiffness_options(options, 3, LINK_GROUPS)
 
     def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         """L in mm (default c): the angle columns of Jx are divided by L before conditioning."""
@@ -226,6 +231,77 @@ class UpsSspr(Mechanism):
     @property
     def field_kernel(self):
         return point_fields
+
+    # ----- stiffness (scalesynth.stiffness; pose level only, no per-voxel fields yet) ------------------
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at pose (alpha, beta, Y); raises InvalidPose
+        outside the workspace box or the actuator limits. Joints as in joint_screws: UPS legs (U at A_i with both
+        axes normal to the leg, which gives the same twist space as any U whose axes do not contain the leg; a
+        prismatic actuator spring between cylinder and rod, each half the leg; S at B_i), the SR link A0B1 (S at A0,
+        welded through B0, revolute about the platform's x axis at B1) and the SPR leg (S at M, prismatic actuator,
+        revolute about the same axis at B0 on the link). Links in groups 'leg' and 'link'; the platform is rigid with
+        reference point B1 = P. ``joints`` 'bonded' welds the passive joints."""
+        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.sections import tube_section
+
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        if self.point_kernel(self.pack(design, options), alpha, beta, yy) < 0.0:
+            raise InvalidPose(f"pose: ({alpha:g}, {beta:g}, {yy:g}) is outside the workspace (box and actuator "
+                              "limits)")
+        a, b, c = design["a"], design["b"], design["c"]
+        rho = math.sqrt(c * c - yy * yy)
+        sa, ca, sb, cb = math.sin(alpha), math.cos(alpha), math.sin(beta), math.cos(beta)
+        rot = np.array([[cb, sb * sa, sb * ca], [0.0, ca, -sa], [-sb, cb * sa, cb * ca]])  # Ry(beta) Rx(alpha)
+        p = np.array([sb * rho, yy, cb * rho])
+        bxy = b * INV_SQRT2
+        k = options["actuator_stiffness"]
+        sec = {g: tube_section(options, g, "mm") for g in LINK_GROUPS}
+        links, js = [], []
+
+        def unit(v):
+            v = np.asarray(v, dtype=float)
+            return v / np.linalg.norm(v)
+
+        def link(name, group, start, end):
+            q = sec[group]
+            d = unit(end - start)
+            up = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+            links.append(Link(name, group, np.array(start, float), np.array(end, float), q.EA, q.EI, q.EI, q.GJ, up))
+
+        def joint(name, kind, at, part_a, part_b, axes=(), stiffness=None):
+            if joints == "bonded" and stiffness is None:
+                kind, axes = "fixed", ()
+            js.append(Joint(name, kind, np.array(at, float), (part_a, part_b), tuple(unit(x) for x in axes),
+                            stiffness))
+
+        for i, sx in ((2, -1.0), (3, 1.0)):
+            base = np.array([sx * SQRT3_2 * a, -a / 2.0, 0.0])
+            top = p + rot @ np.array([sx * bxy, bxy, 0.0])
+            mid = 0.5 * (base + top)
+            n1 = np.cross(np.cross((0.0, 0.0, 1.0), base), top - base)
+            link(f"cylinder{i}", "leg", base, mid)
+            link(f"rod{i}", "leg", mid, top)
+            joint(f"U{i}", "universal", base, f"cylinder{i}.a", "base", (n1, np.cross(top - base, n1)))
+            joint(f"P{i}", "prismatic", mid, f"cylinder{i}.b", f"rod{i}.a", (top - base,), k)
+            joint(f"S{i}", "spherical", top, f"rod{i}.b", "platform")
+        x_link = rot[:, 0]  # the platform's x axis Ry(beta) x: both revolute axes
+        m = np.array([0.0, -a / 2.0, 0.0])
+        b0 = K0 * p
+        mid = 0.5 * (m + b0)
+        link("link_lower", "link", np.zeros(3), b0)
+        link("link_upper", "link", b0, p)
+        link("cylinder1", "leg", m, mid)
+        link("rod1", "leg", mid, b0)
+        joint("S_A0", "spherical", np.zeros(3), "link_lower.a", "base")
+        js.append(Joint("link_B0", "fixed", b0, ("link_lower.b", "link_upper.a")))  # one rigid-jointed link
+        joint("R_B1", "revolute", p, "link_upper.b", "platform", (x_link,))
+        joint("S_M", "spherical", m, "cylinder1.a", "base")
+        joint("P1", "prismatic", mid, "cylinder1.b", "rod1.a", (b0 - m,), k)
+        joint("R_B0", "revolute", b0, "rod1.b", "link_lower.b", (x_link,))
+        bodies = (Body("base", np.zeros(3)), Body("platform", p.copy()))
+        notes = ("spatial frame, base frame A0-xyz of spec §3.1 (z up); the load acts at B1 = P",)
+        return FrameModel(3, "mm", tuple(links), tuple(js), bodies, "platform", np.asarray(options["load"], float),
+                          notes)
 
     def kernel_branch(self, options) -> str:
         return IK_LABEL
@@ -479,6 +555,8 @@ MECHANISM = UpsSspr(
             None,
             "L in mm homogenising the Jacobian (angle columns / L) for the LCI, null = c",
         ),
+        *stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator, N/mm (an assumption)",
+                           [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
     default_length_unit="mm",
     fields=base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),

@@ -1,0 +1,204 @@
+"""Rebuild a stiffness ``model`` (the JSON of `scalesynth stiffness --json`) as a PyNite frame and solve it.
+
+PyNite (PyNiteFEA, a maintained 3-D frame finite-element package, test-only dependency) is the independent check
+of scalesynth's solver: nothing here uses scalesynth code. Planar models live in the global XY plane with the
+out-of-plane DOFs (DZ, RX, RY) held at every node. Joints: all parts meeting at a point share one node; a passive
+revolute joint is a moment release (Rz) of the link end it names (the first part that is a link end when both
+are), an actuator a rotational support spring at the base node, a fixed joint no release. Rigid bodies (hinge
+plates, platform) are stars of members 1e4 times stiffer than the stiffest link from the body's reference node.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from Pynite import FEModel3D
+
+RIGID = 1e4  # penalty stiffness ratio: 1e4 balances penalty error against round-off (both ~1e-6 here)
+
+
+def _key(p) -> tuple:
+    return tuple(round(float(c), 7) for c in p)
+
+
+def solve_model(model: dict) -> np.ndarray:
+    """Deflection (length unit) of the platform point under the model's load, by PyNite."""
+    if model["dim"] == 3:
+        return solve_model_3d(model)
+    fe = FEModel3D()
+    nodes: dict[tuple, str] = {}
+
+    def node(p) -> str:
+        k = _key(p)
+        if k not in nodes:
+            nodes[k] = f"N{len(nodes)}"
+            fe.add_node(nodes[k], float(p[0]), float(p[1]), 0.0)
+        return nodes[k]
+
+    E = 1.0  # sections carry E: A = EA / E etc.
+    fe.add_material("mat", E, 0.4, 0.3, 0.0)
+    stiffest = 0.0
+    for link in model["links"]:
+        fe.add_section(link["name"], link["EA"] / E, link["EI"] / E, link["EI"] / E, 2 * link["EI"] / E)
+        fe.add_member(link["name"], node(link["from"]), node(link["to"]), "mat", link["name"])
+        stiffest = max(stiffest, link["EA"], link["EI"])
+    fe.add_section("rigid", RIGID * stiffest, RIGID * stiffest, RIGID * stiffest, RIGID * stiffest)
+    bodies = {b["name"]: b for b in model["bodies"]}
+    releases: dict[str, list[bool]] = {link["name"]: [False] * 12 for link in model["links"]}
+    keeps_rotation: dict[str, bool] = {}  # node -> some unreleased member or support holds its rotation
+    supports: dict[str, dict] = {}
+    body_points: dict[str, set] = {}
+    for j in model["joints"]:
+        n = node(j["at"])
+        parts = j["parts"]
+        links_here = [p for p in parts if "." in p]
+        others = [p for p in parts if "." not in p]
+        for o in others:
+            if o == "base":
+                sup = supports.setdefault(n, {"DX": True, "DY": True})
+                if j["kind"] == "revolute" and j["name"] not in {a["joint"] for a in model["actuators"]}:
+                    sup["RZ"] = True  # the released member does not need it; holds the node's spare DOF
+                elif j["kind"] == "fixed":
+                    sup["RZ"] = True
+            elif bodies[o]["kind"] == "rigid":
+                body_points.setdefault(o, set()).add(_key(j["at"]))
+        if j["kind"] == "revolute" and j["name"] not in {a["joint"] for a in model["actuators"]}:
+            name, end = links_here[-1].split(".") if len(links_here) == 2 else links_here[0].split(".")
+            releases[name][5 if end == "a" else 11] = True
+    for a in model["actuators"]:
+        n = node(a["at"])
+        fe.def_support_spring(n, "RZ", a["stiffness"], None)
+    for b, pts in body_points.items():
+        ref = _key(bodies[b]["ref"])
+        node(bodies[b]["ref"])
+        for i, p in enumerate(sorted(pts)):
+            if p != ref:
+                fe.add_member(f"{b}_{i}", nodes[ref], nodes[p], "mat", "rigid")
+                keeps_rotation[nodes[ref]] = keeps_rotation[nodes[p]] = True
+    for link in model["links"]:
+        fe.def_releases(link["name"], *releases[link["name"]])
+        for end, idx in ((link["from"], 5), (link["to"], 11)):
+            if not releases[link["name"]][idx]:
+                keeps_rotation[node(end)] = True
+    for n in nodes.values():
+        sup = supports.get(n, {})
+        fe.def_support(n, sup.get("DX", False), sup.get("DY", False), True, True, True,
+                       sup.get("RZ", False) or not keeps_rotation.get(n, False))
+    p = node(model["platform"]["point"])
+    fx, fy = model["load"]["force"]
+    fe.add_node_load(p, "FX", fx)
+    fe.add_node_load(p, "FY", fy)
+    fe.analyze_linear(check_stability=False)
+    nd = fe.nodes[p]
+    return np.array([nd.DX["Combo 1"], nd.DY["Combo 1"]])
+
+
+def _merge_prismatic(model: dict) -> tuple[list[dict], list[dict]]:
+    """Links joined end to end by a prismatic actuator (collinear, same section) become one member whose axial
+    compliance adds the spring's: L/EA_eff = L_a/EA + 1/k + L_b/EA (the joint passes every other force and moment,
+    and the axial force is the same along the leg). Returns the members and the remaining joints."""
+    links = {link["name"]: dict(link) for link in model["links"]}
+    stiffness = {a["joint"]: a["stiffness"] for a in model["actuators"]}
+    joints = [dict(j) for j in model["joints"]]
+    for j in [j for j in joints if j["kind"] == "prismatic"]:
+        (na, ea), (nb, eb) = (p.split(".") for p in j["parts"])
+        a, b = links.pop(na), links.pop(nb)
+        assert (ea, eb) == ("b", "a") and (a["EIy"], a["EIz"], a["GJ"]) == (b["EIy"], b["EIz"], b["GJ"])
+        axis = np.asarray(j["axes"][0])
+        for link in (a, b):
+            d = np.subtract(link["to"], link["from"])
+            assert np.linalg.norm(np.cross(d, axis)) < 1e-9 * np.linalg.norm(d) * np.linalg.norm(axis)
+        length = a["length"] + b["length"]
+        comp = a["length"] / a["EA"] + b["length"] / b["EA"] + 1.0 / stiffness[j["name"]]
+        name = f"{na}+{nb}"
+        links[name] = dict(a, name=name, to=b["to"], length=length, EA=length / comp)
+        rename = {f"{na}.a": f"{name}.a", f"{nb}.b": f"{name}.b"}
+        joints = [dict(x, parts=[rename.get(p, p) for p in x["parts"]]) for x in joints if x["name"] != j["name"]]
+    return list(links.values()), joints
+
+
+def _oriented(fe, member: str, axis) -> None:
+    """Rotate a member about its own axis so that its local z axis is ``axis`` (which must be normal to it)."""
+    m = fe.members[member]
+    dc = m.T()[:3, :3]  # rows: local x, y, z
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    assert abs(a @ dc[0]) < 1e-9, "a revolute axis along a member cannot be a member end release"
+    m.rotation = float(np.degrees(np.arctan2(-(a @ dc[1]), a @ dc[2])))
+
+
+def solve_model_3d(model: dict) -> np.ndarray:
+    """Spatial models: every joint a member end release in the member's local axes (spherical: all rotations;
+    revolute: the member turned so that local z is the axis, then Rz; universal: both bending rotations, which needs
+    both axes normal to the member); prismatic actuators merged into their leg (_merge_prismatic)."""
+    links, joints = _merge_prismatic(model)
+    fe = FEModel3D()
+    nodes: dict[tuple, str] = {}
+
+    def node(p) -> str:
+        k = _key(p)
+        if k not in nodes:
+            nodes[k] = f"N{len(nodes)}"
+            fe.add_node(nodes[k], *(float(c) for c in p))
+        return nodes[k]
+
+    E, G = 1.0, 1.0
+    fe.add_material("mat", E, G, 0.3, 0.0)
+    stiffest = 0.0
+    for link in links:
+        fe.add_section(link["name"], link["EA"] / E, link["EIy"] / E, link["EIz"] / E, link["GJ"] / G)
+        fe.add_member(link["name"], node(link["from"]), node(link["to"]), "mat", link["name"])
+        stiffest = max(stiffest, link["EA"], link["EIy"], link["EIz"], link["GJ"])
+    fe.add_section("rigid", RIGID * stiffest, RIGID * stiffest, RIGID * stiffest, RIGID * stiffest)
+    releases = {link["name"]: [False] * 12 for link in links}
+    bodies = {b["name"]: b for b in model["bodies"]}
+    supported, held = set(), set()
+    body_points: dict[str, set] = {}
+    welded = {p for j in joints if j["kind"] == "fixed" for p in j["parts"]}
+    for j in joints:
+        n = node(j["at"])
+        ends = [p for p in j["parts"] if "." in p]
+        for o in (p for p in j["parts"] if "." not in p):
+            if o == "base":
+                supported.add(n)
+            else:
+                body_points.setdefault(o, set()).add(_key(j["at"]))
+        if j["kind"] == "fixed":
+            continue
+        assert j["name"] not in {a["joint"] for a in model["actuators"]}, "actuated revolute joints: not needed yet"
+        # release the end that is welded to nothing else at this node (the others share the node's rotations)
+        free = [e for e in ends if e not in welded] or ends
+        name, end = free[-1].split(".")
+        off = 0 if end == "a" else 6
+        if j["kind"] == "spherical":
+            releases[name][off + 3 : off + 6] = [True, True, True]
+        elif j["kind"] == "revolute":
+            _oriented(fe, name, j["axes"][0])
+            releases[name][off + 5] = True
+        elif j["kind"] == "universal":
+            m = fe.members[name]
+            x = m.T()[0, :3]
+            for ax in j["axes"]:
+                assert abs(np.dot(ax, x)) < 1e-9, "universal joint axes must be normal to the member"
+            releases[name][off + 4 : off + 6] = [True, True]
+    for b, pts in body_points.items():
+        ref = _key(bodies[b]["ref"])
+        node(bodies[b]["ref"])
+        for i, p in enumerate(sorted(pts)):
+            if p != ref:
+                fe.add_member(f"{b}_{i}", nodes[ref], nodes[p], "mat", "rigid")
+                held.update((nodes[ref], nodes[p]))
+    for link in links:
+        fe.def_releases(link["name"], *releases[link["name"]])
+        for p, off in ((link["from"], 0), (link["to"], 6)):
+            if not all(releases[link["name"]][off + 3 : off + 6]):
+                held.add(node(p))
+    for n in nodes.values():
+        free_rot = n not in held  # no member holds its rotations: support them (they carry nothing)
+        fe.def_support(n, n in supported, n in supported, n in supported, n in supported or free_rot,
+                       n in supported or free_rot, n in supported or free_rot)
+    p = node(model["platform"]["point"])
+    for d, f in zip(("FX", "FY", "FZ"), model["load"]["force"], strict=True):
+        fe.add_node_load(p, d, float(f))
+    fe.analyze_linear(check_stability=False)
+    nd = fe.nodes[p]
+    return np.array([nd.DX["Combo 1"], nd.DY["Combo 1"], nd.DZ["Combo 1"]])
