@@ -162,9 +162,9 @@ def test_pinned_fivebar_by_hand(pose):
 
 
 @pytest.mark.parametrize("e", [1e-3, 1.0, 1e4])
-@pytest.mark.parametrize("k", [1e4, 1e8, 1e12, 1e16])
+@pytest.mark.parametrize("k", [1e4, 1e8, 1e12])  # 1e12: the largest magnitude an option accepts (MAX_MAGNITUDE)
 def test_reference_solver_keeps_accuracy_with_stiff_and_soft_parts(e, k):
-    """Links 1e-3 ... 1e4 times aluminium with actuators of 1e4 ... 1e16 N mm/rad: the saddle-point solve agrees with
+    """Links 1e-3 ... 1e4 times aluminium with actuators of 1e4 ... 1e12 N mm/rad: the saddle-point solve agrees with
     the hand solution to 1e-5 (measured <= 8e-7; a Schur-complement condensation lost 0.1 % and more here)."""
     opt = options(youngs_modulus=70.0 * e, actuator_stiffness=k)
     C = np.linalg.inv(hand_fivebar(opt, (300.0, -700.0))[0])
