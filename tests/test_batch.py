@@ -248,9 +248,9 @@ def test_ci_workflow_runs_a_small_batch_and_uploads_its_directory(root):
 
 
 def test_unreachable_scheduler_is_a_one_line_error_exit_1(tmp_path, monkeypatch):
-    from scalesynth import batch
+    from scalesynth import cluster
 
-    monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", "1s")
     cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
     r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"),
                                  "--scheduler", "tcp://127.0.0.1:9"])

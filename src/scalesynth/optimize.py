@@ -170,11 +170,14 @@ def run(
     progress: ProgressFn | None = None,
     plots: bool = True,
     stop_after: int | None = None,
+    on_checkpoint: Callable[[Path, int], None] | None = None,
 ) -> RunResult:
     """Run NSGA-II for ``cfg`` and write the results directory.
 
     ``stop_after`` (generations) ends the loop early without writing final results, leaving a checkpoint: it
-    exists for tests of resume and for chunked runs.
+    exists for tests of resume and for chunked runs. ``on_checkpoint(path, generation)`` is called after every
+    checkpoint write (the last one too, before the results are written); an exception it raises ends the run
+    there, leaving that checkpoint (the batch runner ships checkpoints to its client this way).
     """
     if seed is not None:
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
@@ -229,6 +232,8 @@ def run(
                 ckpt_path,
                 {"algorithm": algorithm, "history": history, "elapsed": elapsed, "digest": digest, "started": started},
             )
+            if on_checkpoint is not None:
+                on_checkpoint(ckpt_path, row["generation"])
         if stop_after is not None and gens_this_call >= stop_after and not done:
             raise RunError(f"stopped after {gens_this_call} generations (checkpoint in {ckpt_path})")
     wall = elapsed_before + time.perf_counter() - t0
