@@ -260,26 +260,84 @@ def test_unreachable_scheduler_is_a_one_line_error_exit_1(tmp_path, monkeypatch)
     assert not (tmp_path / "out").exists()
 
 
-def test_a_lost_worker_fails_only_its_task(monkeypatch):
-    """A future that raises (e.g. KilledWorker when a worker process dies) becomes a failed record."""
-    from concurrent.futures import Future
+def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monkeypatch, sequential):
+    """The client's chunk driver with real chunks run in this process and dask's failures injected: a chunk that
+    dask gives up on (KilledWorker) is resubmitted with the checkpoint the client wrote, and the task ends
+    byte-identical to a sequential run; a task whose chunks are always killed fails alone after MAX_RESUBMITS
+    resubmissions, its checkpoint kept on the client; retries come from the scheduler's remove-worker events."""
+    from collections import deque
+
+    from distributed.scheduler import KilledWorker
 
     from scalesynth import batch
+    from scalesynth.batch_task import run_chunk
+
+    class Future:
+        def __init__(self, outcome):
+            self.outcome = outcome
+
+        def result(self):
+            if isinstance(self.outcome, BaseException):
+                raise self.outcome
+            return self.outcome
+
+        def release(self):
+            pass
+
+    class AsCompleted:
+        def __init__(self, loop=None):
+            self.queue = deque()
+
+        def add(self, fut):
+            self.queue.append(fut)
+
+        def __next__(self):
+            return self.queue.popleft()
 
     class Client:
-        def submit(self, fn, data, seed, out_dir, **kwargs):
-            fut = Future()
-            if seed == 2:
-                fut.set_exception(RuntimeError("Attempted to run task on 3 different workers,\n all died"))
-            else:
-                fut.set_result({"status": "skipped", "hypervolume": 1.0})
-            return fut
+        loop = None
 
-    monkeypatch.setattr("dask.distributed.as_completed", lambda futures: list(futures))
-    tasks = [batch.BatchTask("a", "a.yaml", s, Path(f"out/a/seed{s}"), {}) for s in (1, 2, 3)]
-    records = batch.run_tasks(tasks, Client())
-    assert [r.status for r in records] == ["skipped", "failed", "skipped"]
-    assert records[1].error == "RuntimeError: Attempted to run task on 3 different workers, all died"
+        def __init__(self):
+            self.calls, self.events = [], []
+
+        def nthreads(self):
+            return {"tcp://127.0.0.1:1": 1, "tcp://127.0.0.1:2": 1}
+
+        def get_events(self, topic):
+            assert topic == "all"
+            return tuple(self.events)
+
+        def submit(self, fn, data, seed, checkpoint, *, key, **kwargs):
+            assert fn is run_chunk and kwargs["allow_other_workers"] is True
+            self.calls.append((seed, checkpoint, key))
+            n_seed = sum(c[0] == seed for c in self.calls)
+            if (seed, n_seed) == (3, 2) or seed == 4 and n_seed > 1:  # killed: the scheduler logs the lost chunk
+                self.events.append((float(len(self.calls)), {"action": "remove-worker", "worker": "tcp://dead:1",
+                                                             "processing-tasks": [key], "expected": False}))
+                return Future(KilledWorker(key, None, 3))
+            return Future(fn(data, seed, checkpoint))
+
+    monkeypatch.setattr("distributed.as_completed", AsCompleted)
+    client = Client()
+    tasks = batch.plan([("alpha.yaml", config_from_dict(copy.deepcopy(ALPHA)))], 2, tmp_path)
+    lines = []
+    records = batch.run_tasks(tasks, client, lines.append)
+    ok, lost = records
+    assert ok.status == "finished" and ok.retries == 1 and ok.lost_workers == ["tcp://dead:1"]
+    for f in ("pareto.csv", "population.csv"):
+        assert (tmp_path / "alpha" / "seed3" / f).read_bytes() == (sequential[("alpha", 3)] / f).read_bytes()
+    # SMALL: 6 generations, a checkpoint every 2 -> chunks end at generations 2, 4, 6; the killed second chunk is
+    # resubmitted with the checkpoint of generation 2 that the first chunk returned
+    seed3 = [(ck, key) for s, ck, key in client.calls if s == 3]
+    assert [key.rsplit("-", 2)[1] for _, key in seed3] == ["gen0", "gen2", "gen2", "gen4"]
+    assert seed3[0][0] is None and seed3[1][0] == seed3[2][0] and seed3[1][0] is not None
+    assert ok.chunks == 3 and ok.workers == ["local"] and ok.numba_threads == 1
+    assert lost.status == "failed" and lost.retries == batch.MAX_RESUBMITS + 1
+    assert lost.error.startswith("workers kept dying while running generations after 2 (dask's KilledWorker 4 times)")
+    seed4 = [ck for s, ck, _ in client.calls if s == 4]
+    assert (tmp_path / "alpha" / "seed4" / "checkpoint.pkl").read_bytes() == seed4[1]
+    assert not (tmp_path / "alpha" / "seed4" / "manifest.json").exists()
+    assert sum("worker tcp://dead:1 lost while running generations after 2" in ln for ln in lines) == 5
 
 
 def test_without_dask_the_batch_says_how_to_install_it(tmp_path, monkeypatch):

@@ -423,7 +423,8 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
             fut.release()
             run.resubmits += 1
             if run.resubmits > MAX_RESUBMITS:
-                fail(run, f"lost {run.record.retries} workers running generations after {run.generation}")
+                fail(run, f"workers kept dying while running generations after {run.generation} (dask's "
+                          f"KilledWorker {run.resubmits} times); re-run to resume from the client's checkpoint")
             else:
                 pending.appendleft(run)
             submit_ready()
