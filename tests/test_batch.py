@@ -9,6 +9,7 @@ import copy
 import json
 import logging
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -252,8 +253,10 @@ def test_unreachable_scheduler_is_a_one_line_error_exit_1(tmp_path, monkeypatch)
 
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", "1s")
     cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    t0 = time.monotonic()
     r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"),
                                  "--scheduler", "tcp://127.0.0.1:9"])
+    assert time.monotonic() - t0 < 30  # bounded by CONNECT_TIMEOUT (1 s here), not dask's retries forever
     assert r.exit_code == 1, r.output
     lines = r.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: --scheduler tcp://127.0.0.1:9: cannot connect"), lines
@@ -309,6 +312,7 @@ def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monke
 
         def submit(self, fn, data, seed, checkpoint, *, key, **kwargs):
             assert fn is run_chunk and kwargs["allow_other_workers"] is True
+            assert str(tmp_path) not in repr(data)  # a chunk never gets a client path: OUT stays the client's
             self.calls.append((seed, checkpoint, key))
             n_seed = sum(c[0] == seed for c in self.calls)
             if (seed, n_seed) == (3, 2) or seed == 4 and n_seed > 1:  # killed: the scheduler logs the lost chunk
@@ -347,3 +351,108 @@ def test_without_dask_the_batch_says_how_to_install_it(tmp_path, monkeypatch):
     assert r.exit_code == 1
     assert r.output.strip() == "error: batch needs dask.distributed: pip install 'scalesynth[dask]'"
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("address", "problem"),
+    [
+        ("tcp://127.0.0.1:notaport", "port 'notaport' is not a number in 1..65535"),
+        ("tcp://127.0.0.1:0", "port '0' is not a number in 1..65535"),
+        ("tcp://127.0.0.1:70000", "port '70000' is not a number in 1..65535"),
+        ("foo bar", "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        ("tcp://127.0.0.1", "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        ("tcp://:8786", "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        ("http://127.0.0.1:8786", "unknown protocol 'http' (use tcp, tls, ws, wss, ucx)"),
+    ],
+)
+def test_a_malformed_scheduler_address_is_bad_input_exit_2(tmp_path, address, problem):
+    cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"), "--scheduler", address])
+    assert r.exit_code == 2, r.output
+    assert r.output.strip().splitlines() == [f"error: --scheduler: {address!r}: {problem}"]
+    assert not (tmp_path / "out").exists()
+
+
+def test_scheduler_addresses_are_normalised():
+    from scalesynth.cluster import check_address
+
+    assert check_address("127.0.0.1:8786") == "tcp://127.0.0.1:8786"
+    assert check_address(" tls://node-7.cluster:08786 ") == "tls://node-7.cluster:8786"
+    assert check_address("tcp://[::1]:8786") == "tcp://[::1]:8786"
+
+
+@pytest.mark.parametrize(
+    ("content", "problem"),
+    [
+        (None, "cannot read (No such file or directory)"),
+        ("{not json", "not a dask scheduler file (invalid JSON)"),
+        ('{"id": "Scheduler-1"}', "not a dask scheduler file (no 'address')"),
+        ('{"address": "tcp://127.0.0.1:x"}', None),
+    ],
+)
+def test_a_bad_scheduler_file_is_bad_input_exit_2(tmp_path, content, problem):
+    cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    sched = tmp_path / "scheduler.json"
+    if content is not None:
+        sched.write_text(content)
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"), "--scheduler-file",
+                                 str(sched)])
+    assert r.exit_code == 2, r.output
+    expected = (f"error: --scheduler-file {sched}: {problem}" if problem
+                else "error: --scheduler: 'tcp://127.0.0.1:x': port 'x' is not a number in 1..65535")
+    assert r.output.strip().splitlines() == [expected]
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"), "--scheduler-file",
+                                 str(sched), "--scheduler", "tcp://127.0.0.1:8786"])
+    assert r.exit_code == 2 and r.output.strip() == "error: --scheduler, --scheduler-file: give one of them"
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_worker_without_scalesynth_or_with_other_versions_is_named():
+    """check_workers compares dask's package report of every worker with the client's: the first differing worker
+    is named with what differs, on one line (a RunError: exit 1, before any task is submitted)."""
+    from scalesynth.cluster import CHECKED_PACKAGES, check_workers, client_versions
+
+    mine = client_versions()
+    ok = {"packages": {"python": sys.version.split()[0] + ".final.0", **{p: mine[p] for p in CHECKED_PACKAGES}}}
+
+    class Client:
+        def __init__(self, workers):
+            self.workers = workers
+
+        def scheduler_info(self, n_workers=5):
+            assert n_workers == -1  # every worker, not the first five
+            return {"workers": {a: {"name": f"n{i}", "nthreads": 2} for i, a in enumerate(sorted(self.workers))}}
+
+        def get_versions(self, packages):
+            assert set(packages) == set(CHECKED_PACKAGES)
+            return {"workers": self.workers}
+
+    good = {"tcp://10.0.0.1:1": ok, "tcp://10.0.0.2:1": ok}
+    assert check_workers(Client(good)) == {"tcp://10.0.0.1:1": {"name": "n0", "nthreads": 2},
+                                           "tcp://10.0.0.2:1": {"name": "n1", "nthreads": 2}}
+    lacking = {"packages": {**ok["packages"], "scalesynth": None}}
+    older = {"packages": {**ok["packages"], "numba": "0.60.0", "pymoo": "0.6.0"}}
+    with pytest.raises(RunError) as err:
+        check_workers(Client({**good, "tcp://10.0.0.3:1": lacking}))
+    assert str(err.value) == f"worker tcp://10.0.0.3:1 (n2): scalesynth not installed (client {mine['scalesynth']})"
+    with pytest.raises(RunError) as err:
+        check_workers(Client({"tcp://10.0.0.1:1": ok, "tcp://10.0.0.4:1": older, "tcp://10.0.0.5:1": lacking}))
+    assert str(err.value) == (f"worker tcp://10.0.0.4:1 (n1): numba 0.60.0 (client {mine['numba']}); pymoo 0.6.0 "
+                              f"(client {mine['pymoo']}) (and 1 more workers)")
+
+
+def test_a_task_uses_its_workers_thread_count_capped_by_numbas_pool():
+    import numba
+
+    from scalesynth.batch_task import set_numba_threads, worker_identity
+
+    before = numba.get_num_threads()
+    try:
+        assert set_numba_threads(1) == 1 == numba.get_num_threads()
+        # more than the pool Numba started with (NUMBA_NUM_THREADS): the whole pool, never an error
+        assert set_numba_threads(10**6) == numba.config.NUMBA_NUM_THREADS
+    finally:
+        numba.set_num_threads(before)
+    # outside a dask worker (a direct call): Numba's pool size stands in for the worker's threads
+    assert worker_identity() == {"address": "local", "name": "local", "nthreads": numba.config.NUMBA_NUM_THREADS,
+                                 "local_directory": None}

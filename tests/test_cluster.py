@@ -295,7 +295,8 @@ def test_a_worker_with_another_scalesynth_version_is_named_and_nothing_runs(kill
         tree = tmp_path / "client"
         (tree / "results").mkdir(parents=True)
         (tree / "cluster.yaml").write_text((killed_batch["tree"] / "cluster.yaml").read_text())
-        code, stdout, stderr = _finish(_cli(["batch", "cluster.yaml", "--scheduler", cluster["address"],
+        sched_file = cluster["base"] / "scheduler" / "scheduler.json"  # the address, as jobqueue users pass it
+        code, stdout, stderr = _finish(_cli(["batch", "cluster.yaml", "--scheduler-file", str(sched_file),
                                              "--out", "results/b"], tree), 120)
         assert code == 1 and stdout == ""
         assert stderr.strip().splitlines() == [

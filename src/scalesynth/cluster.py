@@ -7,11 +7,13 @@ lazily.
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 from scalesynth.errors import ConfigError, RunError
@@ -41,6 +43,21 @@ def check_address(address: str) -> str:
     if problem:
         raise ConfigError(f"--scheduler: {address!r}: {problem}")
     return f"{scheme}://{host}:{int(port)}"
+
+
+def address_from_file(path: Path) -> str:
+    """The scheduler address in a dask scheduler file (``dask scheduler --scheduler-file``, dask-jobqueue, dask-mpi);
+    ConfigError (exit 2) naming --scheduler-file if it cannot be read or holds no valid address."""
+    try:
+        info = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as err:
+        raise ConfigError(f"--scheduler-file {path}: cannot read ({err.strerror or err})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise ConfigError(f"--scheduler-file {path}: not a dask scheduler file (invalid JSON)") from None
+    address = info.get("address") if isinstance(info, dict) else None
+    if not isinstance(address, str):
+        raise ConfigError(f"--scheduler-file {path}: not a dask scheduler file (no 'address')")
+    return check_address(address)
 
 
 def local_cluster_shape(n_tasks: int, cores: int | None = None) -> tuple[int, int]:
