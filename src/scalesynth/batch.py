@@ -40,7 +40,7 @@ from scalesynth import io as rio
 from scalesynth.batch_task import one_line, run_chunk
 from scalesynth.cluster import check_workers, dask_client, local_cluster_shape, version_differences
 from scalesynth.config import RunConfig
-from scalesynth.errors import ConfigError, ScalesynthError
+from scalesynth.errors import ConfigError, RunError, ScalesynthError
 
 __all__ = ["local_cluster_shape", "one_line", "plan", "run_batch", "run_tasks"]
 
@@ -335,6 +335,7 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
     def fail(run: TaskRun, error: str) -> None:
         rec = run.record
         rec.status, rec.error, rec.generation = "failed", error, run.generation
+        run.checkpoint = None  # the client keeps it in OUT, not in memory
         finish(rec, run.index)
 
     pending: deque[TaskRun] = deque()
@@ -409,34 +410,45 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
         except (ScalesynthError, OSError, KeyError, ValueError) as err:
             return fail(run, one_line(err))
         rec.status = "finished"
+        run.checkpoint = None
         finish(rec, run.index)
         return None
 
-    submit_ready()
-    while inflight:
+    def step() -> None:
         fut = next(completed)
         run, _ = inflight.pop(fut)
         note_lost()
+        owner.pop(fut.key, None)  # its lost-worker events, if any, were just counted
         try:
             chunk = fut.result()
         except KilledWorker:  # dask gave up after several workers died running it: try again, a few times
-            fut.release()
             run.resubmits += 1
             if run.resubmits > MAX_RESUBMITS:
                 fail(run, f"workers kept dying while running generations after {run.generation} (dask's "
                           f"KilledWorker {run.resubmits} times); re-run to resume from the client's checkpoint")
             else:
                 pending.appendleft(run)
-            submit_ready()
-            continue
+            return
         except Exception as err:  # cancelled, or the chunk could not be shipped / unpickled on the worker
-            fut.release()
+            if getattr(client, "status", "running") != "running":
+                raise  # the scheduler is gone: handled below, for the whole batch
             fail(run, one_line(err))
-            submit_ready()
-            continue
-        fut.release()
+            return
+        finally:
+            fut.release()
         accept(run, chunk)
+
+    try:
         submit_ready()
+        while inflight:
+            step()
+            submit_ready()
+    except Exception as err:
+        if getattr(client, "status", "running") == "running":
+            raise  # not a lost scheduler: a bug, let it show
+        # the scheduler went away: what is done (results, checkpoints) is in OUT
+        raise RunError(f"lost the dask scheduler ({one_line(err)}); finished tasks and the latest checkpoints are "
+                       "in OUT: re-run the same command to resume") from None
     return [r for r in records if r is not None]
 
 def nondominated_mask(F: np.ndarray) -> np.ndarray:
