@@ -276,8 +276,8 @@ def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monke
     from scalesynth.batch_task import run_chunk
 
     class Future:
-        def __init__(self, outcome):
-            self.outcome = outcome
+        def __init__(self, outcome, key):
+            self.outcome, self.key = outcome, key
 
         def result(self):
             if isinstance(self.outcome, BaseException):
@@ -318,8 +318,8 @@ def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monke
             if (seed, n_seed) == (3, 2) or seed == 4 and n_seed > 1:  # killed: the scheduler logs the lost chunk
                 self.events.append((float(len(self.calls)), {"action": "remove-worker", "worker": "tcp://dead:1",
                                                              "processing-tasks": [key], "expected": False}))
-                return Future(KilledWorker(key, None, 3))
-            return Future(fn(data, seed, checkpoint))
+                return Future(KilledWorker(key, None, 3), key)
+            return Future(fn(data, seed, checkpoint), key)
 
     monkeypatch.setattr("distributed.as_completed", AsCompleted)
     client = Client()
