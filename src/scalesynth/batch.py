@@ -70,8 +70,9 @@ class BatchTask:
 class TaskRecord:
     """Outcome of one task. ``wall_seconds`` is the time its chunks spent on workers in this batch (seconds);
     ``run_seconds`` the run's own wall time from its manifest (all sessions of a resumed run). ``worker`` ran its
-    last chunk, ``workers`` every chunk that returned (in order, each once); ``retries`` counts chunk runs lost
-    with their worker (and run again from the client's checkpoint), ``lost_workers`` those workers."""
+    last chunk; ``workers`` lists every worker whose chunks returned (in order of first chunk) with its address,
+    name, nthreads, the Numba threads the chunks used and how many chunks; ``retries`` counts chunk runs lost with
+    their worker (and run again from the client's checkpoint), ``lost_workers`` those workers."""
 
     config: str
     source: str
@@ -90,7 +91,7 @@ class TaskRecord:
     worker_name: str | None = None
     worker_nthreads: int | None = None
     numba_threads: int | None = None
-    workers: list[str] = field(default_factory=list)
+    workers: list[dict[str, Any]] = field(default_factory=list)
     retries: int = 0
     lost_workers: list[str] = field(default_factory=list)
     chunks: int = 0
@@ -387,8 +388,12 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
         rec.wall_seconds += float(chunk.get("seconds", 0.0))
         rec.worker, rec.worker_name = chunk.get("worker"), chunk.get("worker_name")
         rec.worker_nthreads, rec.numba_threads = chunk.get("worker_nthreads"), chunk.get("numba_threads")
-        if rec.worker and rec.worker not in rec.workers:
-            rec.workers.append(rec.worker)
+        entry = next((w for w in rec.workers if w["address"] == rec.worker), None)
+        if entry is None:
+            entry = {"address": rec.worker, "name": rec.worker_name, "nthreads": rec.worker_nthreads,
+                     "numba_threads": rec.numba_threads, "chunks": 0}
+            rec.workers.append(entry)
+        entry["chunks"] += 1
         rec.chunks += 1
         if chunk.get("kind") == "failed":
             return fail(run, str(chunk.get("error")))
