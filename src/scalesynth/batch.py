@@ -281,15 +281,25 @@ def _write_results(out_dir: Path, files: dict[str, bytes]) -> None:
 
 class LostChunks:
     """Chunk runs that dask lost with a worker, from the scheduler's 'remove-worker' events (topic 'all'): dask
-    runs such a chunk again elsewhere from the same checkpoint; these events are the only trace of it."""
+    runs such a chunk again elsewhere from the same checkpoint, and these events are the only trace of it. The
+    events are fetched only when a worker has left (or on demand): the topic also logs every gather."""
 
     def __init__(self, client):
         self.client = client
+        try:
+            self.known: set[str] = set(client.nthreads())
+        except Exception:
+            self.known = set()
         self.seen: set[tuple[float, str]] = set()
 
-    def poll(self) -> list[tuple[str, str]]:
+    def poll(self, force: bool = False) -> list[tuple[str, str]]:
         """New (worker address, chunk key) pairs since the last poll."""
         try:
+            workers = set(self.client.nthreads())
+            left = bool(self.known - workers)
+            self.known = workers
+            if not (left or force):
+                return []
             events = self.client.get_events("all")
         except Exception:  # the summary loses a retry count, the results nothing
             return []
@@ -372,8 +382,8 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
             owner[key] = run
             completed.add(fut)
 
-    def note_lost() -> None:
-        for worker, key in lost.poll():
+    def note_lost(force: bool = False) -> None:
+        for worker, key in lost.poll(force):
             run = owner.get(key)
             if run is None or run.record.status != "running":
                 continue
@@ -422,11 +432,10 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
     def step() -> None:
         fut = next(completed)
         run, _ = inflight.pop(fut)
-        note_lost()
-        owner.pop(fut.key, None)  # its lost-worker events, if any, were just counted
         try:
             chunk = fut.result()
         except KilledWorker:  # dask gave up after several workers died running it: try again, a few times
+            note_lost(force=True)
             run.resubmits += 1
             if run.resubmits > MAX_RESUBMITS:
                 fail(run, f"workers kept dying while running generations after {run.generation} (dask's "
@@ -439,9 +448,12 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
                 raise  # the scheduler is gone: handled below, for the whole batch
             fail(run, one_line(err))
             return
+        else:
+            note_lost()  # before the record is closed: a rerun of this very chunk counts
+            accept(run, chunk)
         finally:
             fut.release()
-        accept(run, chunk)
+            owner.pop(fut.key, None)
 
     try:
         submit_ready()

@@ -70,7 +70,7 @@ def local_cluster_shape(n_tasks: int, cores: int | None = None) -> tuple[int, in
 
 def _dask():
     try:
-        from dask import distributed
+        import dask.distributed as distributed
     except ImportError:
         raise RunError("batch needs dask.distributed: pip install 'scalesynth[dask]'") from None
     return distributed
