@@ -18,6 +18,7 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from fake_dask import InlineClient, use_inline_dask
 from scalesynth.batch import combined_front, format_table, local_cluster_shape, nondominated_mask, run_batch
 from scalesynth.cli import app
 from scalesynth.config import config_from_dict
@@ -268,61 +269,25 @@ def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monke
     dask gives up on (KilledWorker) is resubmitted with the checkpoint the client wrote, and the task ends
     byte-identical to a sequential run; a task whose chunks are always killed fails alone after MAX_RESUBMITS
     resubmissions, its checkpoint kept on the client; retries come from the scheduler's remove-worker events."""
-    from collections import deque
-
     from distributed.scheduler import KilledWorker
 
     from scalesynth import batch
     from scalesynth.batch_task import run_chunk
 
-    class Future:
-        def __init__(self, outcome, key):
-            self.outcome, self.key = outcome, key
-
-        def result(self):
-            if isinstance(self.outcome, BaseException):
-                raise self.outcome
-            return self.outcome
-
-        def release(self):
-            pass
-
-    class AsCompleted:
-        def __init__(self, loop=None):
-            self.queue = deque()
-
-        def add(self, fut):
-            self.queue.append(fut)
-
-        def __next__(self):
-            return self.queue.popleft()
-
-    class Client:
-        loop = None
-
-        def __init__(self):
-            self.calls, self.events = [], []
-
-        def nthreads(self):
-            return {"tcp://127.0.0.1:1": 1, "tcp://127.0.0.1:2": 1}
-
-        def get_events(self, topic):
-            assert topic == "all"
-            return tuple(self.events)
-
-        def submit(self, fn, data, seed, checkpoint, *, key, **kwargs):
-            assert fn is run_chunk and kwargs["allow_other_workers"] is True
-            assert str(tmp_path) not in repr(data)  # a chunk never gets a client path: OUT stays the client's
-            self.calls.append((seed, checkpoint, key))
-            n_seed = sum(c[0] == seed for c in self.calls)
-            if (seed, n_seed) == (3, 2) or seed == 4 and n_seed > 1:  # killed: the scheduler logs the lost chunk
-                self.events.append((float(len(self.calls)), {"action": "remove-worker", "worker": "tcp://dead:1",
+    def inject(fn, args, key):
+        data, seed, _ = args
+        assert fn is run_chunk
+        assert str(tmp_path) not in repr(data)  # a chunk never gets a client path: OUT stays the client's
+        n_seed = sum(c[1][1] == seed for c in client.calls)
+        if (seed, n_seed) == (3, 2) or seed == 4 and n_seed > 1:  # killed: the scheduler logs the lost chunk
+            client.events.append((float(len(client.calls)), {"action": "remove-worker", "worker": "tcp://dead:1",
                                                              "processing-tasks": [key], "expected": False}))
-                return Future(KilledWorker(key, None, 3), key)
-            return Future(fn(data, seed, checkpoint), key)
+            return KilledWorker(key, None, 3)
+        return None
 
-    monkeypatch.setattr("distributed.as_completed", AsCompleted)
-    client = Client()
+    use_inline_dask(monkeypatch)
+    monkeypatch.setattr(batch, "PROGRESS_EVERY", 0.0)  # a progress line after every checkpoint
+    client = InlineClient(inject=inject)
     tasks = batch.plan([("alpha.yaml", config_from_dict(copy.deepcopy(ALPHA)))], 2, tmp_path)
     lines = []
     records = batch.run_tasks(tasks, client, lines.append)
@@ -332,17 +297,27 @@ def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monke
         assert (tmp_path / "alpha" / "seed3" / f).read_bytes() == (sequential[("alpha", 3)] / f).read_bytes()
     # SMALL: 6 generations, a checkpoint every 2 -> chunks end at generations 2, 4, 6; the killed second chunk is
     # resubmitted with the checkpoint of generation 2 that the first chunk returned
-    seed3 = [(ck, key) for s, ck, key in client.calls if s == 3]
+    calls = [(args[1], args[2], key, kwargs) for _, args, key, kwargs in client.calls]
+    assert all(kw["allow_other_workers"] is True and len(kw["workers"]) == 1 for *_, kw in calls)
+    seed3 = [(ck, key) for s, ck, key, _ in calls if s == 3]
     assert [key.rsplit("-", 2)[1] for _, key in seed3] == ["gen0", "gen2", "gen2", "gen4"]
     assert seed3[0][0] is None and seed3[1][0] == seed3[2][0] and seed3[1][0] is not None
     assert ok.chunks == 3 and ok.numba_threads == 1
     assert ok.workers == [{"address": "local", "name": "local", "nthreads": 1, "numba_threads": 1, "chunks": 3}]
     assert lost.status == "failed" and lost.retries == batch.MAX_RESUBMITS + 1
     assert lost.error.startswith("workers kept dying while running generations after 2 (dask's KilledWorker 4 times)")
-    seed4 = [ck for s, ck, _ in client.calls if s == 4]
+    seed4 = [ck for s, ck, _, _ in calls if s == 4]
     assert (tmp_path / "alpha" / "seed4" / "checkpoint.pkl").read_bytes() == seed4[1]
     assert not (tmp_path / "alpha" / "seed4" / "manifest.json").exists()
     assert sum("worker tcp://dead:1 lost while running generations after 2" in ln for ln in lines) == 5
+    # one progress line per checkpoint (PROGRESS_EVERY 0): both first chunks run at once (two idle workers), seed 3
+    # reaches 2, seed 4 reaches 2 (its later chunks are all killed), seed 3 reaches 4; 2 x 6 generations in all.
+    # The other task's chunk is in flight each time.
+    assert [ln for ln in lines if ln.startswith("progress: ")] == [
+        "progress: 0/2 tasks ended, 1 chunks running, generations 2/12 (17 %)",
+        "progress: 0/2 tasks ended, 1 chunks running, generations 4/12 (33 %)",
+        "progress: 0/2 tasks ended, 1 chunks running, generations 6/12 (50 %)",
+    ]
 
 
 def test_without_dask_the_batch_says_how_to_install_it(tmp_path, monkeypatch):

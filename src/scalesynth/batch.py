@@ -49,6 +49,7 @@ COMBINED = "combined_pareto.csv"
 HV_PLOT = "hypervolume_by_seed.png"
 MAX_SEED = 2**32 - 1
 MAX_RESUBMITS = 3  # times a chunk is resubmitted after dask gave up on it (KilledWorker: its workers kept dying)
+PROGRESS_EVERY = 30.0  # seconds between progress lines while tasks run
 
 
 @dataclass(frozen=True)
@@ -331,11 +332,24 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
     records: list[TaskRecord | None] = [None] * len(tasks)
     mine = client_versions()
     done = 0
+    n_gen = [int(t.data["algorithm"]["n_gen"]) for t in tasks]
+    generations = [0] * len(tasks)  # per task: the generation of the client's latest checkpoint (n_gen: ended)
+    last_progress = time.monotonic()
+
+    def progress() -> None:
+        nonlocal last_progress
+        if echo is None or time.monotonic() - last_progress < PROGRESS_EVERY:
+            return
+        last_progress = time.monotonic()
+        share = 100.0 * sum(generations) / max(1, sum(n_gen))
+        echo(f"progress: {done}/{len(tasks)} tasks ended, {len(inflight)} chunks running, generations "
+             f"{sum(generations)}/{sum(n_gen)} ({share:.0f} %)")
 
     def finish(rec: TaskRecord, index: int) -> None:
         nonlocal done
         records[index] = rec
         done += 1
+        generations[index] = n_gen[index]
         if echo is not None:
             hv = f"HV {rec.hypervolume:.6g}, " if rec.hypervolume is not None else ""
             why = f": {rec.error}" if rec.error else ""
@@ -417,7 +431,9 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
                 blob = chunk["checkpoint"]
                 rio.write_atomic(run.task.out_dir / rio.CHECKPOINT, lambda fh: fh.write(blob), mode="wb")
                 run.checkpoint, run.generation = blob, int(chunk["generation"])
+                generations[run.index] = run.generation
                 pending.appendleft(run)
+                progress()
                 return None
             _write_results(run.task.out_dir, chunk["files"])
             for k, v in _results_outcome(run.task.out_dir).items():
