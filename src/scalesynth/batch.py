@@ -484,6 +484,7 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
                        "in OUT: re-run the same command to resume") from None
     return [r for r in records if r is not None]
 
+
 def nondominated_mask(F: np.ndarray) -> np.ndarray:
     """True for rows of F (minimisation) that no other row weakly dominates with one strict improvement."""
     F = np.asarray(F, dtype=float)

@@ -46,7 +46,7 @@ def check_address(address: str) -> str:
 
 
 def address_from_file(path: Path) -> str:
-    """The scheduler address in a dask scheduler file (``dask scheduler --scheduler-file``, dask-jobqueue, dask-mpi);
+    """The scheduler address in a dask scheduler file (``dask scheduler --scheduler-file``, dask-mpi);
     ConfigError (exit 2) naming --scheduler-file if it cannot be read or holds no valid address."""
     try:
         info = json.loads(Path(path).read_text(encoding="utf-8"))

@@ -23,7 +23,7 @@ def batch_cmd(
     scheduler_file: Annotated[
         Path | None,
         typer.Option("--scheduler-file", help="JSON file with the scheduler's address, as written by `dask scheduler "
-                     "--scheduler-file` or dask-jobqueue"),
+                     "--scheduler-file` or dask-mpi"),
     ] = None,
     out: Annotated[Path, typer.Option("--out", help="batch directory on this machine (the client)")] = Path(
         "results/batch"),
