@@ -9,6 +9,7 @@ import copy
 import json
 import logging
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from fake_dask import InlineClient, use_inline_dask
 from scalesynth.batch import combined_front, format_table, local_cluster_shape, nondominated_mask, run_batch
 from scalesynth.cli import app
 from scalesynth.config import config_from_dict
@@ -250,38 +252,74 @@ def test_ci_workflow_runs_a_small_batch_and_uploads_its_directory(root):
 
 
 def test_unreachable_scheduler_is_a_one_line_error_exit_1(tmp_path, monkeypatch):
-    from scalesynth import batch
+    from scalesynth import cluster
 
-    monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", "1s")
     cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    t0 = time.monotonic()
     r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"),
                                  "--scheduler", "tcp://127.0.0.1:9"])
+    assert time.monotonic() - t0 < 30  # bounded by CONNECT_TIMEOUT (1 s here), not dask's retries forever
     assert r.exit_code == 1, r.output
     lines = r.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: --scheduler tcp://127.0.0.1:9: cannot connect"), lines
     assert not (tmp_path / "out").exists()
 
 
-def test_a_lost_worker_fails_only_its_task(monkeypatch):
-    """A future that raises (e.g. KilledWorker when a worker process dies) becomes a failed record."""
-    from concurrent.futures import Future
+def test_lost_chunks_are_resubmitted_from_the_clients_checkpoint(tmp_path, monkeypatch, sequential):
+    """The client's chunk driver with real chunks run in this process and dask's failures injected: a chunk that
+    dask gives up on (KilledWorker) is resubmitted with the checkpoint the client wrote, and the task ends
+    byte-identical to a sequential run; a task whose chunks are always killed fails alone after MAX_RESUBMITS
+    resubmissions, its checkpoint kept on the client; retries come from the scheduler's remove-worker events."""
+    from distributed.scheduler import KilledWorker
 
     from scalesynth import batch
+    from scalesynth.batch_task import run_chunk
 
-    class Client:
-        def submit(self, fn, data, seed, out_dir, **kwargs):
-            fut = Future()
-            if seed == 2:
-                fut.set_exception(RuntimeError("Attempted to run task on 3 different workers,\n all died"))
-            else:
-                fut.set_result({"status": "skipped", "hypervolume": 1.0})
-            return fut
+    def inject(fn, args, key):
+        data, seed, _ = args
+        assert fn is run_chunk
+        assert str(tmp_path) not in repr(data)  # a chunk never gets a client path: OUT stays the client's
+        n_seed = sum(c[1][1] == seed for c in client.calls)
+        if (seed, n_seed) == (3, 2) or seed == 4 and n_seed > 1:  # killed: the scheduler logs the lost chunk
+            client.events.append((float(len(client.calls)), {"action": "remove-worker", "worker": "tcp://dead:1",
+                                                             "processing-tasks": [key], "expected": False}))
+            return KilledWorker(key, None, 3)
+        return None
 
-    monkeypatch.setattr("dask.distributed.as_completed", lambda futures: list(futures))
-    tasks = [batch.BatchTask("a", "a.yaml", s, Path(f"out/a/seed{s}"), {}) for s in (1, 2, 3)]
-    records = batch.run_tasks(tasks, Client())
-    assert [r.status for r in records] == ["skipped", "failed", "skipped"]
-    assert records[1].error == "RuntimeError: Attempted to run task on 3 different workers, all died"
+    use_inline_dask(monkeypatch)
+    monkeypatch.setattr(batch, "PROGRESS_EVERY", 0.0)  # a progress line after every checkpoint
+    client = InlineClient(inject=inject)
+    tasks = batch.plan([("alpha.yaml", config_from_dict(copy.deepcopy(ALPHA)))], 2, tmp_path)
+    lines = []
+    records = batch.run_tasks(tasks, client, lines.append)
+    ok, lost = records
+    assert ok.status == "finished" and ok.retries == 1 and ok.lost_workers == ["tcp://dead:1"]
+    for f in ("pareto.csv", "population.csv"):
+        assert (tmp_path / "alpha" / "seed3" / f).read_bytes() == (sequential[("alpha", 3)] / f).read_bytes()
+    # SMALL: 6 generations, a checkpoint every 2 -> chunks end at generations 2, 4, 6; the killed second chunk is
+    # resubmitted with the checkpoint of generation 2 that the first chunk returned
+    calls = [(args[1], args[2], key, kwargs) for _, args, key, kwargs in client.calls]
+    assert all(kw["allow_other_workers"] is True and len(kw["workers"]) == 1 for *_, kw in calls)
+    seed3 = [(ck, key) for s, ck, key, _ in calls if s == 3]
+    assert [key.rsplit("-", 2)[1] for _, key in seed3] == ["gen0", "gen2", "gen2", "gen4"]
+    assert seed3[0][0] is None and seed3[1][0] == seed3[2][0] and seed3[1][0] is not None
+    assert ok.chunks == 3 and ok.numba_threads == 1
+    assert ok.workers == [{"address": "local", "name": "local", "nthreads": 1, "numba_threads": 1, "chunks": 3}]
+    assert lost.status == "failed" and lost.retries == batch.MAX_RESUBMITS + 1
+    assert lost.error.startswith("workers kept dying while running generations after 2 (dask's KilledWorker 4 times)")
+    seed4 = [ck for s, ck, _, _ in calls if s == 4]
+    assert (staging_path(tmp_path / "alpha" / "seed4") / "checkpoint.pkl").read_bytes() == seed4[1]
+    assert not (tmp_path / "alpha" / "seed4" / "manifest.json").exists()
+    assert sum("worker tcp://dead:1 lost while running generations after 2" in ln for ln in lines) == 5
+    # one progress line per checkpoint (PROGRESS_EVERY 0): both first chunks run at once (two idle workers), seed 3
+    # reaches 2, seed 4 reaches 2 (its later chunks are all killed), seed 3 reaches 4; 2 x 6 generations in all.
+    # The other task's chunk is in flight each time.
+    assert [ln for ln in lines if ln.startswith("progress: ")] == [
+        "progress: 0/2 tasks ended, 1 chunks running, generations 2/12 (17 %)",
+        "progress: 0/2 tasks ended, 1 chunks running, generations 4/12 (33 %)",
+        "progress: 0/2 tasks ended, 1 chunks running, generations 6/12 (50 %)",
+    ]
 
 
 def test_without_dask_the_batch_says_how_to_install_it(tmp_path, monkeypatch):
@@ -291,3 +329,108 @@ def test_without_dask_the_batch_says_how_to_install_it(tmp_path, monkeypatch):
     assert r.exit_code == 1
     assert r.output.strip() == "error: batch needs dask.distributed: pip install 'scalesynth[dask]'"
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("address", "problem"),
+    [
+        ("tcp://127.0.0.1:notaport", "port 'notaport' is not a number in 1..65535"),
+        ("tcp://127.0.0.1:0", "port '0' is not a number in 1..65535"),
+        ("tcp://127.0.0.1:70000", "port '70000' is not a number in 1..65535"),
+        ("foo bar", "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        ("tcp://127.0.0.1", "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        ("tcp://:8786", "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"),
+        ("http://127.0.0.1:8786", "unknown protocol 'http' (use tcp, tls, ws, wss, ucx)"),
+    ],
+)
+def test_a_malformed_scheduler_address_is_bad_input_exit_2(tmp_path, address, problem):
+    cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"), "--scheduler", address])
+    assert r.exit_code == 2, r.output
+    assert r.output.strip().splitlines() == [f"error: --scheduler: {address!r}: {problem}"]
+    assert not (tmp_path / "out").exists()
+
+
+def test_scheduler_addresses_are_normalised():
+    from scalesynth.cluster import check_address
+
+    assert check_address("127.0.0.1:8786") == "tcp://127.0.0.1:8786"
+    assert check_address(" tls://node-7.cluster:08786 ") == "tls://node-7.cluster:8786"
+    assert check_address("tcp://[::1]:8786") == "tcp://[::1]:8786"
+
+
+@pytest.mark.parametrize(
+    ("content", "problem"),
+    [
+        (None, "cannot read (No such file or directory)"),
+        ("{not json", "not a dask scheduler file (invalid JSON)"),
+        ('{"id": "Scheduler-1"}', "not a dask scheduler file (no 'address')"),
+        ('{"address": "tcp://127.0.0.1:x"}', None),
+    ],
+)
+def test_a_bad_scheduler_file_is_bad_input_exit_2(tmp_path, content, problem):
+    cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
+    sched = tmp_path / "scheduler.json"
+    if content is not None:
+        sched.write_text(content)
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"), "--scheduler-file",
+                                 str(sched)])
+    assert r.exit_code == 2, r.output
+    expected = (f"error: --scheduler-file {sched}: {problem}" if problem
+                else "error: --scheduler: 'tcp://127.0.0.1:x': port 'x' is not a number in 1..65535")
+    assert r.output.strip().splitlines() == [expected]
+    r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"), "--scheduler-file",
+                                 str(sched), "--scheduler", "tcp://127.0.0.1:8786"])
+    assert r.exit_code == 2 and r.output.strip() == "error: --scheduler, --scheduler-file: give one of them"
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_worker_without_scalesynth_or_with_other_versions_is_named():
+    """check_workers compares dask's package report of every worker with the client's: the first differing worker
+    is named with what differs, on one line (a RunError: exit 1, before any task is submitted)."""
+    from scalesynth.cluster import CHECKED_PACKAGES, check_workers, client_versions
+
+    mine = client_versions()
+    ok = {"packages": {"python": sys.version.split()[0] + ".final.0", **{p: mine[p] for p in CHECKED_PACKAGES}}}
+
+    class Client:
+        def __init__(self, workers):
+            self.workers = workers
+
+        def scheduler_info(self, n_workers=5):
+            assert n_workers == -1  # every worker, not the first five
+            return {"workers": {a: {"name": f"n{i}", "nthreads": 2} for i, a in enumerate(sorted(self.workers))}}
+
+        def get_versions(self, packages):
+            assert set(packages) == set(CHECKED_PACKAGES)
+            return {"workers": self.workers}
+
+    good = {"tcp://10.0.0.1:1": ok, "tcp://10.0.0.2:1": ok}
+    assert check_workers(Client(good)) == {"tcp://10.0.0.1:1": {"name": "n0", "nthreads": 2},
+                                           "tcp://10.0.0.2:1": {"name": "n1", "nthreads": 2}}
+    lacking = {"packages": {**ok["packages"], "scalesynth": None}}
+    older = {"packages": {**ok["packages"], "numba": "0.60.0", "pymoo": "0.6.0"}}
+    with pytest.raises(RunError) as err:
+        check_workers(Client({**good, "tcp://10.0.0.3:1": lacking}))
+    assert str(err.value) == f"worker tcp://10.0.0.3:1 (n2): scalesynth not installed (client {mine['scalesynth']})"
+    with pytest.raises(RunError) as err:
+        check_workers(Client({"tcp://10.0.0.1:1": ok, "tcp://10.0.0.4:1": older, "tcp://10.0.0.5:1": lacking}))
+    assert str(err.value) == (f"worker tcp://10.0.0.4:1 (n1): numba 0.60.0 (client {mine['numba']}); pymoo 0.6.0 "
+                              f"(client {mine['pymoo']}) (and 1 more workers)")
+
+
+def test_a_task_uses_its_workers_thread_count_capped_by_numbas_pool():
+    import numba
+
+    from scalesynth.batch_task import set_numba_threads, worker_identity
+
+    before = numba.get_num_threads()
+    try:
+        assert set_numba_threads(1) == 1 == numba.get_num_threads()
+        # more than the pool Numba started with (NUMBA_NUM_THREADS): the whole pool, never an error
+        assert set_numba_threads(10**6) == numba.config.NUMBA_NUM_THREADS
+    finally:
+        numba.set_num_threads(before)
+    # outside a dask worker (a direct call): Numba's pool size stands in for the worker's threads
+    assert worker_identity() == {"address": "local", "name": "local", "nthreads": numba.config.NUMBA_NUM_THREADS,
+                                 "local_directory": None}

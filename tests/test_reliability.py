@@ -308,22 +308,17 @@ def test_disk_full_in_batch_summary_is_exit_1(tmp_path, monkeypatch):
 
     cfg = config_from_dict(small(name="solo", algorithm={"pop_size": 8, "n_gen": 2}))
 
-    class InlineClient:  # runs tasks in this process: the failure under test is on the client side
-        def submit(self, fn, *args, **kwargs):
-            from concurrent.futures import Future
-
-            fut = Future()
-            fut.set_result(fn(*args))
-            return fut
-
     from contextlib import contextmanager
 
+    from fake_dask import InlineClient, use_inline_dask
+
     @contextmanager
-    def inline(scheduler, n_tasks):
+    def inline(scheduler, n_tasks):  # runs tasks in this process: the failure under test is on the client side
         yield InlineClient()
 
     monkeypatch.setattr(batch, "dask_client", inline)
-    monkeypatch.setattr("dask.distributed.as_completed", lambda futures: list(futures))
+    monkeypatch.setattr(batch, "check_workers", lambda client: {})
+    use_inline_dask(monkeypatch)
     _disk_full_inside(monkeypatch, tmp_path / "batch.json")
     with pytest.raises(RunError, match=r"batch\.json: cannot write \(No space left on device\)"):
         batch.run_batch([("solo.yaml", cfg)], tmp_path, seeds=1)

@@ -201,11 +201,14 @@ def run(
     progress: ProgressFn | None = None,
     plots: bool = True,
     stop_after: int | None = None,
+    on_checkpoint: Callable[[Path, int], None] | None = None,
 ) -> RunResult:
     """Run NSGA-II for ``cfg`` and write the results directory.
 
     ``stop_after`` (generations) ends the loop early without writing final results, leaving a checkpoint: it
-    exists for tests of resume and for chunked runs.
+    exists for tests of resume and for chunked runs. ``on_checkpoint(path, generation)`` is called after every
+    checkpoint write (the last one too, before the results are written); an exception it raises ends the run
+    there, leaving that checkpoint (the batch runner ships checkpoints to its client this way).
     """
     if seed is not None:
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
@@ -245,14 +248,14 @@ def run(
             out = claimed.fresh()  # a fresh run: an abandoned staging directory belongs to another run
             algorithm = fresh_algorithm
         result = _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, history, elapsed_before,
-                                  started, progress, plots, stop_after)
+                                  started, progress, plots, stop_after, on_checkpoint)
         claimed.commit()
     # ---- end of the run-directory block ------------------------------------------------------------------------
     return dataclasses.replace(result, out_dir=target)  # the same run, now at its target
 
 
 def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, history, elapsed_before, started,
-                     progress, plots, stop_after) -> RunResult:
+                     progress, plots, stop_after, on_checkpoint=None) -> RunResult:
     """The NSGA-II loop from ``algorithm``'s state; writes checkpoints and the results into ``out``."""
     # compile the kernels before the clock starts on the first generation
     problem.metrics(np.atleast_2d((problem.xl + problem.xu) / 2))
@@ -274,6 +277,8 @@ def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, histo
                 ckpt_path,
                 {"algorithm": algorithm, "history": history, "elapsed": elapsed, "digest": digest, "started": started},
             )
+            if on_checkpoint is not None:
+                on_checkpoint(ckpt_path, row["generation"])
         if stop_after is not None and gens_this_call >= stop_after and not done:
             raise RunError(f"stopped after {gens_this_call} generations (checkpoint in {ckpt_path})")
     wall = elapsed_before + time.perf_counter() - t0

@@ -2,25 +2,12 @@
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
-
-_ADDRESS = re.compile(r"^(?:(?:tcp|tls|ucx|ws|wss|inproc)://)?(?:\[[0-9a-fA-F:.]+\]|[A-Za-z0-9_.-]+)(?::[0-9]{1,5})?/?$")
-
-
-def check_scheduler_address(address: str) -> None:
-    """ConfigError (exit 2) unless ``address`` looks like a dask scheduler address: [protocol://]host[:port]."""
-    from scalesynth.config import _quote
-    from scalesynth.errors import ConfigError
-
-    port = address.rstrip("/").rsplit(":", 1)[-1]
-    if not _ADDRESS.match(address) or (port.isdigit() and not 0 < int(port) < 65536):
-        raise ConfigError(f"--scheduler: not a scheduler address such as tcp://host:8786, got {_quote(address)}")
 
 
 @app.command("batch")
@@ -33,7 +20,13 @@ def batch_cmd(
         typer.Option("--scheduler", help="address of a running dask scheduler, e.g. tcp://host:8786 (default: a "
                      "local cluster sized to this machine)"),
     ] = None,
-    out: Annotated[Path, typer.Option("--out", help="batch directory")] = Path("results/batch"),
+    scheduler_file: Annotated[
+        Path | None,
+        typer.Option("--scheduler-file", help="JSON file with the scheduler's address, as written by `dask scheduler "
+                     "--scheduler-file` or dask-mpi"),
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", help="batch directory on this machine (the client)")] = Path(
+        "results/batch"),
     sets: SetOpt = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="print the summary (batch.json) instead of the table")
@@ -41,12 +34,15 @@ def batch_cmd(
 ) -> None:
     """Run every (config, seed) pair as one dask task into OUT/<name>/seed<k>/ (finished tasks are skipped,
     unfinished ones resumed); write OUT/batch.json and, per config, the combined front and a hypervolume plot.
-    Exit code 1 if any task failed."""
+    The client writes every file: workers need no access to OUT. Exit code 1 if any task failed."""
     from scalesynth.batch import format_table, run_batch
+    from scalesynth.cluster import address_from_file, check_address
     from scalesynth.config import load_config
+    from scalesynth.errors import ConfigError
 
-    if scheduler is not None:
-        check_scheduler_address(scheduler)
+    if scheduler and scheduler_file:
+        raise ConfigError("--scheduler, --scheduler-file: give one of them")
+    scheduler = address_from_file(scheduler_file) if scheduler_file else check_address(scheduler) if scheduler else None
     loaded = [(str(path), load_config(path, sets)) for path in configs]  # all validated before any task starts
     summary = run_batch(loaded, out, seeds=seeds, scheduler=scheduler, echo=lambda line: typer.echo(line, err=True))
     if as_json:

@@ -1,0 +1,151 @@
+"""Connecting ``scalesynth batch`` to dask: scheduler address checks, an embedded LocalCluster sized to the machine,
+and the check that every worker runs the client's versions of scalesynth and the packages its results depend on.
+
+dask is an optional dependency (``pip install scalesynth[dask]``): it is imported only here and in scalesynth.batch,
+lazily.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from scalesynth.errors import ConfigError, RunError
+
+CONNECT_TIMEOUT = "20s"  # for --scheduler: how long to try to reach the scheduler
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_HOST = re.compile(r"^(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)$")
+# packages whose versions must match between client and workers for byte-identical results (+ scalesynth itself)
+CHECKED_PACKAGES = ("scalesynth", "numpy", "numba", "llvmlite", "pymoo", "moocore", "pandas", "pydantic", "pyyaml")
+
+
+def check_address(address: str) -> str:
+    """A dask scheduler address as ``scheme://host:port`` (the scheme defaults to tcp); ConfigError (exit 2)
+    naming --scheduler if it is malformed."""
+    text = address.strip()
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    host, colon, port = rest.rpartition(":")
+    problem = None
+    if scheme not in SCHEMES:
+        problem = f"unknown protocol {scheme!r} (use {', '.join(SCHEMES)})"
+    elif not colon or not host or not _HOST.match(host):
+        problem = "expected SCHEME://HOST:PORT, e.g. tcp://10.0.0.5:8786"
+    elif not port.isdigit() or not 1 <= int(port) <= 65535:
+        problem = f"port {port!r} is not a number in 1..65535"
+    if problem:
+        raise ConfigError(f"--scheduler: {address!r}: {problem}")
+    return f"{scheme}://{host}:{int(port)}"
+
+
+def address_from_file(path: Path) -> str:
+    """The scheduler address in a dask scheduler file (``dask scheduler --scheduler-file``, dask-mpi);
+    ConfigError (exit 2) naming --scheduler-file if it cannot be read or holds no valid address."""
+    try:
+        info = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as err:
+        raise ConfigError(f"--scheduler-file {path}: cannot read ({err.strerror or err})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise ConfigError(f"--scheduler-file {path}: not a dask scheduler file (invalid JSON)") from None
+    address = info.get("address") if isinstance(info, dict) else None
+    if not isinstance(address, str):
+        raise ConfigError(f"--scheduler-file {path}: not a dask scheduler file (no 'address')")
+    return check_address(address)
+
+
+def local_cluster_shape(n_tasks: int, cores: int | None = None) -> tuple[int, int]:
+    """(worker processes, threads per worker) for an embedded cluster: workers x threads <= cores. Each task's
+    Numba kernels use its worker's threads."""
+    cores = max(1, cores or os.cpu_count() or 1)
+    workers = max(1, min(n_tasks, cores))
+    return workers, max(1, cores // workers)
+
+
+def _dask():
+    try:
+        import dask.distributed as distributed
+    except ImportError:
+        raise RunError("batch needs dask.distributed: pip install 'scalesynth[dask]'") from None
+    return distributed
+
+
+@contextmanager
+def dask_client(scheduler: str | None, n_tasks: int) -> Iterator[Any]:
+    """A dask Client: on the cluster at ``scheduler`` (used as it is; an unreachable one is a RunError after
+    CONNECT_TIMEOUT), else on an embedded LocalCluster of worker processes with ``threads`` threads each and
+    NUMBA_NUM_THREADS = threads, so the machine is not oversubscribed."""
+    distributed = _dask()
+    if scheduler:
+        address = check_address(scheduler)
+        try:
+            client = distributed.Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as err:
+            from scalesynth.batch_task import one_line
+
+            raise RunError(f"--scheduler {scheduler}: cannot connect ({one_line(err)})") from None
+        with client:
+            yield client
+        return
+    workers, threads = local_cluster_shape(n_tasks)
+    cluster = distributed.LocalCluster(
+        n_workers=workers,
+        threads_per_worker=threads,
+        processes=True,
+        # the scheduler always serves HTTP (health routes): a free port, not the default 8787; no dashboard
+        dashboard_address=":0",
+        scheduler_kwargs={"dashboard": False},
+        silence_logs=logging.ERROR,
+        env={"NUMBA_NUM_THREADS": str(threads)},
+    )
+    with cluster, distributed.Client(cluster, set_as_default=False) as client:
+        yield client
+
+
+def _major_minor(python: str | None) -> str | None:
+    return ".".join(python.split(".")[:2]) if python else None
+
+
+def client_versions() -> dict[str, str | None]:
+    """This process's versions of CHECKED_PACKAGES and Python (major.minor), as dask reports them."""
+    from distributed.versions import get_package_info
+
+    info = get_package_info(CHECKED_PACKAGES)
+    return {"python": _major_minor(info.get("python")), **{p: info.get(p) for p in CHECKED_PACKAGES}}
+
+
+def version_differences(mine: dict[str, str | None], theirs: dict[str, str | None]) -> list[str]:
+    """'PACKAGE X (client Y)' for every package whose version differs ('not installed' where missing)."""
+    out = []
+    for pkg, want in mine.items():
+        have = theirs.get(pkg)
+        if have != want:
+            out.append(f"{pkg} {have or 'not installed'} (client {want or 'not installed'})")
+    return out
+
+
+def check_workers(client) -> dict[str, dict[str, Any]]:
+    """The connected workers as {address: {name, nthreads}}; RunError naming the first worker whose scalesynth or
+    result-relevant packages differ from the client's (or that lacks scalesynth), and what differs."""
+    info = client.scheduler_info(n_workers=-1)["workers"]
+    versions = client.get_versions(packages=list(CHECKED_PACKAGES))["workers"]
+    mine = client_versions()
+    bad = []
+    for address in sorted(versions):
+        packages = (versions[address] or {}).get("packages", {})
+        theirs = {"python": _major_minor(packages.get("python")), **{p: packages.get(p) for p in CHECKED_PACKAGES}}
+        diff = version_differences(mine, theirs)
+        if diff:
+            bad.append((address, diff))
+    if bad:
+        address, diff = bad[0]
+        name = info.get(address, {}).get("name", address)
+        more = f" (and {len(bad) - 1} more workers)" if len(bad) > 1 else ""
+        raise RunError(f"worker {address} ({name}): {'; '.join(diff)}{more}")
+    return {a: {"name": str(w.get("name", a)), "nthreads": int(w.get("nthreads", 0))} for a, w in sorted(info.items())}
