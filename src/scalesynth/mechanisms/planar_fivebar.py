@@ -32,6 +32,7 @@ from numba import njit
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels.conditioning import lci_2x2
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     Mechanism,
     Option,
@@ -44,6 +45,8 @@ from scalesynth.mechanisms.base import (
 )
 
 MODES = ("++", "+-", "-+", "--")
+# default capsule radii (mm) of the bodies, illustrative like the lengths: the platform ball carries the gripper
+LINK_RADII = {"base": 25.0, "arm1": 20.0, "arm2": 20.0, "forearm1": 15.0, "forearm2": 15.0, "platform": 40.0}
 TWO_PI = 2.0 * math.pi
 
 # packed-parameter layout (see PlanarFivebar.pack); arm limit i occupies 6 slots from _LIM[i]:
@@ -128,6 +131,7 @@ class PlanarFivebar(Mechanism):
             raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
         for name in ("alpha1_limits", "alpha2_limits"):
             options[name] = parse_range(name, options[name])
+        links.check_radius_option(options, LINK_RADII)
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(N_PACKED)
@@ -268,6 +272,31 @@ class PlanarFivebar(Mechanism):
             return 0.0
         return svd_lci(jac["J"])
 
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules in the plane z = 0 (mm): base B2 -> B1, arm_i B_i -> Q_i, forearm_i Q_i -> P, and the
+        platform as a ball at P. Adjacent (a joint between them): base-arm_i, arm_i-forearm_i, the two forearms
+        (they meet at P), forearm_i-platform. Radii: option ``link_radius``, defaults LINK_RADII."""
+        x, y = self.check_vector("pose", pose, 2)
+        q1, q2 = self.elbows(design, q)
+        rad = links.radii(options, LINK_RADII)
+        r = design["r"]
+        b1, b2, p = links.point(r, 0.0), links.point(-r, 0.0), links.point(x, y)
+        e1, e2 = links.point(*q1), links.point(*q2)
+        ends = {"base": (b2, b1), "arm1": (b1, e1), "arm2": (b2, e2), "forearm1": (e1, p), "forearm2": (e2, p),
+                "platform": (p, p)}
+        segments = tuple(links.Segment(name, name, a, b, rad[name]) for name, (a, b) in ends.items())
+        return links.LinkGeometry(segments, links.adjacency([
+            ("base", "arm1"), ("base", "arm2"), ("arm1", "forearm1"), ("arm2", "forearm2"),
+            ("forearm1", "forearm2"), ("forearm1", "platform"), ("forearm2", "platform"),
+        ]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """A = Jq^-1 Jx (rad/mm): alpha_dot = A P_dot, the inverse of J (spec §2.4); rows with an inverse
+        singularity (Jq_ii = 0) are infinite."""
+        jac = self.jacobians(design, options, pose, q)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return jac["Jx"] / np.diag(jac["Jq"])[:, None]
+
     def resolution_index(self, design, options, pose, dalpha=(1.0, 1.0)) -> float:
         """Kinematic resolution |J dalpha| (mm per the arm increments dalpha in rad; spec §2.4, paper eq. 18) in
         the working mode options['mode']. Infinite at an exact forward singularity (J unbounded); raises
@@ -337,6 +366,8 @@ MECHANISM = PlanarFivebar(
         Option("mode", "+-", "working mode sigma1 sigma2: '+-' = elbows out (operating mode), '++', '-+', '--'"),
         Option("alpha1_limits", None, "[lo, hi] rad for alpha1 modulo 2 pi, null = none (spec: [-4pi/9, 7pi/36])"),
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults "
+               "base 25, arm1/arm2 20, forearm1/forearm2 15, platform 40 (illustrative)"),
     ),
     default_length_unit="mm",
 )
