@@ -313,7 +313,12 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
         if cyc.speed_limits is not None or cyc.force_limits is not None:
             bad["max_cycles_per_minute"] = 0.0
         return bad
-    n = len(mech.joints)
+    return result_metrics(res, cyc)
+
+
+def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:
+    """The catalogue metrics (see ``metrics``) of an analysed, followable cycle."""
+    n = len(res.joints)
     speed = ccfg.limit_vector(cyc.speed_limits, n)
     force = ccfg.limit_vector(cyc.force_limits, n)
     scale = max_rate_scale(res, speed, force)

@@ -1,0 +1,120 @@
+"""``scalesynth cycle CONFIG|RUN_DIR``: a design's pick-and-place cycle (``scalesynth.cycle``).
+
+CONFIG is a run config with a ``cycle:`` section (its ``design`` is analysed); RUN_DIR is a results directory,
+whose config must have one, with ``--design knee`` (default), ``best-<metric>`` (the best front row for an
+objective's metric, or for a cycle metric: the lowest speed/acceleration/force, the highest LCI, clearance or
+rate) or a row number of pareto.csv. Writes cycle.csv, cycle.json, actuators.png, path.png, quality.png to
+``--out`` (default: <results dir>/cycle for a config, RUN_DIR/cycle-<design> for a run).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from scalesynth.cli import JsonOpt, SetOpt, _print_json, app, handles_errors
+from scalesynth.errors import ConfigError
+
+# the better direction of each cycle metric (for --design best-<metric>)
+_CYCLE_SENSE = {
+    "cycle_feasible": "max",
+    "cycle_max_actuator_speed": "min",
+    "cycle_max_actuator_accel": "min",
+    "cycle_max_actuator_force": "min",
+    "cycle_min_lci": "max",
+    "cycle_min_clearance": "max",
+    "max_cycles_per_minute": "max",
+}
+
+
+def pick_design(run_dir: Path, choice: str):
+    """(config, design, label) of a results directory's front row chosen by ``choice``."""
+    import numpy as np
+
+    from scalesynth.problem import SynthesisProblem
+    from scalesynth.report import design_of, load_run, objective_matrix
+    from scalesynth.selection import choose
+
+    cfg, pareto, _, _ = load_run(run_dir)
+    if not len(pareto):
+        raise ConfigError(f"{run_dir}: the front is empty (no feasible design)")
+    problem = SynthesisProblem(cfg)
+    if choice == "knee":
+        row = choose(objective_matrix(problem, pareto), "knee")
+    elif choice.startswith("best-"):
+        metric = choice.removeprefix("best-")
+        senses = {k: o.sense for k, o in zip(problem.objective_keys, cfg.objectives, strict=True)}
+        sense = senses.get(metric, _CYCLE_SENSE.get(metric))
+        if metric not in pareto.columns or sense is None:
+            known = sorted(set(senses) | (set(_CYCLE_SENSE) & set(pareto.columns)))
+            raise ConfigError(f"--design: best-{metric}: not an objective or cycle metric of the run "
+                              f"(known: {', '.join(known)})")
+        values = pareto[metric].to_numpy(dtype=float)
+        row = int(np.argmax(values) if sense == "max" else np.argmin(values))
+    else:
+        try:
+            row = int(choice)
+        except ValueError:
+            raise ConfigError(f"--design: expected knee, best-<metric> or a row number, got {choice!r}") from None
+        if not 0 <= row < len(pareto):
+            raise ConfigError(f"--design: row {row} out of range (pareto.csv has {len(pareto)} rows)")
+    return cfg, design_of(problem, pareto.iloc[row]), f"{choice}" if choice.startswith(("knee", "best-")) else f"row{row}"
+
+
+def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None):
+    """Analyse the cycle and write its files; returns the summary dict (cycle.json's content plus file paths)."""
+    from scalesynth import io as rio
+    from scalesynth.config import load_config
+    from scalesynth.cycle import analysis, output
+
+    source = Path(source)
+    if source.is_dir():
+        if sets:
+            raise ConfigError("--set: applies to a config file, not to a results directory")
+        cfg, design, label = pick_design(source, design_choice or "knee")
+        out_dir = out if out is not None else source / f"cycle-{label}"
+    else:
+        if design_choice is not None:
+            raise ConfigError("--design: applies to a results directory, not to a config file")
+        cfg = load_config(source, sets)
+        design = cfg.resolved_design()
+        out_dir = out if out is not None else cfg.output_dir() / "cycle"
+    if cfg.cycle is None:
+        raise ConfigError("cycle: the config has no cycle section (cycle.path or cycle.preset)")
+    options = cfg.resolved_options()
+    res = analysis.analyse(cfg.mech, design, options, cfg.cycle, cfg.units.length)
+    metrics = analysis.result_metrics(res, cfg.cycle)
+    out_dir = rio.ensure_dir(Path(out_dir))
+    output.write_csv(out_dir / "cycle.csv", res)
+    info = output.summary(res, metrics, design, cfg.cycle)
+    plots = output.write_plots(out_dir, cfg, design, options, res)
+    rio.write_json(out_dir / "cycle.json", info)
+    info["files"] = [str(out_dir / "cycle.csv"), str(out_dir / "cycle.json")] + [str(p) for p in plots]
+    return info
+
+
+@app.command("cycle")
+@handles_errors
+def cycle_cmd(
+    source: Annotated[Path, typer.Argument(help="run config (YAML) with a cycle section, or a results directory")],
+    sets: SetOpt = None,
+    design: Annotated[
+        str | None, typer.Option("--design", help="results directory only: knee (default), best-<metric> or a row")
+    ] = None,
+    out: Annotated[Path | None, typer.Option("--out", help="output directory")] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Pick-and-place cycle of a design: actuator curves and forces, LCI and link clearance (cycle.csv, plots)."""
+    info = run_cycle(source, sets, design, out)
+    if as_json:
+        _print_json(info)
+        return
+    m = info["metrics"]
+    typer.echo(f"cycle of {info['period_s']:.4g} s, {info['samples']} samples, {len(info['vertices']) - 1} segments")
+    for key, value in m.items():
+        typer.echo(f"  {key:<26} {value:.6g}")
+    where = info["min_clearance_at"]
+    typer.echo(f"  min clearance at t = {where['t_s']:.4g} s between {' and '.join(where['segments']) or '-'}")
+    typer.echo("wrote " + ", ".join(info["files"]))
