@@ -60,7 +60,8 @@ def pick_design(run_dir: Path, choice: str):
             raise ConfigError(f"--design: expected knee, best-<metric> or a row number, got {choice!r}") from None
         if not 0 <= row < len(pareto):
             raise ConfigError(f"--design: row {row} out of range (pareto.csv has {len(pareto)} rows)")
-    return cfg, design_of(problem, pareto.iloc[row]), f"{choice}" if choice.startswith(("knee", "best-")) else f"row{row}"
+    label = choice if choice.startswith(("knee", "best-")) else f"row{row}"
+    return cfg, design_of(problem, pareto.iloc[row]), label
 
 
 def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None):

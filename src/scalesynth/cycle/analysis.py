@@ -107,7 +107,8 @@ def _size(mech: Mechanism, design, options) -> float:
 
 def _where(mech: Mechanism, traj, k: int) -> str:
     pos = ", ".join(f"{v:.6g}" for v in traj.p[k])
-    return f"sample {k} (t = {traj.t[k]:.4g} s, segment {traj.segment[k] + 1}) at ({', '.join(mech.task_axes)}) = ({pos})"
+    axes = ", ".join(mech.task_axes)
+    return f"sample {k} (t = {traj.t[k]:.4g} s, segment {traj.segment[k] + 1}) at ({axes}) = ({pos})"
 
 
 def _branches(mech: Mechanism, design, options, pose) -> dict[str, np.ndarray]:
@@ -250,9 +251,9 @@ def _forces(mech, A, traj, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray
     """Actuator forces (n, n_joints), the payload force F = m (a - g) (n, k) and the map between them
     (n, n_joints, k), SI."""
     if any(u != "length" for u in mech.task_units):
-        raise CycleError(f"cycle: payload forces need Cartesian task axes; {mech.name} has {', '.join(mech.task_axes)}")
+        axes = ", ".join(mech.task_axes)
+        raise CycleError(f"cycle: payload forces need Cartesian task axes; {mech.name} has {axes}")
     n, k = traj.p.shape
-    nj = A.shape[-1]
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     F = mass * (traj.pdd * m_per_unit - g[None, :])
     A_si = si_velocity_map(mech, A, length_unit)
@@ -302,8 +303,8 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
     cycle_max_actuator_speed / _accel / _force: the largest |qd_i|, |qdd_i|, |force_i| over the cycle and the
     actuators (their units: length unit or rad per s, per s^2; N or N m; mixed for mixed actuators).
     cycle_min_lci, cycle_min_clearance (length unit; < 0 interference). max_cycles_per_minute: the configured
-    rate times max_rate_scale (only with speed or force limits). A cycle that cannot be followed gives feasible 0, speed,
-    acceleration and force CYCLE_PENALTY, LCI 0, clearance -CYCLE_PENALTY and 0 cycles per minute."""
+    rate times max_rate_scale (only with speed or force limits). A cycle that cannot be followed gives feasible 0,
+    speed, acceleration and force CYCLE_PENALTY, LCI 0, clearance -CYCLE_PENALTY and 0 cycles per minute."""
     try:
         res = analyse(mech, design, options, cyc, length_unit)
     except CycleError:
