@@ -1,4 +1,8 @@
-"""Plots and report.md for a finished results directory (reads its CSVs and config; draws via plotting.py)."""
+"""Plots and report.md of a run, from its RunResult in memory (scalesynth.results); draws via plotting.py.
+
+``optimize.run`` passes the result it just built, so report.md, the plots and manifest.json show the same
+figures; the ``plot-*`` commands pass ``results.load(run_dir)``.
+"""
 
 from __future__ import annotations
 
@@ -6,33 +10,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from scalesynth import io as rio
 from scalesynth import plotting
-from scalesynth.config import RunConfig, load_config
-from scalesynth.errors import ConfigError
+from scalesynth.config import RunConfig
 from scalesynth.evaluate import evaluate_config
 from scalesynth.problem import SynthesisProblem
+from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
-
-
-def load_run(run_dir: Path) -> tuple[RunConfig, pd.DataFrame, pd.DataFrame, pd.DataFrame | None]:
-    run_dir = Path(run_dir)
-    for name in ("config.yaml", "pareto.csv", "history.csv"):
-        if not (run_dir / name).is_file():
-            raise ConfigError(f"{run_dir}: not a scalesynth results directory (missing {name})")
-    cfg = load_config(run_dir / "config.yaml")
-    pareto = pd.read_csv(run_dir / "pareto.csv")
-    history = pd.read_csv(run_dir / "history.csv")
-    pop_path = run_dir / "population.csv"
-    population = pd.read_csv(pop_path) if pop_path.is_file() else None
-    return cfg, pareto, history, population
-
-
-def objective_matrix(problem: SynthesisProblem, frame: pd.DataFrame) -> np.ndarray:
-    """Objectives of the rows in minimisation form."""
-    return frame[problem.objective_keys].to_numpy(dtype=float) * problem.signs
 
 
 def _axes(problem: SynthesisProblem, cfg: RunConfig) -> tuple[str, str]:
@@ -42,13 +27,7 @@ def _axes(problem: SynthesisProblem, cfg: RunConfig) -> tuple[str, str]:
     return cfg.mech.measure_key(cfg.units.length), keys[0]
 
 
-def design_of(problem: SynthesisProblem, row: pd.Series) -> dict[str, float]:
-    d = dict(problem.base_design)
-    d.update({k: float(row[k]) for k in problem.var_names})
-    return d
-
-
-def reference_points(cfg: RunConfig, problem: SynthesisProblem) -> list[dict[str, Any]]:
+def reference_points(cfg: RunConfig) -> list[dict[str, Any]]:
     """The config's reference designs re-evaluated with the run's model and grid."""
     out = []
     for label, ref in cfg.references.items():
@@ -63,17 +42,16 @@ def dominated_by_front(F_front: np.ndarray, f: np.ndarray) -> bool:
     return bool(np.any(np.all(F_front <= f, axis=1) & np.any(F_front < f, axis=1)))
 
 
-def plot_front(run_dir: Path) -> dict[str, Any]:
+def plot_front(result: RunResult) -> dict[str, Any]:
     """plots/front.png (front, final population, reference designs, knee) and plots/hypervolume.png."""
-    run_dir = Path(run_dir)
-    cfg, pareto, history, population = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
-    plots = rio.ensure_dir(run_dir / "plots")
+    cfg, pareto, history, population, problem = (result.cfg, result.pareto, result.history, result.population,
+                                                 result.problem)
+    plots = rio.ensure_dir(result.out_dir / PLOTS)
     xk, yk = _axes(problem, cfg)
-    refs = reference_points(cfg, problem)
+    refs = reference_points(cfg)
     highlight = []
     if len(pareto):
-        F = objective_matrix(problem, pareto)
+        F = result.objective_matrix()
         k = choose(F, "knee")
         highlight.append(("knee", float(pareto[xk].iloc[k]), float(pareto[yk].iloc[k])))
         for r in refs:
@@ -106,9 +84,10 @@ def band_labels(edges) -> list[str]:
     return [f"{'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]" for b in range(len(edges) - 1)]
 
 
-def featured_designs(problem: SynthesisProblem, pareto: pd.DataFrame) -> list[tuple[str, int]]:
-    """The knee and the best design of each objective, as (label, row index), without repeats."""
-    F = objective_matrix(problem, pareto)
+def featured_designs(result: RunResult) -> list[tuple[str, int]]:
+    """The knee and the best design of each objective on the front, as (label, row index), without repeats."""
+    problem = result.problem
+    F = result.objective_matrix()
     out = [("knee", choose(F, "knee"))]
     for obj_idx, row in enumerate(extremes(F)):
         label = f"best {problem.objective_keys[obj_idx] if obj_idx < len(problem.objective_keys) else obj_idx}"
@@ -126,7 +105,7 @@ def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, A
     res = max(cfg.grid.resolution, SECTION_RESOLUTION)
     cfg = cfg.model_copy(update={"grid": cfg.grid.model_copy(update={"resolution": res + res % 2 + 1})})
     rep = evaluate_config(cfg, design, keep_grid=True)
-    g, lci = rep.grid, rep.lci_grid
+    g, lci = rep.grid, rep.field("lci")
     names = cfg.mech.task_axes
     ext = [(g.lo[a], g.lo[a] + g.shape[a] * g.step[a]) for a in range(3)]
     if len(names) == 2:
@@ -144,12 +123,10 @@ def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, A
     ]
 
 
-def plot_bands(run_dir: Path) -> dict[str, Any]:
+def plot_bands(result: RunResult) -> dict[str, Any]:
     """plots/bands_front.png, plots/band_shares.png and plots/sections_<design>.png (paper Figs. 7-10, Table 5)."""
-    run_dir = Path(run_dir)
-    cfg, pareto, _, _ = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
-    plots = rio.ensure_dir(run_dir / "plots")
+    cfg, pareto, problem = result.cfg, result.pareto, result.problem
+    plots = rio.ensure_dir(result.out_dir / PLOTS)
     edges = cfg.dexterity.band_edges
     labels = band_labels(edges)
     nb = len(edges) - 1
@@ -162,14 +139,14 @@ def plot_bands(run_dir: Path) -> dict[str, Any]:
     rio.save_figure(fig, plots / "bands_front.png")
     plotting.close(fig)
     files.append("plots/bands_front.png")
-    featured = featured_designs(problem, pareto)
+    featured = featured_designs(result)
     bar = np.array([[pareto[f"band{b}_share"].iloc[i] for b in range(nb)] for _, i in featured])
     fig = plotting.band_shares_figure([label for label, _ in featured], bar, labels)
     rio.save_figure(fig, plots / "band_shares.png")
     plotting.close(fig)
     files.append("plots/band_shares.png")
     for label, i in featured:
-        design = design_of(problem, pareto.iloc[i])
+        design = result.design_of(pareto.iloc[i])
         panels = section_panels(cfg, design)
         title = f"{label}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
         fig = plotting.sections_figure(panels, edges, title)
@@ -180,15 +157,10 @@ def plot_bands(run_dir: Path) -> dict[str, Any]:
     return {"files": files, "featured": [(label, int(i)) for label, i in featured]}
 
 
-def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str, Any]) -> None:
-    """report.md: key numbers of the run and links to its plots."""
-    import json
-
-    run_dir = Path(run_dir)
-    cfg, pareto, history, _ = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
-    manifest_path = run_dir / "manifest.json"
-    manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() else {}
+def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> str:
+    """report.md: key numbers of the run (from the RunResult and its manifest) and links to its plots."""
+    cfg, pareto, history, manifest, problem = (result.cfg, result.pareto, result.history, result.manifest,
+                                               result.problem)
     mkey = cfg.mech.measure_key(cfg.units.length)
     bands = ", ".join(band_labels(cfg.dexterity.band_edges))
     objectives = ", ".join(f"{o.sense} {k}" for o, k in zip(cfg.objectives, problem.objective_keys, strict=True))
@@ -199,6 +171,14 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
         f"{int(history['evaluations'].iloc[-1])} evaluations, seed {cfg.algorithm.seed}",
         f"- grid: {cfg.grid.resolution} cells per axis; dexterity bands {bands}",
         f"- objectives: {objectives}",
+    ]
+    if cfg.constraints:
+        lines.append("- constraints: " + ", ".join(
+            f"{k} {'>= ' + repr(float(c.min)) if c.min is not None else ''}"
+            f"{' and ' if c.min is not None and c.max is not None else ''}"
+            f"{'<= ' + repr(float(c.max)) if c.max is not None else ''}"
+            for c, k in zip(cfg.constraints, problem.constraint_keys, strict=True)))
+    lines += [
         f"- final hypervolume: {history['hypervolume'].iloc[-1]:.6g}",
         f"- Pareto front: {len(pareto)} designs",
     ]
@@ -207,6 +187,12 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
         lines.append(f"- wall time: {manifest['wall_seconds']:.1f} s on {cores} cores")
     if "m_minus_n" in pareto.columns:
         lines.append("- note: the model depends on m and n only through m - n (spec §1.1); see column m_minus_n")
+    diagnostics = infeasibility_lines(manifest)
+    if diagnostics:
+        lines += ["", "## No feasible design", "",
+                  "The final population has no design that meets every constraint. Best value seen of each "
+                  "constraint over the run:", ""]
+        lines += [f"- {line}" for line in diagnostics]
     lines += ["", "## Featured designs", ""]
     cols = [*problem.var_names, *problem.objective_keys, *problem.constraint_keys, mkey, "gci", "fci", "min_lci"]
     cols += [c for c in pareto.columns if c.endswith("_share")]
@@ -228,10 +214,15 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
     lines += ["", "## Plots", ""]
     for f in front_info.get("files", []) + bands_info.get("files", []):
         lines.append(f"![{Path(f).stem}]({f})")
-    rio.write_text(run_dir / "report.md", "\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
 
 
-def write_plots_and_report(run_dir: Path) -> None:
-    front = plot_front(run_dir)
-    bands = plot_bands(run_dir)
-    write_report(run_dir, front, bands)
+def write_report(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> None:
+    rio.write_text(result.out_dir / REPORT, report_text(result, front_info, bands_info))
+
+
+def write_plots_and_report(result: RunResult) -> None:
+    """Every plot and report.md of a run, from the RunResult (no files re-read, no second problem)."""
+    front = plot_front(result)
+    bands = plot_bands(result)
+    write_report(result, front, bands)

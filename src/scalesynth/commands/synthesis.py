@@ -25,6 +25,7 @@ def optimize_cmd(
     from scalesynth.config import load_config
     from scalesynth.optimize import run
     from scalesynth.progress import make_progress
+    from scalesynth.results import infeasibility_lines
 
     cfg = load_config(config, sets)
     progress = make_progress(cfg.algorithm.n_gen, quiet)
@@ -34,6 +35,8 @@ def optimize_cmd(
         if progress is not None:
             progress.close()
     m = result.manifest
+    for line in infeasibility_lines(m):
+        typer.echo(line, err=True)
     typer.echo(
         f"{m['name']}: {m['pareto_size']} Pareto designs, HV {m['hypervolume']:.6g}, "
         f"{m['evaluations']} evaluations in {m['wall_seconds']:.1f} s -> {result.out_dir}",
@@ -47,8 +50,9 @@ def optimize_cmd(
 def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")]) -> None:
     """Pareto front with the config's reference designs re-evaluated, and hypervolume per generation."""
     from scalesynth.report import plot_front
+    from scalesynth.results import load
 
-    info = plot_front(run_dir)
+    info = plot_front(load(run_dir, require_finished=False))
     for f in info["files"]:
         typer.echo(str(Path(run_dir) / f))
 
@@ -58,8 +62,9 @@ def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directo
 def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")]) -> None:
     """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs."""
     from scalesynth.report import plot_bands
+    from scalesynth.results import load
 
-    info = plot_bands(run_dir)
+    info = plot_bands(load(run_dir, require_finished=False))
     for f in info["files"]:
         typer.echo(str(Path(run_dir) / f))
 
