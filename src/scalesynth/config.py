@@ -224,7 +224,8 @@ class RunConfig(_Strict):
         for where, items in (("objectives", self.objectives), ("constraints", self.constraints)):
             for i, item in enumerate(items):
                 try:
-                    m = resolve(mech, self.units.length, item.metric, item.band, n_bands, has_task, has_path, options)
+                    m = resolve(mech, self.units.length, item.metric, item.band, n_bands, has_task, has_path, options,
+                                self.cycle)
                 except ValueError as err:
                     raise ValueError(f"{where}[{i}].{err}") from None
                 if where == "objectives" and item.sense == "min" and m.worst is None:

@@ -263,15 +263,7 @@ def _forces(mech, A, traj, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray
 
 # ----- design-level metrics (catalogue: cycle_*) ------------------------------------------------------------
 CYCLE_PENALTY = 1e12  # a speed/acceleration/force no actuator reaches: the value of an infeasible cycle
-METRICS = (
-    "cycle_feasible",
-    "cycle_max_actuator_speed",
-    "cycle_max_actuator_accel",
-    "cycle_max_actuator_force",
-    "cycle_min_lci",
-    "cycle_min_clearance",
-    "max_cycles_per_minute",
-)
+METRICS = ccfg.CYCLE_METRICS
 
 
 def max_rate_scale(res: CycleResult, speed_limits, force_limits) -> float:

@@ -223,3 +223,22 @@ def limit_vector(value, n: int) -> np.ndarray | None:
     if value is None:
         return None
     return np.full(n, float(value)) if isinstance(value, (int, float)) else np.asarray(value, dtype=float)
+
+
+CYCLE_METRICS = (
+    "cycle_feasible",
+    "cycle_max_actuator_speed",
+    "cycle_max_actuator_accel",
+    "cycle_max_actuator_force",
+    "cycle_min_lci",
+    "cycle_min_clearance",
+    "max_cycles_per_minute",
+)
+
+
+def searched(cfg) -> CycleConfig | None:
+    """The config's cycle when an objective or constraint is a cycle metric (the optimisation then evaluates the
+    cycle of every design), else None: a cycle costs seconds per design, so it is not analysed for results columns
+    nobody optimises (``scalesynth evaluate`` and ``scalesynth cycle`` always report it)."""
+    used = {item.metric for item in [*cfg.objectives, *cfg.constraints]}
+    return cfg.cycle if used & set(CYCLE_METRICS) else None
