@@ -295,3 +295,74 @@ def test_bad_cycle_input_one_line_exit_2_nothing_written(tmp_path, cfg, change, 
     assert res.stderr.startswith(message), res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
     assert not out.exists()
+
+
+# ----- per-voxel clearance field ---------------------------------------------------------------------------
+def test_numba_segment_distance_matches_the_numpy_version():
+    from scalesynth.kernels.clearance import segment_distance as jit_distance
+
+    rng = np.random.default_rng(11)
+    pts = rng.normal(size=(400, 4, 3))
+    pts[::7, 1] = pts[::7, 0]  # some zero-length segments
+    pts[::5, 3] = pts[::5, 2] + 2.0 * (pts[::5, 1] - pts[::5, 0])  # some parallel pairs
+    for p1, q1, p2, q2 in pts:
+        assert jit_distance(*p1, *q1, *p2, *q2) == pytest.approx(float(segment_distance(p1, q1, p2, q2)), abs=1e-12)
+
+
+@pytest.mark.parametrize("radius", [None, 150.0])
+def test_fivebar_clearance_field_matches_numpy_link_geometry(radius):
+    """The field kernel's clearance at every reachable node of a grid against cycle.clearance of the mechanism's
+    link_geometry (NumPy, the cycle's code path), and interference_free = reachable and clearance >= 0."""
+    from scalesynth.evaluate import make_grid
+    from scalesynth.kernels import grid as kgrid
+
+    mech = FIVEBAR.mech
+    design = FIVEBAR.resolved_design()
+    options = mech.resolve_options({**FIVEBAR.options, "link_radius": radius})
+    g = make_grid(mech, design, options, 31)
+    slot = mech.field_names.index("clearance")
+    fields = kgrid.sample_fields(mech.field_kernel, mech.n_fields, mech.pack(design, options), g.lo, g.step, g.shape)
+    reach = fields[..., 0] >= 0
+    checked = 0
+    for i, j in zip(*np.nonzero(reach[:, :, 0]), strict=True):
+        pose = (g.axis(0)[i], g.axis(1)[j])
+        q = next(s.values for s in mech.inverse_kinematics(design, options, pose) if s.label == options["mode"])
+        expected = clearance(mech.link_geometry(design, options, pose, q)).value
+        assert fields[i, j, 0, slot] == pytest.approx(expected, abs=1e-9 * 1000)
+        checked += 1
+    assert checked > 100
+    free = mech.resolve_options({**options, "interference_free": True})
+    only = kgrid.sample_fields(mech.field_kernel, mech.n_fields, mech.pack(design, free), g.lo, g.step, g.shape)
+    assert np.array_equal(only[..., 0] >= 0, reach & (fields[..., slot] >= 0))
+    if radius is not None:
+        assert (reach & (fields[..., slot] < 0)).any()  # fat links: some reachable poses do interfere
+
+
+def test_five_bar_synthesis_minimising_cycle_speed_with_clearance_constraint(tmp_path):
+    """Done-when of issue 13: cycle_max_actuator_speed (min) as an objective, cycle_min_clearance >= 0 as a
+    constraint; every front row's cycle metrics equal a fresh analysis of that design."""
+    data = yaml.safe_load((ROOT / "configs" / "fivebar_packing.yaml").read_text())
+    data.update(name="fivebar_cycle", grid={"resolution": 16}, task=None,
+                objectives=[{"metric": "cycle_max_actuator_speed", "sense": "min"}, {"metric": "gci", "sense": "max"}],
+                constraints=[{"metric": "cycle_min_clearance", "min": 0.0}],
+                algorithm={"pop_size": 6, "n_gen": 2, "seed": 3}, output={"checkpoint_every": 1})
+    data["cycle"]["samples"] = 24
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(data))
+    res = CliRunner().invoke(app, ["optimize", str(path), "--out", str(tmp_path / "run"), "--no-plots"])
+    assert res.exit_code == 0, res.output
+    import pandas as pd
+
+    front = pd.read_csv(tmp_path / "run" / "pareto.csv")
+    assert len(front) >= 1
+    cfg = load_config(path)
+    for _, row in front.iterrows():
+        design = {k: row[k] for k in ("r", "l1", "l2")}
+        m = analysis.metrics(cfg.mech, design, cfg.resolved_options(), cfg.cycle, "mm")
+        assert row["cycle_max_actuator_speed_rad_per_s"] == pytest.approx(m["cycle_max_actuator_speed"], rel=1e-9)
+        assert row["cycle_min_clearance_mm"] >= 0
+    res = CliRunner().invoke(app, ["cycle", str(tmp_path / "run"), "--design", "best-cycle_max_actuator_speed",
+                                   "--out", str(tmp_path / "cyc"), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["metrics"]["cycle_max_actuator_speed"] == pytest.approx(
+        front["cycle_max_actuator_speed_rad_per_s"].min(), rel=1e-9)

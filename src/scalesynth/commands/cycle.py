@@ -1,9 +1,8 @@
 """``scalesynth cycle CONFIG|RUN_DIR``: a design's pick-and-place cycle (``scalesynth.cycle``).
 
 CONFIG is a run config with a ``cycle:`` section (its ``design`` is analysed); RUN_DIR is a results directory,
-whose config must have one, with ``--design knee`` (default), ``best-<metric>`` (the best front row for an
-objective's metric, or for a cycle metric: the lowest speed/acceleration/force, the highest LCI, clearance or
-rate) or a row number of pareto.csv. Writes cycle.csv, cycle.json, actuators.png, path.png, quality.png to
+whose config must have one, with ``--design knee`` (default), ``best-<metric>`` (the front row with the best
+value of a metric) or a row number of pareto.csv. Writes cycle.csv, cycle.json, actuators.png, path.png, quality.png to
 ``--out`` (default: <results dir>/cycle for a config, RUN_DIR/cycle-<design> for a run).
 """
 
@@ -17,41 +16,33 @@ import typer
 from scalesynth.cli import JsonOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 
-# the better direction of each cycle metric (for --design best-<metric>)
-_CYCLE_SENSE = {
-    "cycle_feasible": "max",
-    "cycle_max_actuator_speed": "min",
-    "cycle_max_actuator_accel": "min",
-    "cycle_max_actuator_force": "min",
-    "cycle_min_lci": "max",
-    "cycle_min_clearance": "max",
-    "max_cycles_per_minute": "max",
-}
-
 
 def pick_design(run_dir: Path, choice: str):
-    """(config, design, label) of a results directory's front row chosen by ``choice``."""
+    """(config, design, label) of a results directory's front row chosen by ``choice``: knee, best-<metric> (a
+    catalogue metric name or result column; the best value in the objective's sense, or the catalogue's better
+    direction for a metric that is not an objective) or a row number of pareto.csv."""
     import numpy as np
 
-    from scalesynth.problem import SynthesisProblem
-    from scalesynth.report import design_of, load_run, objective_matrix
+    from scalesynth import results
+    from scalesynth.metrics import catalogue
     from scalesynth.selection import choose
 
-    cfg, pareto, _, _ = load_run(run_dir)
+    result = results.load(run_dir, require_finished=False)
+    cfg, pareto = result.cfg, result.pareto
     if not len(pareto):
         raise ConfigError(f"{run_dir}: the front is empty (no feasible design)")
-    problem = SynthesisProblem(cfg)
     if choice == "knee":
-        row = choose(objective_matrix(problem, pareto), "knee")
+        row = choose(result.objective_matrix(), "knee")
     elif choice.startswith("best-"):
-        metric = choice.removeprefix("best-")
-        senses = {k: o.sense for k, o in zip(problem.objective_keys, cfg.objectives, strict=True)}
-        sense = senses.get(metric, _CYCLE_SENSE.get(metric))
-        if metric not in pareto.columns or sense is None:
-            known = sorted(set(senses) | (set(_CYCLE_SENSE) & set(pareto.columns)))
-            raise ConfigError(f"--design: best-{metric}: not an objective or cycle metric of the run "
-                              f"(known: {', '.join(known)})")
-        values = pareto[metric].to_numpy(dtype=float)
+        wanted = choice.removeprefix("best-")
+        cat = catalogue(cfg.mech, cfg.units.length)
+        entry = next((m for m in cat.values() if wanted in (m.name, m.column) and "band" not in m.needs), None)
+        if entry is None or entry.column not in pareto.columns or entry.better is None:
+            known = [m.name for m in cat.values() if m.column in pareto.columns and m.better is not None]
+            raise ConfigError(f"--design: best-{wanted}: not a metric of the run's results (known: {', '.join(known)})")
+        senses = {o.metric: o.sense for o in cfg.objectives}
+        sense = senses.get(entry.name, entry.better)
+        values = pareto[entry.column].to_numpy(dtype=float)
         row = int(np.argmax(values) if sense == "max" else np.argmin(values))
     else:
         try:
@@ -61,7 +52,7 @@ def pick_design(run_dir: Path, choice: str):
         if not 0 <= row < len(pareto):
             raise ConfigError(f"--design: row {row} out of range (pareto.csv has {len(pareto)} rows)")
     label = choice if choice.startswith(("knee", "best-")) else f"row{row}"
-    return cfg, design_of(problem, pareto.iloc[row]), label
+    return cfg, result.design_of(pareto.iloc[row]), label
 
 
 def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None):

@@ -21,6 +21,13 @@ from typing import Any
 import numpy as np
 
 from scalesynth.errors import InvalidParameter
+from scalesynth.mechanisms.base import Field
+
+# the per-voxel field of the mechanisms whose field kernels compute their capsules' clearance
+CLEARANCE_FIELD = Field(
+    "clearance", "{length}", "smallest distance between the capsules of links that share no joint, minus their "
+    "radii (< 0: the links interfere); radii from options.link_radius", "max", (-math.inf, math.inf),
+)
 
 
 @dataclass(frozen=True)
@@ -106,3 +113,9 @@ def radii(options: Mapping[str, Any], defaults: Mapping[str, float]) -> dict[str
         out.update({k: float(v) for k, v in value.items()})
         return out
     return {k: float(value) for k in out}
+
+
+def check_flag_option(options: dict[str, Any], name: str) -> None:
+    """A boolean option (true/false); raise InvalidParameter naming it otherwise."""
+    if not isinstance(options.get(name), bool):
+        raise InvalidParameter(f"options.{name}: expected true or false, got {options.get(name)!r}")

@@ -31,6 +31,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import planar_capsule_gap
 from scalesynth.kernels.conditioning import SIGMA_CAP, sv_2x2
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -56,7 +57,10 @@ TWO_PI = 2.0 * math.pi
 # has, cos lo, sin lo, cos hi, sin hi, wide (1 if hi - lo > pi)
 _R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
 _LIM1, _LIM2 = 5, 11
-N_PACKED = 17
+# capsule radii of base, arm1, arm2, forearm1, forearm2, platform (order of LINK_RADII); 1 = interference-free only
+_RAD = 17
+_FREE_ONLY = 23
+N_PACKED = 24
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -102,7 +106,8 @@ def _arc_ok(p, k, c, s):
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """Fields at P = (x, y) in the packed working mode (kernels.grid contract): LCI (sigma_min/sigma_max of J),
-    sigma_min and sigma_max of J = dx/dq (mm/rad); LCI -1 if unreachable; z unused."""
+    sigma_min and sigma_max of J = dx/dq (mm/rad), clearance (mm) of the link capsules; LCI -1 if unreachable (or,
+    with interference_free, where the capsules overlap); z unused."""
     r = p[_R]
     l1 = p[_L1]
     l2 = p[_L2]
@@ -119,6 +124,25 @@ def point_fields(p, x, y, z, out):
     if not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
         _grid.write_unreachable(out)
         return
+    # clearance (field 3): capsules base B2-B1, arm_i B_i-Q_i, forearm_i Q_i-P, platform ball at P; the pairs that
+    # share no joint (as in link_geometry)
+    q1x = r + l1 * c1
+    q1y = l1 * s1
+    q2x = -r + l1 * c2
+    q2y = l1 * s2
+    rb, ra1, ra2, rf1, rf2, rp = p[_RAD], p[_RAD + 1], p[_RAD + 2], p[_RAD + 3], p[_RAD + 4], p[_RAD + 5]
+    gap = planar_capsule_gap(-r, 0.0, r, 0.0, rb, q1x, q1y, x, y, rf1)
+    gap = min(gap, planar_capsule_gap(-r, 0.0, r, 0.0, rb, q2x, q2y, x, y, rf2))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, r, 0.0, rb, x, y, x, y, rp))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, -r, 0.0, q2x, q2y, ra2))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, q2x, q2y, x, y, rf2))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, x, y, x, y, rp))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, q2x, q2y, ra2, q1x, q1y, x, y, rf1))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, q2x, q2y, ra2, x, y, x, y, rp))
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
+    out[3] = gap
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1
@@ -163,6 +187,7 @@ class PlanarFivebar(Mechanism):
         for name in ("alpha1_limits", "alpha2_limits"):
             options[name] = parse_range(name, options[name])
         links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(N_PACKED)
@@ -177,6 +202,8 @@ class PlanarFivebar(Mechanism):
             if lim is not None and lim[1] - lim[0] < TWO_PI:  # a full turn or more restricts nothing
                 lo, hi = lim
                 p[k : k + 6] = (1.0, math.cos(lo), math.sin(lo), math.cos(hi), math.sin(hi), hi - lo > math.pi)
+        p[_RAD : _RAD + 6] = list(links.radii(options, LINK_RADII).values())
+        p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
         return p
 
     @property
@@ -399,8 +426,9 @@ MECHANISM = PlanarFivebar(
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults "
                "base 25, arm1/arm2 20, forearm1/forearm2 15, platform 40 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
-    fields=base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"),
+    fields=(*base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"), links.CLEARANCE_FIELD),
     design_metrics=DESIGN_METRICS,
 )
