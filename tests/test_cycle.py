@@ -366,3 +366,25 @@ def test_five_bar_synthesis_minimising_cycle_speed_with_clearance_constraint(tmp
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["metrics"]["cycle_max_actuator_speed"] == pytest.approx(
         front["cycle_max_actuator_speed_rad_per_s"].min(), rel=1e-9)
+
+
+def test_cycle_on_a_mechanism_with_angular_task_axes_is_refused(tmp_path):
+    """rps-upu's task axes are (z, theta, psi): m (a - g) has no meaning there; one line, exit 2."""
+    path = _write(tmp_path, "rps_upu.yaml", path=[[40, 0, 0], [50, 0, 0]], cycles_per_minute=30)
+    res = CliRunner().invoke(app, ["cycle", str(path), "--out", str(tmp_path / "out")])
+    assert res.exit_code == 2
+    assert res.stderr.startswith("error: cycle: ") and len(res.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("config", ["paper_2pauu_ppap.yaml", "rps_upu_tool.yaml", "pprs_rprs.yaml"])
+def test_cycle_runs_on_the_configs_with_a_cycle(tmp_path, config):
+    """`scalesynth cycle` on each shipped config with a cycle (fewer samples for speed): feasible, clearance >= 0,
+    and the power balance of its CSV columns."""
+    cfg = load_config(ROOT / "configs" / config, ["cycle.samples=60"])
+    res = run(cfg, samples=60)
+    m = analysis.result_metrics(res, cfg.cycle)
+    assert m["cycle_feasible"] == 1.0 and m["cycle_min_clearance"] >= 0, m
+    lu = METRES_PER_UNIT[cfg.units.length]
+    joint_si = np.array([lu if u == "length" else 1.0 for u in cfg.mech.joint_units])
+    np.testing.assert_allclose(np.sum(res.force * res.qd * joint_si, axis=1),
+                               np.sum(res.task_force * res.traj.pd * lu, axis=1), atol=1e-9)

@@ -3,8 +3,8 @@
 Along the sampled trajectory (``cycle.trajectory``), in the configured working mode (``kernel_branch``):
 
 * every sample must be in the workspace (the point kernel: reachable within every limit); the IK branch is
-  followed with continuity (angles unwrapped; no other branch may come closer than the step taken) and the
-  determinant of the velocity map may not change sign between samples (a singularity crossed). A failure
+  followed with continuity (angles unwrapped; each step in q must match, to first order, the step the velocity
+  map predicts for the step in x, so a branch jump is caught) and the determinant of the velocity map may not change sign between samples (a singularity crossed). A failure
   raises :class:`CycleError` naming the sample, its time and its position;
 * q from the closed-form IK; q_dot = A x_dot with the mechanism's velocity map A (inverse Jacobian);
   q_ddot = A x_ddot + A_dot x_dot, where A_dot x_dot is the derivative of A along the motion, taken by a
@@ -31,7 +31,7 @@ import numpy as np
 from scalesynth.cycle import config as ccfg
 from scalesynth.cycle import trajectory
 from scalesynth.cycle.clearance import clearance
-from scalesynth.errors import InvalidPose
+from scalesynth.errors import InvalidPose, ScalesynthError
 from scalesynth.mechanisms.base import Mechanism, wrap_angle
 
 # relative displacement (of the mechanism's size) for the directional derivative of the velocity map
@@ -167,22 +167,25 @@ def analyse(
     joint_scale = np.where(angular, size, 1.0)
     q = np.empty((n, nj))
     A = np.empty((n, nj, nj))
-    prev = None
     for s in range(n):
         sols = _branches(mech, design, options, traj.p[s])
         if label not in sols:
             raise CycleError(f"cycle: {_where(mech, traj, s)} is out of reach in working mode {label}")
-        q[s] = sols[label] if prev is None else _unwrap(sols[label], prev, angular)
-        if prev is not None:
-            step = np.linalg.norm((q[s] - prev) * joint_scale)
-            for other, qo in sols.items():
-                if other != label and np.linalg.norm((_unwrap(qo, prev, angular) - prev) * joint_scale) < step:
-                    raise CycleError(
-                        f"cycle: branch {label} comes within one step of branch {other} at "
-                        f"{_where(mech, traj, s)} (an inverse singularity on the path)"
-                    )
+        q[s] = sols[label] if s == 0 else _unwrap(sols[label], q[s - 1], angular)
         A[s] = mech.velocity_map(design, options, traj.p[s], q[s])
-        prev = q[s]
+        if s > 0 and np.all(np.isfinite(A[s - 1 : s + 1])):
+            # branch continuity: the step in q must be the one the velocity map predicts for the step in x (to
+            # first order; the trapezoidal rule's error is second order), else the branch jumped
+            dx = np.zeros(nj)
+            dx[:k] = traj.p[s] - traj.p[s - 1]
+            predicted = 0.5 * (A[s] + A[s - 1]) @ dx
+            if np.linalg.norm((q[s] - q[s - 1] - predicted) * joint_scale) > 0.5 * np.linalg.norm(
+                predicted * joint_scale
+            ) + 1e-9 * size:
+                raise CycleError(
+                    f"cycle: branch {label} jumps between sample {s - 1} and {_where(mech, traj, s)} (a singularity "
+                    "or a branch point on the path; more cycle.samples may resolve it)"
+                )
     det = np.linalg.det(A)
     sign = np.sign(det)
     bad = np.nonzero(~np.isfinite(det) | (sign == 0) | (lci <= 0))[0]
@@ -299,7 +302,7 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
     speed, acceleration and force CYCLE_PENALTY, LCI 0, clearance -CYCLE_PENALTY and 0 cycles per minute."""
     try:
         res = analyse(mech, design, options, cyc, length_unit)
-    except CycleError:
+    except ScalesynthError:  # CycleError, or a degenerate design's kinematics refusing a pose
         bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
                 "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
                 "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}

@@ -167,8 +167,23 @@ def adept_axes(cyc: CycleConfig, mech) -> tuple[np.ndarray, np.ndarray]:
 
 def check(cyc: CycleConfig, mech) -> None:
     """Checks that need the mechanism; raise ValueError('cycle.<field>: ...') naming the field."""
+    from scalesynth.mechanisms.base import Mechanism
+
     k = len(mech.task_axes)
     axes = ", ".join(mech.task_axes)
+    if cyc.preset is not None and len(_cartesian(mech)) < 2:
+        raise ValueError(
+            f"cycle.preset: {cyc.preset} needs two Cartesian task axes; {mech.name} has {axes} "
+            f"({', '.join(mech.task_units)})"
+        )
+    for method in ("link_geometry", "velocity_map"):
+        if getattr(type(mech), method) is getattr(Mechanism, method):
+            raise ValueError(f"cycle: {mech.name} has no {method.replace('_', ' ')} yet (cycles need it)")
+    if any(u != "length" for u in mech.task_units):
+        raise ValueError(
+            f"cycle: the payload force m (a - g) needs Cartesian task axes; {mech.name} has {axes} "
+            f"({', '.join(mech.task_units)})"
+        )
     if cyc.path is not None and len(cyc.path[0]) != k:
         raise ValueError(f"cycle.path: points need {k} coordinates ({axes}) for {mech.name}")
     if cyc.gravity is not None and len(cyc.gravity) != k:
@@ -185,11 +200,6 @@ def check(cyc: CycleConfig, mech) -> None:
     if cyc.preset is None:
         return
     cart = _cartesian(mech)
-    if len(cart) < 2:
-        raise ValueError(
-            f"cycle.preset: {cyc.preset} needs two Cartesian task axes; {mech.name} has {axes} "
-            f"({', '.join(mech.task_units)})"
-        )
     if len(cyc.start) != k:
         raise ValueError(f"cycle.start: need {k} coordinates ({axes})")
     if cyc.direction is not None and len(cyc.direction) != k:
