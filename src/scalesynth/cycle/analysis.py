@@ -4,8 +4,9 @@ Along the sampled trajectory (``cycle.trajectory``), in the configured working m
 
 * every sample must be in the workspace (the point kernel: reachable within every limit); the IK branch is
   followed with continuity (angles unwrapped; each step in q must match, to first order, the step the velocity
-  map predicts for the step in x, so a branch jump is caught) and the determinant of the velocity map may not change sign between samples (a singularity crossed). A failure
-  raises :class:`CycleError` naming the sample, its time and its position;
+  map predicts for the step in x, so a branch jump is caught) and the determinant of the velocity map may not
+  change sign between samples (a singularity crossed). A failure raises :class:`CycleError` naming the sample,
+  its time and its position;
 * q from the closed-form IK; q_dot = A x_dot with the mechanism's velocity map A (inverse Jacobian);
   q_ddot = A x_ddot + A_dot x_dot, where A_dot x_dot is the derivative of A along the motion, taken by a
   central difference of A over a displacement of 1e-6 of the mechanism's size (IK re-solved in the branch);
