@@ -164,6 +164,15 @@ def test_seed001_drive_curves_unchanged_from_the_recorded_drives_output():
     np.testing.assert_allclose(res.q, ref[:, 4:], rtol=1e-11, atol=1e-9)  # 12 significant digits in the file
 
 
+def test_drives_alias_writes_the_recorded_bytes(tmp_path):
+    """`drives` is `cycle` on the default square with the constant law: its drives.csv equals, byte for byte, the
+    file the old implementation wrote (tests/data/cycle/README.md)."""
+    res = CliRunner().invoke(app, ["drives", str(ROOT / "configs" / "pprs_rprs.yaml"), "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    recorded = (ROOT / "tests" / "data" / "cycle" / "drives_seed001_square.csv").read_text()
+    assert (tmp_path / "drives.csv").read_text() == recorded
+
+
 # ----- clearance ------------------------------------------------------------------------------------------
 def _segment_points(a, b, n):
     t = np.linspace(0.0, 1.0, n)[:, None]
@@ -388,3 +397,13 @@ def test_cycle_runs_on_the_configs_with_a_cycle(tmp_path, config):
     joint_si = np.array([lu if u == "length" else 1.0 for u in cfg.mech.joint_units])
     np.testing.assert_allclose(np.sum(res.force * res.qd * joint_si, axis=1),
                                np.sum(res.task_force * res.traj.pd * lu, axis=1), atol=1e-9)
+
+
+def test_pprs_rail_input_follows_x_exactly():
+    """Seed 001, conv O, zero orientation: w1 = u1 . C1 = x + r, so qd1 = pd_x and qdd1 = pdd_x exactly (spec §1.3);
+    on the 20 mm square with 3-4-5 sides of 0.25 s the peak is 1.875 * 20 / 0.25 = 150 mm/s."""
+    res = run(PPRS, samples=200)
+    np.testing.assert_allclose(res.q[:, 0], res.traj.p[:, 0] + PPRS.resolved_design()["r"], atol=1e-9)
+    np.testing.assert_allclose(res.qd[:, 0], res.traj.pd[:, 0], atol=1e-9)
+    np.testing.assert_allclose(res.qdd[:, 0], res.traj.pdd[:, 0], atol=1e-6 * np.abs(res.traj.pdd).max())
+    assert np.abs(res.qd[:, 0]).max() == pytest.approx(150.0, rel=1e-4)
