@@ -33,8 +33,8 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
-from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.clearance import segment_distance
+from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
