@@ -23,7 +23,9 @@ from conftest import ROOT
 
 FIVEBAR = load_config(ROOT / "configs" / "fivebar_packing.yaml")
 PPRS = load_config(ROOT / "configs" / "pprs_rprs.yaml")
-CASES = {"planar-fivebar": FIVEBAR, "pprs-rprs": PPRS}
+SEED000 = load_config(ROOT / "configs" / "paper_2pauu_ppap.yaml")
+TOOL = load_config(ROOT / "configs" / "rps_upu_tool.yaml")
+CASES = {"planar-fivebar": FIVEBAR, "pprs-rprs": PPRS, "2pauu-ppap": SEED000, "rps-upu-tool": TOOL}
 
 
 def run(cfg, **changes):
@@ -293,6 +295,8 @@ def _write(tmp_path, cfg, **cycle):
     ("fivebar_packing.yaml", {"preset": "scara"}, "error: cycle.preset: unknown preset 'scara' (known: adept)"),
     ("fivebar_packing.yaml", {"start": [0, -300]}, "error: cycle.adept[0]: (0, -300) is outside the workspace"),
     ("fivebar_packing.yaml", {"law": "cubic"}, "error: cycle.law: unknown motion law 'cubic'"),
+    ("fivebar_packing.yaml", {"payload": -2.0}, "error: cycle.payload: must be a finite number > 0"),
+    ("fivebar_packing.yaml", {"direction": [1.0, 1.0]}, "error: cycle.direction: must be perpendicular to gravity"),
     ("rps_upu.yaml", {"preset": "adept", "start": [40, 0, 0], "cycles_per_minute": 30},
      "error: cycle.preset: adept needs two Cartesian task axes; rps-upu has z, theta, psi"),
 ])
@@ -318,7 +322,7 @@ def test_numba_segment_distance_matches_the_numpy_version():
         assert jit_distance(*p1, *q1, *p2, *q2) == pytest.approx(float(segment_distance(p1, q1, p2, q2)), abs=1e-12)
 
 
-@pytest.mark.parametrize("name, radius", [("planar-fivebar", None), ("planar-fivebar", 150.0),
+@pytest.mark.parametrize("name, radius", [("planar-fivebar", None), ("planar-fivebar", 150.0),  # field kernels
                                           ("pprs-rprs", None), ("pprs-rprs", 30.0)])
 def test_clearance_field_matches_numpy_link_geometry(name, radius):
     """The field kernel's clearance at every reachable node of a grid against cycle.clearance of the mechanism's
@@ -378,6 +382,16 @@ def test_five_bar_synthesis_minimising_cycle_speed_with_clearance_constraint(tmp
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["metrics"]["cycle_max_actuator_speed"] == pytest.approx(
         front["cycle_max_actuator_speed_rad_per_s"].min(), rel=1e-9)
+
+
+def test_bad_link_options_are_one_line_errors(tmp_path):
+    cfg = ROOT / "configs" / "fivebar_packing.yaml"
+    for change, message in (("interference_free=maybe", "options.interference_free: expected true or false"),
+                            ("link_radius=-1", "options.link_radius: expected a length >= 0"),
+                            ("link_radius={elbow: 3}", "options.link_radius.elbow: unknown body")):
+        res = CliRunner().invoke(app, ["cycle", str(cfg), "--set", change, "--out", str(tmp_path / "out")])
+        assert res.exit_code == 2 and message in res.stderr, res.stderr
+        assert not (tmp_path / "out").exists()
 
 
 def test_cycle_on_a_mechanism_with_angular_task_axes_is_refused(tmp_path):
