@@ -213,38 +213,42 @@ def _cycle_values(ctx: EvalContext) -> dict[str, np.ndarray]:
 def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
     from scalesynth.cycle.analysis import CYCLE_PENALTY
 
-    def entry(name, unit, rng, better, worst, needs, description):
+    def entry(name, unit, rng, better, worst, needs, description, plain=False):
         def compute(ctx: EvalContext, name=name) -> np.ndarray:
             return _cycle_values(ctx)[name]
 
-        return Metric(name, _with_unit(name, unit), "cycle", None, None, unit, rng, better, worst, needs,
-                      description, compute=compute)
+        column = name if plain else _with_unit(name, unit)
+        return Metric(name, column, "cycle", None, None, unit, rng, better, worst, needs, description,
+                      compute=compute)
 
     lu = length_unit
     kinds = set(mech.joint_units)
     # one unit when every actuator is of one kind; mixed actuators (pprs-rprs) give a plain column name
+    mixed = len(kinds) > 1  # e.g. pprs-rprs, 2pauu-ppap: the column carries no unit, the entry names both
     speed, accel, force = {frozenset({"angle"}): ("rad/s", "rad/s^2", "N m"),
-                           frozenset({"length"}): (f"{lu}/s", f"{lu}/s^2", "N")}.get(frozenset(kinds), ("", "", ""))
+                           frozenset({"length"}): (f"{lu}/s", f"{lu}/s^2", "N")}.get(
+        frozenset(kinds), (f"rad/s or {lu}/s", f"rad/s^2 or {lu}/s^2", "N m or N"))
     failed = f"; {CYCLE_PENALTY:g} if the cycle cannot be followed"
     return [
         entry("cycle_feasible", "1", (0.0, 1.0), "max", 1.0, ("cycle",),
               "1 if the cycle stays in the workspace without branch jump or singularity, with clearance >= 0 and "
               "within the cycle's speed and force limits, else 0"),
         entry("cycle_max_actuator_speed", speed, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
-              f"largest |qd_i| over the cycle and the actuators ({lu}/s or rad/s, per actuator type){failed}"),
+              f"largest |qd_i| over the cycle and the actuators ({lu}/s or rad/s, per actuator type){failed}",
+              plain=mixed),
         entry("cycle_max_actuator_accel", accel, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
-              f"largest |qdd_i| over the cycle and the actuators ({lu}/s^2 or rad/s^2){failed}"),
+              f"largest |qdd_i| over the cycle and the actuators ({lu}/s^2 or rad/s^2){failed}", plain=mixed),
         entry("cycle_max_actuator_force", force, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
               f"largest actuator force or torque for the payload, quasi-static plus payload inertia (N or N m)"
-              f"{failed}"),
+              f"{failed}", plain=mixed),
         entry("cycle_min_lci", "1", (0.0, 1.0), "max", 1.0, ("cycle",),
               "smallest LCI along the cycle (0 if it cannot be followed)"),
         entry("cycle_min_clearance", lu, (-CYCLE_PENALTY, math.inf), "max", None,
               ("cycle",), f"smallest distance between non-adjacent link capsules along the cycle ({lu}; < 0: "
               f"interference; -{CYCLE_PENALTY:g} if the cycle cannot be followed)"),
-        entry("max_cycles_per_minute", "", (0.0, math.inf), "max", None, ("cycle", "cycle.limits"),
+        entry("max_cycles_per_minute", "1/min", (0.0, math.inf), "max", None, ("cycle", "cycle.limits"),
               "highest cycle rate within the actuator speed and force limits of the cycle section (cycles per "
-              "minute; 0 if gravity alone exceeds a force limit or the cycle cannot be followed)"),
+              "minute; 0 if gravity alone exceeds a force limit or the cycle cannot be followed)", plain=True),
     ]
 
 

@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import JsonOpt, SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import JsonOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 
 

@@ -134,8 +134,8 @@ def build(points, laws, period: float, samples: int) -> Trajectory:
 
 def _constant_speed(verts: np.ndarray, length: np.ndarray, period: float, samples: int) -> Trajectory:
     """Whole loop at speed total / period; ``samples + 1`` points evenly spaced in arc length (the old drives
-    sampling, evaluate.sample_path)."""
-    from scalesynth.evaluate import sample_path
+    sampling, paths.sample_path)."""
+    from scalesynth.paths import sample_path
 
     k = verts.shape[1]
     total = float(length.sum())
