@@ -60,6 +60,7 @@ _LIM1, _LIM2 = 5, 11
 # capsule radii of base, arm1, arm2, forearm1, forearm2, platform (order of LINK_RADII); 1 = interference-free only
 _RAD = 17
 _FREE_ONLY = 23
+_F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
 N_PACKED = 24
 
 
@@ -142,7 +143,7 @@ def point_fields(p, x, y, z, out):
     if gap < 0.0 and p[_FREE_ONLY] > 0.0:
         _grid.write_unreachable(out)
         return
-    out[3] = gap
+    out[_F_CLEARANCE] = gap
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1

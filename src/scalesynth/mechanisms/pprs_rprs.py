@@ -68,6 +68,7 @@ _WLO, _WHI, _SLO, _SHI, _BLO, _BHI = 19, 20, 21, 22, 23, 24
 _BLEN, _ALEN = 25, 26
 _RAD = 27  # capsule radii of the 8 bodies, in LINK_RADII order
 _FREE_ONLY = 35  # 1: poses whose capsules overlap are unreachable
+_F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
 N_PACKED = 36
 
 # capsules of the clearance field, in link_geometry's order, with their body (index into LINK_RADII)
@@ -279,9 +280,9 @@ def point_fields(p, x, y, z, out):
         return
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
         _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
-        out[3] = gap
+        out[_F_CLEARANCE] = gap
         return
-    out[3] = gap
+    out[_F_CLEARANCE] = gap
     # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
     inv_alen = 1.0 / p[_ALEN]
     a = np.empty((6, 6))
