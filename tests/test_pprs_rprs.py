@@ -539,7 +539,8 @@ def test_drives_command_bad_input(tmp_path):
     runner = CliRunner()
     res = runner.invoke(app, ["drives", str(CONFIG), "--side", "40", "--center", "-30,-30", "--out", str(tmp_path)])
     assert res.exit_code == 2
-    assert "path: sample" in res.stderr and "outside the limits" in res.stderr
+    # drives is an alias of cycle: the first corner outside the workspace (within the actuator limits) is named
+    assert res.stderr.startswith("error: cycle.path[") and "outside the workspace" in res.stderr
     res = runner.invoke(app, ["drives", str(CONFIG), "--side", "-1", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "--side" in res.stderr
     res = runner.invoke(app, ["drives", str(ROOT / "configs" / "paper_2pauu_ppap.yaml"), "--out", str(tmp_path)])

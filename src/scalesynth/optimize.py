@@ -15,15 +15,14 @@ import platform
 import time
 from collections.abc import Callable
 from datetime import UTC, datetime
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from scalesynth import __version__, memory, results, rundir
 from scalesynth import io as rio
+from scalesynth import memory, results, rundir
 from scalesynth.config import ConstraintConfig, RunConfig
 from scalesynth.errors import ConfigError, RunError
 from scalesynth.problem import SynthesisProblem
@@ -31,7 +30,6 @@ from scalesynth.results import RunResult
 
 ProgressFn = Callable[[dict[str, Any]], None]
 
-DEPENDENCIES = ("numpy", "numba", "llvmlite", "pymoo", "moocore", "pandas", "matplotlib", "pydantic", "pyyaml", "typer")
 
 
 class CanonicalX:
@@ -148,13 +146,10 @@ def infeasibility(problem: SynthesisProblem, history: list[dict[str, Any]]) -> l
 
 
 def _versions() -> dict[str, str]:
-    out = {"scalesynth": __version__, "python": platform.python_version()}
-    for name in DEPENDENCIES:
-        try:
-            out[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            out[name] = "not installed"
-    return out
+    """Versions of scalesynth, Python and its dependencies (recorded in the manifest; ``versions`` owns the list)."""
+    from scalesynth.versions import installed_versions
+
+    return installed_versions()
 
 
 def _pareto_frame(problem: SynthesisProblem, algorithm) -> tuple[pd.DataFrame, pd.DataFrame, int]:

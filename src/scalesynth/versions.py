@@ -2,17 +2,29 @@
 
 Byte-identical results are promised only for the same machine type and the same versions of scalesynth's
 dependencies, so ``scalesynth reproduce`` warns first when they differ. The recorded set is written by
-``optimize._versions`` into ``manifest.json["versions"]``.
+``optimize.run`` into ``manifest.json["versions"]`` (``installed_versions``).
 """
 
 from __future__ import annotations
 
+import platform
+from importlib import metadata
+
+# the packages whose versions a manifest records (the ones that can change a result's bytes, and the CLI)
+DEPENDENCIES = ("numpy", "numba", "llvmlite", "pymoo", "moocore", "pandas", "matplotlib", "pydantic", "pyyaml", "typer")
+
 
 def installed_versions() -> dict[str, str]:
     """{package: version} of scalesynth, Python and every dependency that a manifest records."""
-    from scalesynth.optimize import _versions
+    from scalesynth import __version__
 
-    return _versions()
+    out = {"scalesynth": __version__, "python": platform.python_version()}
+    for name in DEPENDENCIES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
 
 
 def version_differences(recorded: dict[str, str] | None) -> list[str]:

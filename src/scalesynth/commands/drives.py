@@ -1,10 +1,12 @@
-"""``scalesynth drives``: actuator curves of the 2PPRS-RPRS (seed 001) along a closed square path E-F-G-H-E.
+"""``scalesynth drives``: seed 001's square cycle, an alias of ``scalesynth cycle`` kept for its old outputs.
 
 The paper (§5, Figs. 6-7) moves O1 around a closed path at constant orientation and plots the six drive
-displacements over time; this command does the same from the closed-form IK, with continuation FK checking
-that the path stays in one assembly mode (``pprs_rprs.drive_curves``). Outputs, each written atomically:
-``drives.csv`` (t, x, y, z, w1, w2, beta, s1, s2, s3; mm, beta in rad, t = fraction of the loop at constant
-speed) and ``drives.png`` (one subplot per actuator).
+displacements over time. ``drives CONFIG`` is ``cycle`` on the square E-F-G-H-E with the motion law
+``constant`` (the loop at constant speed, period 1 s, so t is the fraction of the loop) for a pprs-rprs config:
+the same analysis (``scalesynth.cycle.analysis``), written in the old format, each file atomically:
+``drives.csv`` (t, x, y, z, w1, w2, beta, s1, s2, s3; mm, beta in rad) and ``drives.png`` (one subplot per
+actuator). For velocities, accelerations, forces, clearance and rest-to-rest laws use ``scalesynth cycle`` with a
+``cycle:`` section.
 """
 
 from __future__ import annotations
@@ -32,9 +34,9 @@ def square_path(center: tuple[float, float], side: float, z: float) -> np.ndarra
     return np.array([[cx - a, cy - a, z], [cx + a, cy - a, z], [cx + a, cy + a, z], [cx - a, cy + a, z]])
 
 
-def write_csv(path: Path, curves) -> None:
+def write_csv(path: Path, res) -> None:
     """drives.csv, atomically: CSV_COLUMNS, one row per sample, 12 significant digits."""
-    table = np.column_stack([curves.t, curves.points, curves.q])
+    table = np.column_stack([res.traj.t, res.traj.p, res.q])
     lines = [",".join(CSV_COLUMNS)] + [",".join(f"{v:.12g}" for v in row) for row in table]
     write_text(path, "\n".join(lines) + "\n")
 
@@ -50,7 +52,7 @@ def write_plot(path: Path, curves, corners: list[tuple[str, float]]) -> None:
     labels = ("w1 (mm)", "w2 (mm)", "beta (deg)", "s1 (mm)", "s2 (mm)", "s3 (mm)")
     for k, ax in enumerate(axes.T.ravel()):
         values = np.degrees(curves.q[:, k]) if k == 2 else curves.q[:, k]
-        ax.plot(curves.t, values, lw=1.5)
+        ax.plot(curves.traj.t, values, lw=1.5)
         ax.set_ylabel(labels[k])
         for name, t in corners:
             ax.axvline(t, color="0.8", lw=0.8, zorder=0)
@@ -78,13 +80,15 @@ def drives_cmd(
     z: Annotated[float, typer.Option("--z", help="height of the square path (mm)")] = 200.0,
     side: Annotated[float, typer.Option("--side", help="side of the square (mm)")] = 20.0,
     center: Annotated[str, typer.Option("--center", help="centre x,y of the square (mm)")] = DEFAULT_CENTER,
-    samples: Annotated[int, typer.Option("--samples", help="samples along the closed path")] = 400,
+    samples: Annotated[int, typer.Option("--samples", help="samples along the closed path (>= 9)")] = 400,
     out: Annotated[Path | None, typer.Option("--out", help="output directory (default: <run dir>/drives)")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
 ) -> None:
     """Drive-displacement curves of a pprs-rprs design along a closed square E-F-G-H-E: drives.csv, drives.png."""
     from scalesynth.config import load_config
-    from scalesynth.mechanisms.pprs_rprs import MECHANISM, drive_curves
+    from scalesynth.cycle import analysis
+    from scalesynth.cycle.config import CycleConfig
+    from scalesynth.mechanisms.pprs_rprs import MECHANISM
 
     cfg = load_config(config)
     if cfg.mechanism != MECHANISM.name:
@@ -93,10 +97,11 @@ def drives_cmd(
         raise InvalidPose(f"--side: must be a positive length in mm, got {side:g}")
     if not np.isfinite(z):
         raise InvalidPose(f"--z: must be finite, got {z:g}")
-    if samples < 2:
-        raise InvalidPose(f"--samples: need at least 2, got {samples}")
+    if not 9 <= samples <= 100_001:
+        raise InvalidPose(f"--samples: need 9 to 100001 samples, got {samples}")
     corners = square_path(_parse_center(center), side, z)
-    curves = drive_curves(cfg.resolved_design(), cfg.resolved_options(), corners, samples)
+    cycle = CycleConfig(path=corners.tolist(), law="constant", period=1.0, samples=samples - 1)
+    curves = analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cycle, cfg.units.length)
     out_dir = ensure_dir(out if out is not None else cfg.output_dir() / "drives")
     csv_path, png_path = out_dir / "drives.csv", out_dir / "drives.png"
     write_csv(csv_path, curves)
@@ -106,13 +111,12 @@ def drives_cmd(
         "csv": str(csv_path),
         "png": str(png_path),
         "corners": {name: [float(v) for v in c] for name, c in zip("EFGH", corners, strict=True)},
-        "samples": int(curves.t.size),
+        "samples": int(curves.traj.t.size),
         "ranges": {
             name: [float(curves.q[:, k].min()), float(curves.q[:, k].max())]
             for k, name in enumerate(MECHANISM.joints)
         },
         "min_lci": float(curves.lci.min()),
-        "fk_error": curves.fk_error,
     }
     if as_json:
         _print_json(summary)
@@ -124,5 +128,5 @@ def drives_cmd(
     for name, (lo, hi) in summary["ranges"].items():
         unit = "rad" if name == "beta" else "mm"
         typer.echo(f"  {name:<5} {lo:10.4f} .. {hi:10.4f} {unit}")
-    typer.echo(f"  min LCI on the path {summary['min_lci']:.4f}; continuation FK error {curves.fk_error:.2e} mm")
+    typer.echo(f"  min LCI on the path {summary['min_lci']:.4f}")
     typer.echo(f"wrote {csv_path} and {png_path}")

@@ -31,8 +31,10 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import planar_capsule_gap
 from scalesynth.kernels.conditioning import SIGMA_CAP, sv_2x2
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Field,
@@ -53,6 +55,8 @@ FOREARMS = ("single", "parallelogram")
 LINK_GROUPS = ("arm", "forearm", "arm_link", "forearm_link")
 # default actuator stiffness: 1e5 N m/rad (a servo with a stiff precision reducer), in N mm/rad
 ACTUATOR_STIFFNESS = 1e8
+# default capsule radii (mm) of the bodies, illustrative like the lengths: the platform ball carries the gripper
+LINK_RADII = {"base": 25.0, "arm1": 20.0, "arm2": 20.0, "forearm1": 15.0, "forearm2": 15.0, "platform": 40.0}
 TWO_PI = 2.0 * math.pi
 
 # packed-parameter layout (see PlanarFivebar.pack); arm limit i occupies 6 slots from _LIM[i]:
@@ -62,10 +66,14 @@ _LIM1, _LIM2 = 5, 11
 # stiffness slots (point_fields slots 3, 4): arm EA (N), arm EI (N mm^2), forearm EA (N), actuator stiffness (N mm/rad),
 # load Fx, Fy (N)
 _EA1, _EI1, _EA2, _KACT, _FX, _FY = 17, 18, 19, 20, 21, 22
-N_PACKED = 23
 # eigenvalue ratio (smallest / largest) at or below which the platform stiffness is singular (as stiffness.solve)
 SINGULAR_RTOL = 1e-11
 DEFLECTION_CAP = SIGMA_CAP  # mm: the per-voxel deflection at a singular pose (the field contract has no inf)
+# capsule radii of base, arm1, arm2, forearm1, forearm2, platform (order of LINK_RADII); 1 = interference-free only
+_RAD = 23
+_FREE_ONLY = 29
+_F_CLEARANCE = 5  # slot of the clearance field in the field kernel's out (its index in ``fields``)
+N_PACKED = 30
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -190,14 +198,42 @@ def _stiffness(p, x, y, c1, s1, c2, s2):
     return kmin, min(math.sqrt(dx * dx + dy * dy), DEFLECTION_CAP)
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _clearance(p, x, y, c1, s1, c2, s2):
+    """Smallest gap (mm) between the link capsules that share no joint (as in link_geometry): base B2-B1,
+    arm_i B_i-Q_i, forearm_i Q_i-P and the platform ball at P; negative where two of them overlap."""
+    r = p[_R]
+    l1 = p[_L1]
+    q1x = r + l1 * c1
+    q1y = l1 * s1
+    q2x = -r + l1 * c2
+    q2y = l1 * s2
+    rb, ra1, ra2, rf1, rf2, rp = p[_RAD], p[_RAD + 1], p[_RAD + 2], p[_RAD + 3], p[_RAD + 4], p[_RAD + 5]
+    gap = planar_capsule_gap(-r, 0.0, r, 0.0, rb, q1x, q1y, x, y, rf1)
+    gap = min(gap, planar_capsule_gap(-r, 0.0, r, 0.0, rb, q2x, q2y, x, y, rf2))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, r, 0.0, rb, x, y, x, y, rp))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, -r, 0.0, q2x, q2y, ra2))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, q2x, q2y, x, y, rf2))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, x, y, x, y, rp))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, q2x, q2y, ra2, q1x, q1y, x, y, rf1))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, q2x, q2y, ra2, x, y, x, y, rp))
+    return gap
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """Fields at P = (x, y) in the packed working mode (kernels.grid contract): slots 0-2 LCI, sigma_min,
     sigma_max of J = dx/dq (mm/rad); 3 stiffness_min (N/mm), 4 deflection (mm) under the packed load (ideal
-    joints, docs/stiffness.md); LCI -1 (and zeros) if unreachable; z unused."""
+    joints, docs/stiffness.md); 5 clearance (mm) of the link capsules; LCI -1 (and zeros) if unreachable (or, with
+    interference_free, where the capsules overlap); z unused."""
     ok, c1, s1, c2, s2 = _kinematics(p, x, y, out)
     if ok:
+        gap = _clearance(p, x, y, c1, s1, c2, s2)
+        if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+            _grid.write_unreachable(out)
+            return
         out[3], out[4] = _stiffness(p, x, y, c1, s1, c2, s2)
+        out[_F_CLEARANCE] = gap
 
 
 DESIGN_METRICS = (
@@ -240,6 +276,8 @@ class PlanarFivebar(Mechanism):
         for name in ("alpha1_limits", "alpha2_limits"):
             options[name] = parse_range(name, options[name])
         check_fivebar_stiffness_options(options)
+        links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(N_PACKED)
@@ -260,6 +298,8 @@ class PlanarFivebar(Mechanism):
         p[_EA1], p[_EI1], p[_EA2] = arm.EA, arm.EI, fore.EA
         p[_KACT] = options["actuator_stiffness"]
         p[_FX], p[_FY] = options["load"]
+        p[_RAD : _RAD + 6] = list(links.radii(options, LINK_RADII).values())
+        p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
         return p
 
     @property
@@ -385,6 +425,31 @@ class PlanarFivebar(Mechanism):
         if jac["J"] is None or self.singularity(design, options, pose, q, tol=0.0) != "none":
             return 0.0
         return svd_lci(jac["J"])
+
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules in the plane z = 0 (mm): base B2 -> B1, arm_i B_i -> Q_i, forearm_i Q_i -> P, and the
+        platform as a ball at P. Adjacent (a joint between them): base-arm_i, arm_i-forearm_i, the two forearms
+        (they meet at P), forearm_i-platform. Radii: option ``link_radius``, defaults LINK_RADII."""
+        x, y = self.check_vector("pose", pose, 2)
+        q1, q2 = self.elbows(design, q)
+        rad = links.radii(options, LINK_RADII)
+        r = design["r"]
+        b1, b2, p = links.point(r, 0.0), links.point(-r, 0.0), links.point(x, y)
+        e1, e2 = links.point(*q1), links.point(*q2)
+        ends = {"base": (b2, b1), "arm1": (b1, e1), "arm2": (b2, e2), "forearm1": (e1, p), "forearm2": (e2, p),
+                "platform": (p, p)}
+        segments = tuple(links.Segment(name, name, a, b, rad[name]) for name, (a, b) in ends.items())
+        return links.LinkGeometry(segments, links.adjacency([
+            ("base", "arm1"), ("base", "arm2"), ("arm1", "forearm1"), ("arm2", "forearm2"),
+            ("forearm1", "forearm2"), ("forearm1", "platform"), ("forearm2", "platform"),
+        ]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """A = Jq^-1 Jx (rad/mm): alpha_dot = A P_dot, the inverse of J (spec §2.4); rows with an inverse
+        singularity (Jq_ii = 0) are infinite."""
+        jac = self.jacobians(design, options, pose, q)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return jac["Jx"] / np.diag(jac["Jq"])[:, None]
 
     def resolution_index(self, design, options, pose, dalpha=(1.0, 1.0)) -> float:
         """Kinematic resolution |J dalpha| (mm per the arm increments dalpha in rad; spec §2.4, paper eq. 18) in
@@ -533,6 +598,9 @@ MECHANISM = PlanarFivebar(
         *stiffness_options("mm", ACTUATOR_STIFFNESS, "torsional stiffness of each arm actuator, N mm/rad (1e5 N m/rad)",
                            [0.0, -150.0], "default 150 N along -y, the gravity direction (the workspace is below "
                            "the base)"),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults "
+               "base 25, arm1/arm2 20, forearm1/forearm2 15, platform 40 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
     fields=(
@@ -541,6 +609,7 @@ MECHANISM = PlanarFivebar(
               "pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
         Field("deflection", "{length}", "magnitude of the platform's deflection under options.load (default 150 N "
               "along -y); 1e12 at a singular pose", "min", (0.0, SIGMA_CAP)),
+        links.CLEARANCE_FIELD,
     ),
     design_metrics=DESIGN_METRICS,
 )

@@ -33,8 +33,10 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import segment_distance
 from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Mechanism,
@@ -54,6 +56,9 @@ BRANCHES = tuple(a + b + c for a in "+-" for b in "+-" for c in "+-")
 CONVENTIONS = ("O", "R")
 JOINTS = ("w1", "w2", "beta", "s1", "s2", "s3")
 CHAIN_OF_JOINT = (0, 1, 2, 0, 1, 2)
+# default capsule radii (mm), illustrative (the paper gives no cross-sections)
+LINK_RADII = {"base": 5.0, "slider1": 8.0, "slider2": 8.0, "leg3": 8.0, "link1": 5.0, "link2": 5.0, "link3": 5.0,
+              "platform": 5.0}
 
 # packed-parameter layout (see PprsRprs.pack)
 _R1, _R2, _R3 = 0, 3, 6  # rotated sphere-centre offsets r_k = R c_k' (3 each)
@@ -61,7 +66,22 @@ _U3X, _U3Y, _RAIL, _L1, _L2, _L3 = 9, 10, 11, 12, 13, 14
 _SG1, _SG2, _SG3, _CONV = 15, 16, 17, 18
 _WLO, _WHI, _SLO, _SHI, _BLO, _BHI = 19, 20, 21, 22, 23, 24
 _BLEN, _ALEN = 25, 26
-N_PACKED = 27
+_RAD = 27  # capsule radii of the 8 bodies, in LINK_RADII order
+_FREE_ONLY = 35  # 1: poses whose capsules overlap are unreachable
+_F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
+N_PACKED = 36
+
+# capsules of the clearance field, in link_geometry's order, with their body (index into LINK_RADII)
+_SEGMENT_BODY = np.array([0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7], dtype=np.int64)
+_BODIES = tuple(LINK_RADII)
+_ADJACENT = {frozenset(p) for p in (("base", "slider1"), ("base", "slider2"), ("base", "leg3"), ("slider1", "link1"),
+                                    ("slider2", "link2"), ("leg3", "link3"), ("link1", "platform"),
+                                    ("link2", "platform"), ("link3", "platform"))}
+# segment pairs whose clearance counts: different bodies sharing no joint (the same rule as LinkGeometry)
+_PAIRS = np.array([(i, j) for i in range(12) for j in range(i + 1, 12)
+                   if _SEGMENT_BODY[i] != _SEGMENT_BODY[j]
+                   and frozenset((_BODIES[_SEGMENT_BODY[i]], _BODIES[_SEGMENT_BODY[j]])) not in _ADJACENT],
+                  dtype=np.int64)
 
 
 # ----- Numba kernels -----------------------------------------------------------------------------------------
@@ -122,6 +142,16 @@ def _lci_6x6(a):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_seg(seg, k, ax, ay, az, bx, by, bz):
+    seg[k, 0] = ax
+    seg[k, 1] = ay
+    seg[k, 2] = az
+    seg[k, 3] = bx
+    seg[k, 4] = by
+    seg[k, 5] = bz
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
 def _put_row(a, row, scale, gx, gy, gz, rx, ry, rz, inv_alen):
     """Row ``row`` of the scaled Jacobian: scale * [g, (r x g) / angle_length]."""
     a[row, 0] = scale * gx
@@ -138,7 +168,8 @@ def point_fields(p, x, y, z, out):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
     IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
     Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq, x = (O1, angle_length x angular
-    velocity), the beta input times beta_length (dimensionless)."""
+    velocity), the beta input times beta_length (dimensionless); clearance (mm) of the link capsules (with
+    interference_free, overlapping capsules make the pose unreachable)."""
     c1x = x + p[_R1]
     c1y = y + p[_R1 + 1]
     c1z = z + p[_R1 + 2]
@@ -215,9 +246,43 @@ def point_fields(p, x, y, z, out):
     if s3 < slo or s3 > shi:
         _grid.write_unreachable(out)
         return
+    # clearance (field 3) of the capsules of link_geometry: B_i = (u_i . C_i) u_i carries the slider to
+    # D_i = B_i + s_i z; chain 3's prismatic runs from B3 = R u3 along d3 = (-rho3 u3 + h3 z) / mu3
+    seg = np.empty((12, 6))
+    b3x = rail * u3x
+    b3y = rail * u3y
+    d3x = b3x - s3 * rho3 * u3x / mu3
+    d3y = b3y - s3 * rho3 * u3y / mu3
+    d3z = s3 * h3 / mu3
+    p2x = -0.5 * p2
+    p2y = SQRT3_2 * p2
+    _put_seg(seg, 0, 0.0, 0.0, 0.0, rail, 0.0, 0.0)
+    _put_seg(seg, 1, 0.0, 0.0, 0.0, -0.5 * rail, SQRT3_2 * rail, 0.0)
+    _put_seg(seg, 2, 0.0, 0.0, 0.0, b3x, b3y, 0.0)
+    _put_seg(seg, 3, c1x, 0.0, 0.0, c1x, 0.0, s1)
+    _put_seg(seg, 4, p2x, p2y, 0.0, p2x, p2y, s2)
+    _put_seg(seg, 5, b3x, b3y, 0.0, d3x, d3y, d3z)
+    _put_seg(seg, 6, c1x, 0.0, s1, c1x, c1y, c1z)
+    _put_seg(seg, 7, p2x, p2y, s2, c2x, c2y, c2z)
+    _put_seg(seg, 8, d3x, d3y, d3z, c3x, c3y, c3z)
+    _put_seg(seg, 9, c1x, c1y, c1z, c2x, c2y, c2z)
+    _put_seg(seg, 10, c2x, c2y, c2z, c3x, c3y, c3z)
+    _put_seg(seg, 11, c3x, c3y, c3z, c1x, c1y, c1z)
+    gap = math.inf
+    for k in range(_PAIRS.shape[0]):
+        i = _PAIRS[k, 0]
+        j = _PAIRS[k, 1]
+        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
+                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
+        gap = min(gap, d - p[_RAD + _SEGMENT_BODY[i]] - p[_RAD + _SEGMENT_BODY[j]])
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
         _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
+        out[_F_CLEARANCE] = gap
         return
+    out[_F_CLEARANCE] = gap
     # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
     inv_alen = 1.0 / p[_ALEN]
     a = np.empty((6, 6))
@@ -520,6 +585,8 @@ class PprsRprs(Mechanism):
                 if value <= 0.0:
                     raise InvalidParameter(f"options.{name}: must be > 0 (a length in mm) or null, got {value:g}")
                 options[name] = value
+        links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     # ----- kernel side -------------------------------------------------------------------------------
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
@@ -537,6 +604,8 @@ class PprsRprs(Mechanism):
         p[_BLO], p[_BHI] = options["beta_limits"]
         p[_BLEN] = geo.beta_length
         p[_ALEN] = geo.angle_length
+        p[_RAD : _RAD + 8] = list(links.radii(options, LINK_RADII).values())
+        p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
         return p
 
     @property
@@ -672,6 +741,42 @@ class PprsRprs(Mechanism):
             return 0.0
         sv = np.linalg.svd(scaled(geo, twist_jacobian(geo, st)), compute_uv=False)
         return float(sv[-1] / sv[0])
+
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules (mm) at a pose (x, y, z[, phi, theta, psi]) with inputs q: base = the rails O -> R u_1,
+        O -> R u_2 and the strut O -> B3; slider_i the vertical slider B_i -> D_i = B_i + s_i z on its carriage
+        (chains 1, 2); leg3 the tilting prismatic B3 -> D3 = B3 + s3 d3; link_i D_i -> C_i; platform the triangle
+        C1 C2 C3. Adjacent: base-slider1, base-slider2, base-leg3, slider_i-link_i, leg3-link3,
+        link_i-platform. Radii: option ``link_radius``, defaults LINK_RADII."""
+        X = self.full_pose(options, pose)
+        w1, w2, beta, s1, s2, s3 = self.check_vector("inputs", q, 6)
+        geo = Geometry.of(design, options)
+        c = X[:3] + geo.body @ rotation(*X[3:]).T  # rows C_1, C_2, C_3
+        rad = links.radii(options, LINK_RADII)
+        z = np.array([0.0, 0.0, 1.0])
+        o = np.zeros(3)
+        b = [(geo.rail - w if geo.conv_r else w) * geo.u[k] for k, w in enumerate((w1, w2))]
+        d = [b[0] + s1 * z, b[1] + s2 * z]
+        b3 = geo.rail * geo.u[2]
+        d3 = b3 + s3 * (-math.cos(beta) * geo.u[2] + math.sin(beta) * z)
+        parts = [
+            ("rail1", "base", o, geo.rail * geo.u[0]), ("rail2", "base", o, geo.rail * geo.u[1]),
+            ("strut3", "base", o, b3),
+            ("slider1", "slider1", b[0], d[0]), ("slider2", "slider2", b[1], d[1]), ("leg3", "leg3", b3, d3),
+            ("link1", "link1", d[0], c[0]), ("link2", "link2", d[1], c[1]), ("link3", "link3", d3, c[2]),
+            ("platform12", "platform", c[0], c[1]), ("platform23", "platform", c[1], c[2]),
+            ("platform31", "platform", c[2], c[0]),
+        ]
+        segments = tuple(links.Segment(n, body, np.array(a), np.array(e), rad[body]) for n, body, a, e in parts)
+        return links.LinkGeometry(segments, links.adjacency([
+            ("base", "slider1"), ("base", "slider2"), ("base", "leg3"), ("slider1", "link1"), ("slider2", "link2"),
+            ("leg3", "link3"), ("link1", "platform"), ("link2", "platform"), ("link3", "platform"),
+        ]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """The twist Jacobian J_t (6 x 6): q_dot = J_t [v; omega]; the task axes are v (mm/s), the held
+        orientation's angular velocity omega (rad/s) is 0 along a constant-orientation cycle (spec §1.5)."""
+        return self.jacobians(design, options, pose, q)["Jt"]
 
     def joint_limits(self, options: Mapping[str, Any]) -> np.ndarray:
         """Limits (6, 2) of (w1, w2, beta, s1, s2, s3), mm and rad."""
@@ -843,10 +948,13 @@ MECHANISM = PprsRprs(
         Option("w_convention", "O", "'O': B_i = w_i u_i (spec); 'R': B_i = (R - w_i) u_i (eq.10-12, E5)"),
         Option("beta_length", None, "mm multiplying the beta row of J_t for the LCI; null = R"),
         Option("angle_length", None, "mm dividing the angular-velocity columns of J_t for the LCI; null = r"),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 5, "
+               "slider1/slider2/leg3 8, link1/link2/link3 5, platform 5 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
-    fields=base_fields("1", "J = dx/dq, the twist of O1 with its angular part times angle_length and the beta input "
-                       "times beta_length (mm/mm)"),
+    fields=(*base_fields("1", "J = dx/dq, the twist of O1 with its angular part times angle_length and the beta "
+                         "input times beta_length (mm/mm)"), links.CLEARANCE_FIELD),
     design_metrics=(
         DesignMetric(
             "link_length_sum", "{length}",
