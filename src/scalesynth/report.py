@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from scalesynth import io as rio
+from scalesynth import labels as lab
 from scalesynth import plotting
 from scalesynth.config import RunConfig, load_config
 from scalesynth.errors import ConfigError
@@ -63,12 +64,25 @@ def dominated_by_front(F_front: np.ndarray, f: np.ndarray) -> bool:
     return bool(np.any(np.all(F_front <= f, axis=1) & np.any(F_front < f, axis=1)))
 
 
-def plot_front(run_dir: Path) -> dict[str, Any]:
-    """plots/front.png (front, final population, reference designs, knee) and plots/hypervolume.png."""
+def _plots_dir(run_dir: Path, out: Path | None, fmt: str) -> Path:
+    if fmt not in rio.FIGURE_FORMATS:
+        raise ConfigError(f"--format: must be one of {', '.join(rio.FIGURE_FORMATS)}, got {fmt!r}")
+    return rio.ensure_dir(Path(out) if out is not None else run_dir / "plots")
+
+
+def _rel(run_dir: Path, path: Path) -> str:
+    try:
+        return str(path.resolve().relative_to(run_dir.resolve()))
+    except ValueError:
+        return str(path)
+
+
+def plot_front(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+    """plots/front.<fmt> (front, final population, reference designs, knee) and plots/hypervolume.<fmt>."""
     run_dir = Path(run_dir)
+    plots = _plots_dir(run_dir, out, fmt)
     cfg, pareto, history, population = load_run(run_dir)
     problem = SynthesisProblem(cfg)
-    plots = rio.ensure_dir(run_dir / "plots")
     xk, yk = _axes(problem, cfg)
     refs = reference_points(cfg, problem)
     highlight = []
@@ -85,25 +99,25 @@ def plot_front(run_dir: Path) -> dict[str, Any]:
     fig = plotting.front_figure(
         pareto[xk].to_numpy(),
         pareto[yk].to_numpy(),
-        xk,
-        yk,
+        lab.metric_label(xk),
+        lab.metric_label(yk),
         f"{cfg.name}: Pareto front ({cfg.mechanism}, seed {cfg.algorithm.seed})",
         references=[(r["label"], r["metrics"][xk], r["metrics"][yk]) for r in refs],
         highlight=highlight,
         population=pop_xy,
     )
-    rio.save_figure(fig, plots / "front.png")
+    rio.save_figure(fig, plots / f"front.{fmt}")
     plotting.close(fig)
     fig = plotting.hypervolume_figure(
         history["generation"].to_numpy(), history["hypervolume"].to_numpy(), f"{cfg.name}: hypervolume per generation"
     )
-    rio.save_figure(fig, plots / "hypervolume.png")
+    rio.save_figure(fig, plots / f"hypervolume.{fmt}")
     plotting.close(fig)
-    return {"references": refs, "files": ["plots/front.png", "plots/hypervolume.png"]}
+    files = [_rel(run_dir, plots / f"front.{fmt}"), _rel(run_dir, plots / f"hypervolume.{fmt}")]
+    return {"references": refs, "files": files}
 
 
-def band_labels(edges) -> list[str]:
-    return [f"{'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]" for b in range(len(edges) - 1)]
+from scalesynth.workspace_view import band_labels  # noqa: E402  (re-exported: report.band_labels)
 
 
 def featured_designs(problem: SynthesisProblem, pareto: pd.DataFrame) -> list[tuple[str, int]]:
@@ -117,67 +131,85 @@ def featured_designs(problem: SynthesisProblem, pareto: pd.DataFrame) -> list[tu
     return out
 
 
-SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; one design costs ~0.1 s
+SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; a plane costs 128^2 points
 
 
 def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, Any]]:
-    """Mid-plane sections of the LCI grid: (axis0, axis2) at the middle of axis1 and (axis0, axis1) at the middle
-    of axis2 (for seed 000: xz at y = 0 and xy at the centre height); one map for planar mechanisms."""
+    """Workspace sections coloured by LCI, each sampled on its plane only (never a full grid): for a 3-D mechanism
+    the planes normal to its second and third task axes through the workspace centroid (from a coarse grid; an
+    empty plane moves to the nearest one that cuts the workspace), for seed 000 the xz and xy sections; one map
+    for planar mechanisms. Axis labels carry units; axes of different units are not drawn to equal scale."""
+    from scalesynth.show import _task_geometry
+    from scalesynth.workspace_view import default_section_point, sample_plane
+
+    mech = cfg.mech
+    unit = cfg.units.length
     res = max(cfg.grid.resolution, SECTION_RESOLUTION)
-    cfg = cfg.model_copy(update={"grid": cfg.grid.model_copy(update={"resolution": res + res % 2 + 1})})
-    rep = evaluate_config(cfg, design, keep_grid=True)
-    g, lci = rep.grid, rep.lci_grid
-    names = cfg.mech.task_axes
-    ext = [(g.lo[a], g.lo[a] + g.shape[a] * g.step[a]) for a in range(3)]
-    if len(names) == 2:
-        return [{"lci": lci[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": names[0], "ylabel": names[1],
-                 "title": f"{names[0]}{names[1]} workspace"}]
-    j = int(g.shape[1]) // 2
-    k = int(g.shape[2]) // 2
-    yj = g.lo[1] + (j + 0.5) * g.step[1]
-    zk = g.lo[2] + (k + 0.5) * g.step[2]
-    return [
-        {"lci": lci[:, j, :], "extent": (*ext[0], *ext[2]), "xlabel": names[0], "ylabel": names[2],
-         "title": f"{names[0]}{names[2]} section at {names[1]} = {yj:.4g}"},
-        {"lci": lci[:, :, k], "extent": (*ext[0], *ext[1]), "xlabel": names[0], "ylabel": names[1],
-         "title": f"{names[0]}{names[1]} section at {names[2]} = {zk:.4g}"},
-    ]
+    box, path = _task_geometry(cfg)
+    if mech.planar:
+        values, ext = sample_plane(cfg, design, 2, 0.0, res)
+        return [{"values": values, "extent": ext, "xlabel": lab.axis_label(mech, 0, unit),
+                 "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
+                 "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
+                 "path": None if path is None else path[:, :2]}]
+    point = default_section_point(cfg, design)
+    panels = []
+    for normal in (1, 2):
+        a, b = [x for x in range(3) if x != normal]
+        point[normal] = round(float(point[normal]), 10) + 0.0  # no '-7e-17' in titles for a symmetric workspace
+        values, ext = sample_plane(cfg, design, normal, float(point[normal]), res)
+        name = lab.axis_name(mech.task_axes[normal])
+        panel = {"values": values, "extent": ext, "xlabel": lab.axis_label(mech, a, unit),
+                 "ylabel": lab.axis_label(mech, b, unit), "equal": lab.same_units(mech, (a, b)),
+                 "title": f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at "
+                          f"{name} = {point[normal]:.4g} (centroid)"}
+        if box is not None and box[0, normal] <= point[normal] <= box[1, normal]:
+            panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
+        panels.append(panel)
+    return panels
 
 
-def plot_bands(run_dir: Path) -> dict[str, Any]:
-    """plots/bands_front.png, plots/band_shares.png and plots/sections_<design>.png (paper Figs. 7-10, Table 5)."""
+def plot_bands(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+    """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
+    per-band Pareto sets bands/pareto_band<k>.csv with their plots."""
+    from scalesynth.band_fronts import write_band_fronts
+
     run_dir = Path(run_dir)
-    cfg, pareto, _, _ = load_run(run_dir)
+    plots = _plots_dir(run_dir, out, fmt)
+    cfg, pareto, _, population = load_run(run_dir)
     problem = SynthesisProblem(cfg)
-    plots = rio.ensure_dir(run_dir / "plots")
     edges = cfg.dexterity.band_edges
     labels = band_labels(edges)
     nb = len(edges) - 1
     files = []
+    bands_out = None if out is None else plots / "bands"
+    band_info = write_band_fronts(run_dir, cfg, problem, population, fmt, bands_out)
     if not len(pareto):
-        return {"files": files, "featured": []}
+        return {"files": files, "featured": [], "band_files": band_info["files"], "band_sizes": band_info["sizes"]}
     xk, yk = _axes(problem, cfg)
     shares = [pareto[f"band{b}_share"].to_numpy() for b in range(nb)]
-    fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels, xk, yk)
-    rio.save_figure(fig, plots / "bands_front.png")
+    fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels,
+                                     lab.metric_label(xk), lab.metric_label(yk))
+    rio.save_figure(fig, plots / f"bands_front.{fmt}")
     plotting.close(fig)
-    files.append("plots/bands_front.png")
+    files.append(_rel(run_dir, plots / f"bands_front.{fmt}"))
     featured = featured_designs(problem, pareto)
     bar = np.array([[pareto[f"band{b}_share"].iloc[i] for b in range(nb)] for _, i in featured])
     fig = plotting.band_shares_figure([label for label, _ in featured], bar, labels)
-    rio.save_figure(fig, plots / "band_shares.png")
+    rio.save_figure(fig, plots / f"band_shares.{fmt}")
     plotting.close(fig)
-    files.append("plots/band_shares.png")
+    files.append(_rel(run_dir, plots / f"band_shares.{fmt}"))
     for label, i in featured:
         design = design_of(problem, pareto.iloc[i])
         panels = section_panels(cfg, design)
         title = f"{label}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
         fig = plotting.sections_figure(panels, edges, title)
-        name = "sections_" + label.replace(" ", "_") + ".png"
+        name = "sections_" + label.replace(" ", "_") + f".{fmt}"
         rio.save_figure(fig, plots / name)
         plotting.close(fig)
-        files.append(f"plots/{name}")
-    return {"files": files, "featured": [(label, int(i)) for label, i in featured]}
+        files.append(_rel(run_dir, plots / name))
+    return {"files": files, "featured": [(label, int(i)) for label, i in featured],
+            "band_files": band_info["files"], "band_sizes": band_info["sizes"]}
 
 
 def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str, Any]) -> None:
@@ -225,13 +257,26 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
             dom = r.get("dominated_by_front")
             lines.append(f"| {r['label']} | {r['metrics'][mkey]:.4g} | {r['metrics']['gci']:.4g} | "
                          f"{'yes' if dom else 'no' if dom is not None else '-'} |")
-    lines += ["", "## Plots", ""]
-    for f in front_info.get("files", []) + bands_info.get("files", []):
+    sizes = bands_info.get("band_sizes") or []
+    if sizes:
+        lines += ["", "## Per-band Pareto sets", "",
+                  "Designs of the final population non-dominated in band k's measure and the run's other objectives.",
+                  ""]
+        for k, n in enumerate(sizes):
+            lines.append(f"- LCI {band_labels(cfg.dexterity.band_edges)[k]}: {n} designs, "
+                         f"[bands/pareto_band{k}.csv](bands/pareto_band{k}.csv)")
+    lines += ["", "## Plots", "", "Interactive version: [report.html](report.html) (self-contained, works offline).",
+              ""]
+    for f in front_info.get("files", []) + bands_info.get("files", []) + bands_info.get("band_files", [])[1::2]:
         lines.append(f"![{Path(f).stem}]({f})")
     rio.write_text(run_dir / "report.md", "\n".join(lines) + "\n")
 
 
 def write_plots_and_report(run_dir: Path) -> None:
+    """Plots, per-band Pareto sets, report.md and the self-contained interactive report.html."""
+    from scalesynth.report_html import write_report_html
+
     front = plot_front(run_dir)
     bands = plot_bands(run_dir)
     write_report(run_dir, front, bands)
+    write_report_html(run_dir, bands.get("featured"), bands.get("band_sizes"))

@@ -97,20 +97,20 @@ def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
     # a margin so that a path along the edges of the box stays visible
     ax.set_xlim(extent[0] - 0.04 * width, extent[1] + 0.04 * width)
     ax.set_ylim(extent[2] - 0.04 * height, extent[3] + 0.04 * height)
-    ax.set_xlabel(f"{axes[0]} ({unit})")
-    ax.set_ylabel(f"{axes[1]} ({unit})")
+    ax.set_xlabel(f"{axes[0]} [{unit}]")
+    ax.set_ylabel(f"{axes[1]} [{unit}]")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
     return fig
 
 
 def _save_atomic(fig, out: Path) -> None:
-    """Write the PNG to a temporary file next to ``out`` and rename it, so a reader never sees half a file."""
+    """Write the figure (format from the suffix) to a temporary file next to ``out`` and rename it."""
     out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".png", dir=out.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=out.suffix or ".png", dir=out.parent)
     os.close(fd)
     try:
-        fig.savefig(tmp, dpi=130)
+        fig.savefig(tmp, dpi=130, format=(out.suffix.lstrip(".") or "png"))
         os.replace(tmp, out)
     finally:
         if os.path.exists(tmp):
@@ -121,7 +121,9 @@ def _save_atomic(fig, out: Path) -> None:
 @handles_errors
 def plot_task_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML) of a planar mechanism with a task section")],
-    out: Annotated[Path | None, typer.Option("--out", help="PNG to write (default OUTDIR/plots/task_lci.png)")] = None,
+    out: Annotated[Path | None, typer.Option("--out", help="directory to write task_lci.<format> into (default "
+                                              "OUTDIR/plots); a name with a .png/.svg/.pdf suffix is the file")] = None,
+    fmt: Annotated[str, typer.Option("--format", help="png | svg | pdf")] = "png",
     sets: SetOpt = None,
     resolution: Annotated[int | None, typer.Option(help="cells per axis (default task/grid resolution)")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
@@ -131,6 +133,8 @@ def plot_task_cmd(
 
     from scalesynth.config import load_config
 
+    if fmt not in ("png", "svg", "pdf"):
+        raise ConfigError(f"--format: must be one of png, svg, pdf, got {fmt!r}")
     cfg = load_config(config, list(sets or []))
     tm = task_map(cfg, resolution)
     unit = cfg.units.length
@@ -141,7 +145,10 @@ def plot_task_cmd(
         f"task coverage {tm.coverage:.4f}, GCI {tm.gci:.4f}, FCI {tm.fci:.4f} ({cells})"
     )
     fig = task_figure(tm, cfg.mech.task_axes[:2], unit, title)
-    target = out or cfg.output_dir() / "plots" / "task_lci.png"
+    if out is not None and out.suffix.lower() in (".png", ".svg", ".pdf"):
+        target = out
+    else:
+        target = (out or cfg.output_dir() / "plots") / f"task_lci.{fmt}"
     try:
         _save_atomic(fig, target)
     finally:

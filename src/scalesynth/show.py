@@ -1,0 +1,221 @@
+"""`scalesynth show`: one design's workspace in 3-D coloured by a per-voxel field, each dexterity band's region with
+its number of connected regions, and sections (default through the workspace centroid), written to a directory
+with ``show.json``.
+
+The source is a config (its ``design``) or a finished results directory (its knee, best-<metric> or a row of
+pareto.csv). PNG, SVG and PDF come from matplotlib; HTML (interactive, self-contained) from plotly.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from scalesynth import io as rio
+from scalesynth import labels as lab
+from scalesynth import workspace_view as wv
+from scalesynth.errors import ConfigError
+
+FORMATS = ("png", "svg", "pdf", "html")
+CONNECTIVITY = "26-connected: cells sharing a face, an edge or a corner (8 in 2-D); face-only count beside it"
+
+
+def load_source(source: Path, sets: Sequence[str] | None = None):
+    """(config, results directory or None) for a config file or a results directory."""
+    from scalesynth.config import load_config
+
+    source = Path(source)
+    if source.is_dir():
+        if not (source / "config.yaml").is_file() or not (source / "pareto.csv").is_file():
+            raise ConfigError(f"{source}: not a scalesynth results directory (no config.yaml / pareto.csv)")
+        return load_config(source / "config.yaml", list(sets or [])), source
+    return load_config(source, list(sets or [])), None
+
+
+def resolve_design(cfg, run_dir: Path | None, choice: str | None) -> tuple[dict[str, float], str, int | None]:
+    """(design, label, row of pareto.csv or None) for ``--design``."""
+    if run_dir is None:
+        if choice not in (None, "config"):
+            raise ConfigError(f"--design {choice}: a config shows its own design; give a results directory to "
+                              "choose knee, best-<metric> or a row")
+        return cfg.resolved_design(), "config", None
+    from scalesynth.problem import SynthesisProblem
+    from scalesynth.report import design_of, load_run
+
+    _, pareto, _, _ = load_run(run_dir)
+    problem = SynthesisProblem(cfg)
+    row, label = wv.choose_row(problem, pareto, choice or "knee", cfg.mech.measure_key(cfg.units.length))
+    return design_of(problem, pareto.iloc[row]), label, row
+
+
+def _task_geometry(cfg):
+    """Task box as a (2, 3) array (lo, hi; planar: third axis 0) and the task path (n, 3), each or None."""
+    task = cfg.task
+    if task is None:
+        return None, None
+    n = len(cfg.mech.task_axes)
+    box = np.zeros((2, 3))
+    for a, name in enumerate(cfg.mech.task_axes):
+        box[:, a] = task.box[name]
+    path = None
+    if task.path is not None:
+        p = np.asarray(task.path, dtype=float)
+        path = np.pad(p, ((0, 0), (0, 3 - p.shape[1])))[:, :3]
+    return (box if n else None), path
+
+
+def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[list[dict], list[dict]]:
+    """Sections normal to each task axis of a 3-D mechanism (the whole map of a planar one), through the point
+    ``at`` (default: the centroid; an empty default plane moves to the nearest plane that cuts the workspace).
+    Returns (figure panels, their descriptions for show.json)."""
+    mech = cfg.mech
+    unit = cfg.units.length
+    values = fg.fields[field]
+    axes = fg.axes()
+    g = fg.grid
+    ext = [(float(g.lo[a]), float(g.lo[a] + g.shape[a] * g.step[a])) for a in range(3)]
+    box, path = _task_geometry(cfg)
+    if mech.planar:
+        panel = {"values": values[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": lab.axis_label(mech, 0, unit),
+                 "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
+                 "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
+                 "path": None if path is None else path[:, :2]}
+        return [panel], [{"normal": None, "cells": int(fg.reachable.sum())}]
+    c = wv.centroid(fg)
+    panels, info = [], []
+    for normal in range(3):
+        requested = at.get(normal)
+        i, moved = wv.nearest_nonempty(fg, normal, c[normal] if requested is None else requested)
+        if requested is not None:  # the user's plane stays where it was asked for, even if empty
+            i, moved = int(np.argmin(np.abs(axes[normal] - requested))), False
+        a, b = [x for x in range(3) if x != normal]
+        plane = np.take(values, i, axis=normal)
+        cells = int(np.isfinite(plane).sum())
+        pos = float(axes[normal][i])
+        name = lab.axis_name(mech.task_axes[normal])
+        title = f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at {name} = {pos:.4g}"
+        panel = {"values": plane, "extent": (*ext[a], *ext[b]), "xlabel": lab.axis_label(mech, a, unit),
+                 "ylabel": lab.axis_label(mech, b, unit), "title": title, "equal": lab.same_units(mech, (a, b))}
+        if box is not None and box[0, normal] <= pos <= box[1, normal]:
+            panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
+        if path is not None:
+            panel["path"] = path[:, [a, b]]
+        panels.append(panel)
+        info.append({"normal": mech.task_axes[normal], "value": pos, "cells": cells,
+                     "source": "--at" if requested is not None else ("centroid, moved to the nearest non-empty plane"
+                                                                      if moved else "centroid")})
+    return panels, info
+
+
+def show_design(
+    source: Path,
+    design: str | None = None,
+    field: str = "lci",
+    at: Sequence[str] | None = None,
+    out: Path | None = None,
+    fmt: str = "png",
+    resolution: int | None = None,
+    sets: Sequence[str] | None = None,
+) -> dict[str, Any]:
+    """Write the views of one design into ``out`` (default <run or results/<name>>/show/<design label>/) and
+    return what show.json holds."""
+    t0 = time.perf_counter()
+    if fmt not in FORMATS:
+        raise ConfigError(f"--format: must be one of {', '.join(FORMATS)}, got {fmt!r}")
+    cfg, run_dir = load_source(source, sets)
+    mech = cfg.mech
+    wv.check_field(mech, field)
+    at_axes = wv.parse_at(at, mech)
+    res = resolution or cfg.grid.resolution
+    if not 4 <= res <= 512:
+        raise ConfigError(f"--resolution: must be between 4 and 512 cells per axis, got {res}")
+    chosen, label, row = resolve_design(cfg, run_dir, design)
+    target = Path(out) if out is not None else (run_dir or cfg.output_dir()) / "show" / label
+    rio.ensure_dir(target)
+    t1 = time.perf_counter()
+    fg = wv.sample_fields(cfg, chosen, res)
+    t_sample = time.perf_counter() - t1
+    ndim = len(mech.task_axes)
+    edges = cfg.dexterity.band_edges
+    bands = wv.band_regions(fg, edges, ndim)
+    panels, section_info = sections(cfg, fg, field, at_axes)
+    unit = cfg.units.length
+    axis_labels = [lab.axis_label(mech, a, unit) for a in range(ndim)]
+    equal = lab.same_units(mech, range(ndim))
+    c = wv.centroid(fg)
+    reach = fg.reachable
+    measure_key = mech.measure_key(unit)
+    summary = {
+        "source": str(source),
+        "mechanism": mech.name,
+        "design_choice": label,
+        "pareto_row": row,
+        "design": chosen,
+        "field": field,
+        "resolution": res,
+        "grid": {name: {"lo": float(fg.grid.lo[a]), "hi": float(fg.grid.lo[a] + fg.grid.shape[a] * fg.grid.step[a]),
+                        "cells": int(fg.grid.shape[a])} for a, name in enumerate(mech.task_axes)},
+        "reachable_cells": int(reach.sum()),
+        measure_key: float(reach.sum() * fg.grid.cell_measure),
+        "gci": float(fg.lci[reach].mean()) if reach.any() else 0.0,
+        "centroid": {name: float(c[a]) for a, name in enumerate(mech.task_axes)},
+        "connectivity": CONNECTIVITY,
+        "bands": [{k: v for k, v in b.items() if not k.startswith("_")} for b in bands],
+        "sections": section_info,
+        "task": None if cfg.task is None else {"box": {k: list(v) for k, v in cfg.task.box.items()},
+                                               "path_points": None if cfg.task.path is None else len(cfg.task.path)},
+        "robot": "not drawn: link geometry of the mechanisms is not available yet (issue 13)",
+        "files": [],
+    }
+    title = f"{mech.name} {label}: " + ", ".join(f"{k}={v:.4g}" for k, v in chosen.items())
+    files = _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target, fmt)
+    summary["files"] = files
+    summary["seconds"] = {"sample": round(t_sample, 3), "total": round(time.perf_counter() - t0, 3)}
+    rio.write_json(target / "show.json", summary)
+    summary["out"] = str(target)
+    return summary
+
+
+def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target: Path, fmt: str) -> list[str]:
+    mech = cfg.mech
+    edges = cfg.dexterity.band_edges
+    field_label = lab.metric_label(field)
+    box, path = _task_geometry(cfg)
+    files = []
+    if fmt == "html":
+        from scalesynth import interactive
+
+        html = interactive.show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path)
+        rio.write_text(target / "show.html", html)
+        return ["show.html"]
+    from scalesynth import plotting
+
+    if not mech.planar:
+        mask = fg.reachable
+        pts, flat = wv.boundary_points(mask, fg.axes())
+        fig = plotting.surface_scatter_figure(pts, fg.fields[field].ravel()[flat], axis_labels,
+                                              f"{title}\nworkspace boundary coloured by {field_label}", field_label,
+                                              box=box, path=path, equal=equal)
+        rio.save_figure(fig, target / f"workspace_3d.{fmt}")
+        plotting.close(fig)
+        files.append(f"workspace_3d.{fmt}")
+        regions = []
+        for b in bands:
+            bmask = b["_labels"] > 0
+            bpts, bflat = wv.boundary_points(bmask, fg.axes())
+            regions.append({"label": b["label"], "points": bpts, "region": b["_labels"].ravel()[bflat] - 1,
+                            "regions": b["regions"]})
+        fig = plotting.band_regions_figure(regions, axis_labels, f"{title}\ndexterity bands (26-connected regions)",
+                                           box=box, path=path, equal=equal)
+        rio.save_figure(fig, target / f"bands_3d.{fmt}")
+        plotting.close(fig)
+        files.append(f"bands_3d.{fmt}")
+    fig = plotting.sections_figure(panels, edges if field == "lci" else None, title, field_label=field_label)
+    rio.save_figure(fig, target / f"sections.{fmt}")
+    plotting.close(fig)
+    files.append(f"sections.{fmt}")
+    return files
