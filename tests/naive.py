@@ -7,9 +7,42 @@ from __future__ import annotations
 
 import numpy as np
 
+SIGMA_CAP = 1e12  # the kernels' stand-in for an unbounded singular value (kernels/conditioning.py)
+
+
+def jacobian_fields(j, regular):
+    """(LCI, sigma_min, sigma_max) of a stack of Jacobians dx/dq (k, n, n) by NumPy's SVD where ``regular``;
+    elsewhere (exact singular poses) the kernels' convention LCI 0, sigma_min 0, sigma_max SIGMA_CAP."""
+    k = j.shape[0]
+    out = np.zeros((k, 3))
+    out[:, 2] = SIGMA_CAP
+    if regular.any():
+        sv = np.linalg.svd(j[regular], compute_uv=False)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[regular, 0] = np.where(sv[:, 0] > 0, sv[:, -1] / sv[:, 0], 0.0)
+        out[regular, 1] = np.minimum(sv[:, -1], SIGMA_CAP)
+        out[regular, 2] = np.minimum(sv[:, 0], SIGMA_CAP)
+    return out
+
+
+def inverse_jacobian_fields(a):
+    """(LCI, sigma_min, sigma_max) of J = A^-1 for a stack of inverse Jacobians dq/dx (k, n, n): J by
+    np.linalg.inv where A is regular, then jacobian_fields."""
+    regular = np.abs(np.linalg.det(a)) > 0
+    j = np.zeros_like(a)
+    if regular.any():
+        j[regular] = np.linalg.inv(a[regular])
+    return jacobian_fields(j, regular)
+
 
 def pauu_lci(design, options, x, y, z):
-    """Seed 000, spec §1.2/§1.4: LCI = 1/cond_2(J), J = Jx^-1 Jq, at arrays of points; -1 where unreachable."""
+    """Seed 000: the LCI of pauu_fields (-1 where unreachable)."""
+    return pauu_fields(design, options, x, y, z)[..., 0]
+
+
+def pauu_fields(design, options, x, y, z):
+    """Seed 000, spec §1.2/§1.4: (LCI = 1/cond_2(J), sigma_min(J), sigma_max(J)), J = Jx^-1 Jq = dx/dq, at arrays of
+    points, shape x.shape + (3,); LCI -1 (and 0, 0) where unreachable."""
     x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
     m, n, l1, l2, c = (design[k] for k in ("m", "n", "l1", "l2", "c"))
     e = 2 * c if options.get("e") is None else options["e"]
@@ -40,7 +73,8 @@ def pauu_lci(design, options, x, y, z):
         ok &= (y >= lo) & (y <= hi)
     if options.get("z_min") is not None:
         ok &= z >= options["z_min"]
-    out = np.full(x.shape, -1.0)
+    out = np.zeros(x.shape + (3,))
+    out[..., 0] = -1.0
     idx = np.nonzero(ok)
     if idx[0].size == 0:
         return out
@@ -59,13 +93,11 @@ def pauu_lci(design, options, x, y, z):
         jq[:, row, row] = -l1 * (a * np.sin(th) + (zs - e) * np.cos(th))
     jx[:, 2, 1] = 1.0
     jq[:, 2, 2] = 1.0
-    # kappa(J) = kappa(J^-1) and J^-1 = Jq^-1 Jx; compute from J^-1 where Jq is regular
-    lci = np.zeros(k)
-    good = (np.abs(jq[:, 0, 0]) > 0) & (np.abs(jq[:, 1, 1]) > 0)
-    jinv = np.linalg.solve(jq[good], jx[good])
-    sv = np.linalg.svd(jinv, compute_uv=False)
-    lci[good] = sv[:, -1] / sv[:, 0]
-    out[idx] = lci
+    # J = Jx^-1 Jq where both are regular (an exact singularity is the kernels' convention)
+    good = (np.abs(jq[:, 0, 0]) > 0) & (np.abs(jq[:, 1, 1]) > 0) & (np.abs(np.linalg.det(jx)) > 0)
+    j = np.zeros((k, 3, 3))
+    j[good] = np.linalg.solve(jx[good], jq[good])
+    out[idx] = jacobian_fields(j, good)
     return out
 
 
@@ -114,8 +146,14 @@ def fivebar_arm_angles(design, options, x, y):
 
 
 def fivebar_lci(design, options, x, y):
-    """Seed 004, spec §2.2/§2.4: LCI = sigma_min/sigma_max of J (NumPy SVD) at arrays of points; -1 where
-    unreachable or outside the arm limits (intervals taken modulo 2 pi)."""
+    """Seed 004: the LCI of fivebar_fields (-1 where unreachable)."""
+    return fivebar_fields(design, options, x, y)[..., 0]
+
+
+def fivebar_fields(design, options, x, y):
+    """Seed 004, spec §2.2/§2.4: (LCI = sigma_min/sigma_max, sigma_min, sigma_max) of J = dx/dq (mm/rad, NumPy SVD)
+    at arrays of points, shape x.shape + (3,); LCI -1 where unreachable or outside the arm limits (intervals taken
+    modulo 2 pi)."""
     x, y = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y)))
     r, l1 = design["r"], design["l1"]
     a1, a2 = fivebar_arm_angles(design, options, x, y)
@@ -125,7 +163,8 @@ def fivebar_lci(design, options, x, y):
         if lims is not None:
             with np.errstate(invalid="ignore"):
                 ok &= np.mod(alpha - lims[0], 2 * np.pi) <= lims[1] - lims[0]
-    out = np.full(x.shape, -1.0)
+    out = np.zeros(x.shape + (3,))
+    out[..., 0] = -1.0
     idx = np.nonzero(ok)
     if idx[0].size == 0:
         return out
@@ -143,16 +182,17 @@ def fivebar_lci(design, options, x, y):
     # at a forward singularity (sin(beta2 - beta1) = 0) J is unbounded and its LCI tends to 0
     det = np.sin(b2 - b1)
     regular = det != 0
-    j = j[regular] * (l1 / det[regular])[:, None, None]
-    sv = np.linalg.svd(j, compute_uv=False)
-    lci = np.zeros(k)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        lci[regular] = np.where(sv[:, 0] > 0, sv[:, -1] / sv[:, 0], 0.0)
-    out[idx] = lci
+    j[regular] *= (l1 / det[regular])[:, None, None]
+    out[idx] = jacobian_fields(j, regular)
     return out
 
 
 def pprs_lci(design, options, x, y, z):
+    """Seed 001: the LCI of pprs_fields (-1 where unreachable)."""
+    return pprs_fields(design, options, x, y, z)[..., 0]
+
+
+def pprs_fields(design, options, x, y, z):
     """Seed 001, spec §1.3/§1.5/§1.8: LCI = sigma_min/sigma_max (NumPy SVD) of J_t with the beta row times
     beta_length (default R) and the angular columns over angle_length (default r), at arrays of positions of
     O1 with the options' orientation; -1 where the IK is not real or an actuator leaves its limits."""
@@ -174,7 +214,8 @@ def pprs_lci(design, options, x, y, z):
     body = np.array([[r, 0, 0], [-r / 2, np.sqrt(3) * r / 2, 0], [-r / 2, -np.sqrt(3) * r / 2, 0]])
     rk = body @ rot.T  # r_k = R c_k'
     pts = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-    out = np.full(pts.shape[0], -1.0)
+    out = np.zeros((pts.shape[0], 3))
+    out[:, 0] = -1.0
     zhat = np.array([0.0, 0.0, 1.0])
     for n, p in enumerate(pts):
         c = p + rk
@@ -194,7 +235,7 @@ def pprs_lci(design, options, x, y, z):
         if not ok:
             continue
         if np.any(kap == 0):
-            out[n] = 0.0
+            out[n] = (0.0, 0.0, SIGMA_CAP)
             continue
         d3 = -np.cos(beta) * u[2] + np.sin(beta) * zhat
         g = [
@@ -208,12 +249,16 @@ def pprs_lci(design, options, x, y, z):
         chain = [0, 1, 2, 0, 1, 2]
         jt = np.array([np.concatenate([g[j], np.cross(rk[chain[j]], g[j])]) for j in range(6)])
         js = np.diag([1, 1, beta_len, 1, 1, 1]) @ jt @ np.diag([1, 1, 1, 1 / ang_len, 1 / ang_len, 1 / ang_len])
-        sv = np.linalg.svd(js, compute_uv=False)
-        out[n] = sv[-1] / sv[0]
-    return out.reshape(x.shape)
+        out[n] = inverse_jacobian_fields(js[None])[0]  # J_t maps the twist to the input rates: dq/dx
+    return out.reshape(x.shape + (3,))
 
 
 def ups_sspr_lci(design, options, alpha, beta, y):
+    """Seed 003: the LCI of ups_sspr_fields (-1 where unreachable)."""
+    return ups_sspr_fields(design, options, alpha, beta, y)[..., 0]
+
+
+def ups_sspr_fields(design, options, alpha, beta, y):
     """Seed 003, spec §3.1/§3.3/§3.5: LCI = 1/cond_2(J diag(1/L, 1/L, 1)), J = dl/d(alpha, beta, Y), at arrays of
     task points; -1 outside the workspace box, outside |Y| < c or outside an actuator's limits.
 
@@ -229,7 +274,8 @@ def ups_sspr_lci(design, options, alpha, beta, y):
     ok = (alpha >= options["alpha_range"][0]) & (alpha <= options["alpha_range"][1])
     ok &= (beta >= options["beta_range"][0]) & (beta <= options["beta_range"][1])
     ok &= (y >= y_range[0]) & (y <= y_range[1]) & (np.abs(y) < c)
-    out = np.full(alpha.shape, -1.0)
+    out = np.zeros(alpha.shape + (3,))
+    out[..., 0] = -1.0
     idx = np.nonzero(ok)
     al, be, yy = alpha[idx], beta[idx], y[idx]
     n = al.size
@@ -264,13 +310,18 @@ def ups_sspr_lci(design, options, alpha, beta, y):
         if lim is not None:
             keep &= (lengths[i] >= lim[0]) & (lengths[i] <= lim[1])
     jac[:, :, :2] /= big_l
-    sv = np.linalg.svd(jac, compute_uv=False)
-    lci = np.where(keep, sv[:, -1] / sv[:, 0], -1.0)
-    out[idx] = lci
+    fields = inverse_jacobian_fields(jac)  # jac = dl/dx homogenised: J = its inverse
+    fields[~keep] = (-1.0, 0.0, 0.0)
+    out[idx] = fields
     return out
 
 
 def rps_upu_lci(design, options, z, theta, psi):
+    """Seed 002: the LCI of rps_upu_fields (-1 where unreachable)."""
+    return rps_upu_fields(design, options, z, theta, psi)[..., 0]
+
+
+def rps_upu_fields(design, options, z, theta, psi):
     """Seed 002, spec §2.3/§2.5: LCI = 1/cond_2 of dq/d(z, L theta, L psi) (NumPy SVD) at arrays of points; -1 where
     a leg leaves the stroke limits or the C-model parametrisation is degenerate.
 
@@ -326,15 +377,20 @@ def rps_upu_lci(design, options, z, theta, psi):
         xc[:, k] += 1j * step
         jac[:, :, k] = legs(xc)[0].imag / step
     jac[:, :, 1:] /= big_l
-    out = np.full(n, -1.0)
+    out = np.zeros((n, 3))
+    out[:, 0] = -1.0
     good = ok & np.all(q > 0, axis=1)
-    sv = np.linalg.svd(jac[good], compute_uv=False)
-    out[good] = sv[:, -1] / sv[:, 0]
-    out[ok & ~np.all(q > 0, axis=1)] = 0.0
-    return out.reshape(z.shape)
+    out[good] = inverse_jacobian_fields(jac[good])  # jac = dq/dx homogenised: J = its inverse
+    out[ok & ~np.all(q > 0, axis=1)] = (0.0, 0.0, SIGMA_CAP)
+    return out.reshape(z.shape + (3,))
 
 
 def rps_upu_tool_lci(design, options, x, y, z):
+    """Seed 002 tool point: the LCI of rps_upu_tool_fields (-1 where unreachable)."""
+    return rps_upu_tool_fields(design, options, x, y, z)[..., 0]
+
+
+def rps_upu_tool_fields(design, options, x, y, z):
     """Seed 002, spec §2.8: LCI = 1/cond_2 of dq/dT (NumPy SVD) of the tool point T = (x, y, z) = O' + R (0, 0, -d),
     P-model, principal branch; -1 where T is out of reach, the pose leaves the z/theta/psi ranges or a leg leaves
     the stroke limits.
@@ -362,7 +418,8 @@ def rps_upu_tool_lci(design, options, x, y, z):
 
     ok = (np.abs(pts[:, 1]) <= d) & (np.abs(pts[:, 0]) <= d * np.sqrt(np.clip(1 - (pts[:, 1] / d) ** 2, 0, 1)))
     ok &= np.abs(pts[:, 1]) < d  # psi = +-pi/2 leaves theta undetermined
-    out = np.full(pts.shape[0], -1.0)
+    out = np.zeros((pts.shape[0], 3))
+    out[:, 0] = -1.0
     t = pts[ok]
     z0, th, ps = pose(t)
     keep = np.ones(t.shape[0], dtype=bool)
@@ -378,7 +435,7 @@ def rps_upu_tool_lci(design, options, x, y, z):
         tc = t.astype(complex)
         tc[:, k] += 1j * step
         jac[:, :, k] = legs(tc).imag / step
-    sv = np.linalg.svd(jac, compute_uv=False)
-    lci = np.where(keep, sv[:, -1] / sv[:, 0], -1.0)
-    out[np.nonzero(ok)[0]] = lci
-    return out.reshape(x.shape)
+    fields = inverse_jacobian_fields(jac)  # jac = dq/dT: J = its inverse
+    fields[~keep] = (-1.0, 0.0, 0.0)
+    out[np.nonzero(ok)[0]] = fields
+    return out.reshape(x.shape + (3,))

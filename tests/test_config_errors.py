@@ -48,6 +48,14 @@ def _delete(path):
     return mutate
 
 
+def _both(*mutations):
+    def mutate(data):
+        for m in mutations:
+            m(data)
+
+    return mutate
+
+
 # (label, mutation of configs/quick.yaml, text the one-line message must contain)
 CASES = [
     ("unknown top-level key", _set(["colour"], "red"), "colour: unknown key"),
@@ -64,7 +72,18 @@ CASES = [
     ("unknown option", _set(["options", "speed"], 1.0), "options.speed: unknown option"),
     ("bad option value", _set(["options", "mode"], "+*"), "options.mode:"),
     ("unknown mechanism", _set(["mechanism"], "hexapod-9000"), "mechanism: unknown mechanism 'hexapod-9000'"),
-    ("unknown objective", _set(["objectives", 0, "metric"], "speed"), "objectives.0.metric:"),
+    ("unknown objective", _set(["objectives", 0, "metric"], "speed"),
+     "objectives[0].metric: unknown metric 'speed' for 2pauu-ppap (valid: volume, gci, "),
+    ("band out of range", _set(["objectives", 0], {"metric": "band_share", "band": 3}),
+     "objectives[0].band: 3 out of range (valid: 0..2)"),
+    ("task metric without a task", _set(["constraints"], [{"metric": "task_coverage", "min": 1.0}]),
+     "constraints[0].metric: task_coverage needs a task section"),
+    ("path metric without a path",
+     _both(_set(["task"], {"box": {"x": [0, 1], "y": [0, 1], "z": [0, 1]}}),
+           _set(["constraints"], [{"metric": "path_min_lci", "min": 0.1}])),
+     "constraints[0].metric: path_min_lci needs task.path"),
+    ("unbounded metric minimised", _set(["objectives", 0], {"metric": "mean_sigma_max", "sense": "min"}),
+     "objectives[0].sense: mean_sigma_max has no finite worst value"),
     ("unknown objective sense", _set(["objectives", 1, "sense"], "maximise"), "objectives.1.sense:"),
     ("band objective without band", _set(["objectives", 0], {"metric": "band_share"}), "objectives[0].band:"),
     ("unknown algorithm", _set(["algorithm", "name"], "cmaes"), "algorithm.name:"),

@@ -9,7 +9,7 @@ from scalesynth.kernels.conditioning import lci_2x2, lci_3x3
 from scalesynth.mechanisms import get
 
 from conftest import EXACT_VOLUME, SPEC_GCI, TABLE4
-from naive import grid_metrics, grid_nodes, pauu_lci
+from naive import grid_metrics, grid_nodes, pauu_fields, pauu_lci
 
 M = get("2pauu-ppap")
 EDGES = (0.0, 0.1, 0.3, 1.0)
@@ -42,6 +42,15 @@ def test_kernel_matches_numpy_twin(group, options):
     lci = kgrid.sample_grid(M.point_kernel, M.pack(design, opts), g.lo, g.step, g.shape)
     assert np.array_equal(lci >= 0, lci_twin >= 0)  # same reachable voxels
     np.testing.assert_allclose(lci[lci >= 0], lci_twin[lci_twin >= 0], rtol=1e-7, atol=1e-10)
+    # sigma_min, sigma_max of J = dx/dq against NumPy's SVD of the same Jacobian
+    fields = kgrid.sample_fields(M.field_kernel, M.n_fields, M.pack(design, opts), g.lo, g.step, g.shape)
+    twin = pauu_fields(design, opts, *grid_nodes(g.lo, g.step, g.shape))
+    assert M.field_names[:3] == ("lci", "sigma_min", "sigma_max")
+    np.testing.assert_array_equal(fields[..., 0], lci)
+    reach = lci >= 0
+    assert reach.sum() > 100
+    np.testing.assert_allclose(fields[reach][:, 1:], twin[reach][:, 1:], rtol=1e-7)
+    assert (fields[~reach][:, 1:] == 0).all()
     rep = evaluate(M, design, opts, resolution=24, band_edges=EDGES)
     assert rep.metrics["voxels"] == ref["count"]
     assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
@@ -121,7 +130,7 @@ def test_closed_form_conditioning_matches_svd():
     [{}, {"mode": "+-"}, {"mode": "--", "z_min": 0.3}, {"theta1_limits": [-1.5, 0.2], "theta2_limits": [-1.5, 0.2]},
      {"theta1_limits": [-1.5, 0.2]}, {"stroke_limits": [-0.3, 0.9]}, {"stroke_limits": [-0.5, 0.5]}],
 )
-@pytest.mark.parametrize("resolution", [17, 24])
+@pytest.mark.parametrize("resolution", [17, 24])  # odd and even: a middle cell on the mirror planes or not
 def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     """The column-interval/symmetry kernel counts exactly the generic kernel's voxels, with the same sums."""
     from scalesynth.mechanisms.pauu_ppap import population_stats_fast
@@ -138,9 +147,14 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     lo = np.stack([g.lo for g in grids])
     step = np.stack([g.step for g in grids])
     edges = np.array(EDGES)
-    generic = kgrid.population_stats(M.point_kernel, packed, lo, step, grids[0].shape, edges)
+    generic = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
     fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    assert fast.shape == generic.shape == (16, kgrid.stat_columns(3, 3))
+    assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
     assert np.array_equal(generic[:, kgrid.COL_COUNT], fast[:, kgrid.COL_COUNT])
+    bands = [kgrid.band_column(3, b) for b in range(3)]
+    assert np.array_equal(generic[:, bands], fast[:, bands])
+    # every field's sums (summed in another order: the fast path weights mirrored cells) and extremes
     np.testing.assert_allclose(fast, generic, rtol=1e-10, atol=1e-12)
 
 

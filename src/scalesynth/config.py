@@ -16,20 +16,6 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from scalesynth.errors import ConfigError, ScalesynthError
 
-METRICS = (
-    "volume",
-    "gci",
-    "fci",
-    "min_lci",
-    "max_lci",
-    "band_share",
-    "band_volume",
-    "task_coverage",
-    "task_gci",
-    "task_fci",
-    "task_min_lci",
-    "path_min_lci",
-)
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
 
@@ -101,16 +87,23 @@ class TaskConfig(_Strict):
 
 
 class ObjectiveConfig(_Strict):
-    metric: Literal[METRICS]  # type: ignore[valid-type]
+    metric: str = Field(..., description="a metric of the catalogue (`scalesynth metrics MECH`)")
     sense: Literal["max", "min"] = "max"
-    band: int | None = Field(None, ge=0, description="band index for band_share / band_volume")
+    band: int | None = Field(None, description="band index for band_share / band_volume")
 
 
 class ConstraintConfig(_Strict):
-    metric: Literal[METRICS]  # type: ignore[valid-type]
+    metric: str = Field(..., description="a metric of the catalogue (`scalesynth metrics MECH`)")
     min: float | None = None
     max: float | None = None
-    band: int | None = Field(None, ge=0)
+    band: int | None = None
+
+    @field_validator("min", "max")
+    @classmethod
+    def _finite(cls, v):
+        if v is not None and not math.isfinite(v):
+            raise ValueError(f"must be finite, got {v}")
+        return v
 
     @model_validator(mode="after")
     def _one_side(self):
@@ -198,19 +191,7 @@ class RunConfig(_Strict):
                 raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} (known: {', '.join(params)})")
             if params[key].positive and lo <= 0:
                 raise ValueError(f"bounds.{key}: lower bound must be > 0 for a length, got {lo}")
-        n_bands = len(self.dexterity.band_edges) - 1
-        for where, items in (("objectives", self.objectives), ("constraints", self.constraints)):
-            for i, item in enumerate(items):
-                if item.metric.startswith("band_"):
-                    if item.band is None:
-                        raise ValueError(f"{where}[{i}].band: required for metric {item.metric}")
-                    if item.band >= n_bands:
-                        raise ValueError(f"{where}[{i}].band: {item.band} out of range (0..{n_bands - 1})")
-            for i, item in enumerate(items):
-                if item.metric.startswith(("task_", "path_")) and self.task is None:
-                    raise ValueError(f"{where}[{i}].metric: {item.metric} needs a task section")
-                if item.metric.startswith("path_") and (self.task is None or self.task.path is None):
-                    raise ValueError(f"{where}[{i}].metric: {item.metric} needs task.path")
+        self._check_metrics(mech)
         axes = ", ".join(mech.task_axes)
         for axis in self.grid.region or {}:
             if axis not in mech.task_axes:
@@ -227,6 +208,26 @@ class RunConfig(_Strict):
         if len(self.objectives) < 1:
             raise ValueError("objectives: need at least one")
         return self
+
+    def _check_metrics(self, mech) -> None:
+        """Every objective and constraint names a catalogue metric this config can evaluate."""
+        from scalesynth.metrics import resolve
+
+        n_bands = len(self.dexterity.band_edges) - 1
+        has_task = self.task is not None
+        has_path = has_task and self.task.path is not None
+        options = mech.resolve_options(self.options)
+        for where, items in (("objectives", self.objectives), ("constraints", self.constraints)):
+            for i, item in enumerate(items):
+                try:
+                    m = resolve(mech, self.units.length, item.metric, item.band, n_bands, has_task, has_path, options)
+                except ValueError as err:
+                    raise ValueError(f"{where}[{i}].{err}") from None
+                if where == "objectives" and item.sense == "min" and m.worst is None:
+                    raise ValueError(
+                        f"{where}[{i}].sense: {item.metric} has no finite worst value for the hypervolume reference, "
+                        "so it cannot be minimised (maximise it, or bound it with a constraint)"
+                    )
 
     # convenient views
     @property

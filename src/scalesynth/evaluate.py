@@ -1,7 +1,8 @@
-"""Workspace and dexterity of designs on voxel grids: evaluate(mechanism, design, ...) -> WorkspaceReport.
+"""Workspace, task and design metrics of designs: evaluate(mechanism, design, ...) -> WorkspaceReport.
 
-Plain functions over the Numba kernels in ``kernels.grid``. Degenerate designs are data: an empty workspace
-gives measure 0 and GCI/FCI/min/max LCI 0, never NaN.
+Plain functions over the Numba kernels in ``kernels.grid``; which metrics exist and how each is named comes from
+the catalogue (``scalesynth.metrics``). Degenerate designs are data: an empty workspace gives measure 0 and every
+field statistic 0, never NaN.
 """
 
 from __future__ import annotations
@@ -13,8 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from scalesynth import metrics as _metrics
 from scalesynth.kernels import grid as _grid
 from scalesynth.mechanisms.base import Mechanism
+from scalesynth.metrics import sample_path  # noqa: F401 - re-exported (path sampling lives with the catalogue)
 
 DEFAULT_BAND_EDGES = (0.0, 0.1, 0.3, 1.0)
 
@@ -62,44 +65,104 @@ def make_grid(
     return Grid(lo=lo, step=step, shape=shape, ndim=ndim)
 
 
-def metric_names(mech: Mechanism, length_unit: str, band_edges: Sequence[float]) -> list[str]:
-    """Column names of the metrics, in a fixed order (units in the names)."""
-    mkey = mech.measure_key(length_unit)
-    names = [mkey, "gci", "fci", "min_lci", "max_lci", "voxels"]
-    for b in range(len(band_edges) - 1):
-        names.append(f"band{b}_share")
-    for b in range(len(band_edges) - 1):
-        names.append(f"band{b}_{mkey}")
-    return names
+def task_grid(mech: Mechanism, task: Any, resolution: int) -> Grid:
+    """The cell-centred grid over a config's task box (``task.resolution`` cells per axis, else ``resolution``)."""
+    ndim = len(mech.task_axes)
+    lo = np.zeros(3)
+    hi = np.zeros(3)
+    shape = np.ones(3, dtype=np.int64)
+    res = task.resolution or resolution
+    for a, name in enumerate(mech.task_axes):  # config validation guarantees every axis is in the box
+        lo[a], hi[a] = task.box[name]
+        shape[a] = res
+    step = np.ones(3)
+    step[:ndim] = (hi[:ndim] - lo[:ndim]) / shape[:ndim]
+    return Grid(lo=lo, step=step, shape=shape, ndim=ndim)
 
 
-def stats_to_metrics(stats: np.ndarray, cell_measure: np.ndarray, names: list[str]) -> dict[str, np.ndarray]:
-    """Turn raw kernel sums (n, N_FIXED + bands) into metric arrays; empty workspaces give 0, never NaN."""
+def stats_to_metrics(
+    mech: Mechanism,
+    stats: np.ndarray,
+    cell_measure: np.ndarray,
+    total_cells: float,
+    entries: Sequence[_metrics.Metric],
+    n_bands: int,
+) -> dict[str, np.ndarray]:
+    """Metric arrays of the catalogue ``entries`` (one family) from statistics rows (n, stat_columns); an empty
+    region gives 0 for every statistic, never NaN."""
     count = stats[:, _grid.COL_COUNT]
-    safe = np.where(count > 0, count, 1.0)
-    gci = np.where(count > 0, stats[:, _grid.COL_SUM] / safe, 0.0)
-    var = np.where(count > 0, stats[:, _grid.COL_SUMSQ] / safe - gci * gci, 0.0)
-    fci = np.sqrt(np.maximum(var, 0.0))
-    bands = stats[:, _grid.N_FIXED :]
-    nb = bands.shape[1]
-    out = {
-        names[0]: count * cell_measure,
-        "gci": gci,
-        "fci": fci,
-        "min_lci": np.where(count > 0, stats[:, _grid.COL_MIN], 0.0),
-        "max_lci": np.where(count > 0, stats[:, _grid.COL_MAX], 0.0),
-        "voxels": count.astype(np.int64),
-    }
-    for b in range(nb):
-        out[names[6 + b]] = np.where(count > 0, bands[:, b] / safe, 0.0)
-    for b in range(nb):
-        out[names[6 + nb + b]] = bands[:, b] * cell_measure
+    has = count > 0
+    safe = np.where(has, count, 1.0)
+    slots = {name: i for i, name in enumerate(mech.field_names)}
+    nf = mech.n_fields
+    out: dict[str, np.ndarray] = {}
+    for m in entries:
+        st = m.statistic
+        if st == "measure":
+            out[m.column] = count * cell_measure
+        elif st == "count":
+            out[m.column] = count.astype(np.int64)
+        elif st == "coverage":
+            out[m.column] = count / total_cells
+        elif st in ("band_share", "band_measure"):
+            for b in range(n_bands):
+                band = stats[:, _grid.band_column(nf, b)]
+                out[m.column_for(b)] = np.where(has, band / safe, 0.0) if st == "band_share" else band * cell_measure
+        else:
+            f = slots[m.field]
+            mean = np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUM)] / safe, 0.0)
+            if st == "mean":
+                out[m.column] = mean
+            elif st == "std":
+                var = np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUMSQ)] / safe - mean * mean, 0.0)
+                out[m.column] = np.sqrt(np.maximum(var, 0.0))
+            else:
+                col = _grid.field_column(f, _grid.STAT_MIN if st == "min" else _grid.STAT_MAX)
+                out[m.column] = np.where(has, stats[:, col], 0.0)
+    return out
+
+
+def _metrics_of(
+    mech: Mechanism,
+    resolved: list[dict[str, float]],
+    options: dict[str, Any],
+    packed: np.ndarray,
+    workspace_stats: np.ndarray,
+    cell: np.ndarray,
+    resolution: int,
+    band_edges: Sequence[float],
+    unit: str,
+    task: Any,
+) -> dict[str, np.ndarray]:
+    """Every catalogue metric of the designs: workspace statistics given, task statistics and the computed
+    families (design, path) evaluated here."""
+    has_path = task is not None and task.path is not None
+    entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options)
+    n_bands = len(band_edges) - 1
+    out = stats_to_metrics(mech, workspace_stats, cell, 0.0, [m for m in entries if m.family == "workspace"],
+                           n_bands)
+    n = packed.shape[0]
+    if task is not None:
+        tg = task_grid(mech, task, resolution)
+        edges = np.asarray(band_edges, dtype=float)
+        tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
+        out.update(stats_to_metrics(mech, tstats, np.full(n, tg.cell_measure), float(tg.n_cells),
+                                    [m for m in entries if m.family == "task" and m.compute is None], n_bands))
+    ctx = _metrics.EvalContext(mech, resolved, options, packed, task, resolution, band_edges, unit)
+    for m in entries:
+        if m.compute is not None:
+            out[m.column] = np.asarray(m.compute(ctx), dtype=float)
     return out
 
 
 @dataclass
 class WorkspaceReport:
-    """Metrics of one design. ``measure_key`` is e.g. 'volume_m3'; band k covers (edges[k], edges[k+1]]."""
+    """Metrics of one design. ``measure_key`` is e.g. 'volume_m3'; band k covers (edges[k], edges[k+1]].
+
+    With ``evaluate(..., keep_grid=True)``, ``field_grid`` holds every per-voxel field on ``grid``:
+    shape (nx, ny, nz, n_fields) in the order of ``field_names``; ``field("sigma_max")`` is one of them and
+    ``lci_grid`` the LCI (-1 where unreachable; other fields are 0 there).
+    """
 
     mechanism: str
     design: dict[str, float]
@@ -109,7 +172,8 @@ class WorkspaceReport:
     resolution: int
     grid_cells: int
     seconds: float
-    lci_grid: np.ndarray | None = field(default=None, repr=False)
+    field_names: tuple[str, ...] = ()
+    field_grid: np.ndarray | None = field(default=None, repr=False)
     grid: Grid | None = field(default=None, repr=False)
 
     @property
@@ -119,6 +183,18 @@ class WorkspaceReport:
     @property
     def gci(self) -> float:
         return self.metrics["gci"]
+
+    @property
+    def lci_grid(self) -> np.ndarray | None:
+        return None if self.field_grid is None else self.field_grid[..., 0]
+
+    def field(self, name: str) -> np.ndarray:
+        """Per-voxel values of field ``name`` (needs keep_grid=True), shape (nx, ny, nz)."""
+        if self.field_grid is None:
+            raise ValueError("field: evaluate with keep_grid=True to keep the per-voxel fields")
+        if name not in self.field_names:
+            raise KeyError(f"field: {name!r} is not a field of {self.mechanism} ({', '.join(self.field_names)})")
+        return self.field_grid[..., self.field_names.index(name)]
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"mechanism": self.mechanism, "design": self.design}
@@ -142,7 +218,8 @@ def evaluate(
     keep_grid: bool = False,
     task: Any = None,
 ) -> WorkspaceReport:
-    """Evaluate one design on a ``resolution``-per-axis grid. ``seconds`` excludes JIT compilation."""
+    """Evaluate one design on a ``resolution``-per-axis grid. ``seconds`` (the workspace grid alone) excludes JIT
+    compilation. ``keep_grid``: keep every per-voxel field (WorkspaceReport.field_grid)."""
     design = mech.resolve_design(design)
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
@@ -153,21 +230,23 @@ def evaluate(
     t0 = time.perf_counter()
     stats = mech.grid_stats(packed, g.lo[None, :], g.step[None, :], g.shape, edges)
     seconds = time.perf_counter() - t0
-    names = metric_names(mech, unit, band_edges)
-    metrics = {k: v[0].item() for k, v in stats_to_metrics(stats, np.array([g.cell_measure]), names).items()}
-    if task is not None:
-        metrics.update({k: v[0].item() for k, v in task_metrics(mech, packed, task, resolution, band_edges).items()})
-    lci = _grid.sample_grid(mech.point_kernel, packed[0], g.lo, g.step, g.shape) if keep_grid else None
+    values = _metrics_of(mech, [design], options, packed, stats, np.array([g.cell_measure]), resolution, band_edges,
+                         unit, task)
+    metrics = {k: v[0].item() for k, v in values.items()}
+    fields = None
+    if keep_grid:
+        fields = _grid.sample_fields(mech.field_kernel, mech.n_fields, packed[0], g.lo, g.step, g.shape)
     return WorkspaceReport(
         mechanism=mech.name,
         design=dict(design),
-        measure_key=names[0],
+        measure_key=mech.measure_key(unit),
         metrics=metrics,
         band_edges=[float(e) for e in band_edges],
         resolution=resolution,
         grid_cells=g.n_cells,
         seconds=seconds,
-        lci_grid=lci,
+        field_names=mech.field_names,
+        field_grid=fields,
         grid=g if keep_grid else None,
     )
 
@@ -186,63 +265,6 @@ def warm_up(mech: Mechanism, packed: np.ndarray, edges: np.ndarray) -> None:
     _WARM.add(key)
 
 
-def sample_path(points: Sequence[Sequence[float]], samples: int) -> np.ndarray:
-    """``samples`` points evenly spaced by arc length along a polyline (ends included), padded to 3 columns."""
-    pts = np.asarray(points, dtype=float)
-    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    if s[-1] == 0.0:
-        out = np.repeat(pts[:1], samples, axis=0)
-    else:
-        t = np.linspace(0.0, s[-1], samples)
-        out = np.stack([np.interp(t, s, pts[:, a]) for a in range(pts.shape[1])], axis=1)
-    return np.pad(out, ((0, 0), (0, 3 - out.shape[1])))
-
-
-def task_metrics(
-    mech: Mechanism,
-    packed: np.ndarray,
-    task: Any,
-    resolution: int,
-    band_edges: Sequence[float],
-) -> dict[str, np.ndarray]:
-    """Coverage of the task box (share of its cells reachable within all limits), GCI/FCI/min LCI over the
-    reachable part of the box, and the LCI along the task path (0 where the path leaves the workspace)."""
-    n = packed.shape[0]
-    box = task.box
-    ndim = len(mech.task_axes)
-    lo = np.zeros(3)
-    hi = np.zeros(3)
-    shape = np.ones(3, dtype=np.int64)
-    res = task.resolution or resolution
-    for a, name in enumerate(mech.task_axes):  # config validation guarantees every axis is in the box
-        lo[a], hi[a] = box[name]
-        shape[a] = res
-    step = np.ones(3)
-    step[:ndim] = (hi[:ndim] - lo[:ndim]) / shape[:ndim]
-    edges = np.asarray(band_edges, dtype=float)
-    stats = mech.grid_stats(packed, np.tile(lo, (n, 1)), np.tile(step, (n, 1)), shape, edges)
-    count = stats[:, _grid.COL_COUNT]
-    total = float(np.prod(shape))
-    safe = np.where(count > 0, count, 1.0)
-    gci = np.where(count > 0, stats[:, _grid.COL_SUM] / safe, 0.0)
-    var = np.where(count > 0, stats[:, _grid.COL_SUMSQ] / safe - gci * gci, 0.0)
-    out = {
-        "task_coverage": count / total,
-        "task_gci": gci,
-        "task_fci": np.sqrt(np.maximum(var, 0.0)),
-        "task_min_lci": np.where(count > 0, stats[:, _grid.COL_MIN], 0.0),
-    }
-    if task.path is not None:
-        pts = sample_path(task.path, task.path_samples)
-        lci = _grid.population_points_lci(mech.point_kernel, packed, pts)
-        reach = lci >= 0
-        out["path_reachable"] = reach.mean(axis=1)
-        out["path_min_lci"] = np.where(reach.all(axis=1), lci.min(axis=1), 0.0)
-        out["path_mean_lci"] = np.where(reach, lci, 0.0).mean(axis=1)
-    return out
-
-
 def evaluate_population(
     mech: Mechanism,
     designs: Sequence[Mapping[str, float]],
@@ -254,15 +276,17 @@ def evaluate_population(
     length_unit: str | None = None,
     task: Any = None,
 ) -> dict[str, np.ndarray]:
-    """Metrics of many designs in one parallel kernel call (no Python work per voxel); with ``task`` (a
-    config TaskConfig) also the task-box and path metrics."""
+    """Every catalogue metric of many designs, column name -> (n,) array; the workspace grids in one parallel
+    kernel call (no Python work per voxel); with ``task`` (a config TaskConfig) also the task-box and path
+    metrics."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
     n = len(resolved)
-    names = metric_names(mech, unit, band_edges)
     if n == 0:
-        return {k: np.zeros(0) for k in names}
+        has_path = task is not None and task.path is not None
+        cols = _metrics.result_columns(mech, unit, len(band_edges) - 1, task is not None, has_path, options)
+        return {k: np.zeros(0) for k in cols}
     packed = np.stack([mech.pack(d, options) for d in resolved])
     grids = [make_grid(mech, d, options, resolution, region) for d in resolved]
     lo = np.stack([g.lo for g in grids])
@@ -270,10 +294,7 @@ def evaluate_population(
     edges = np.asarray(band_edges, dtype=float)
     stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
     cell = np.array([g.cell_measure for g in grids])
-    out = stats_to_metrics(stats, cell, names)
-    if task is not None:
-        out.update(task_metrics(mech, packed, task, resolution, band_edges))
-    return out
+    return _metrics_of(mech, resolved, options, packed, stats, cell, resolution, band_edges, unit, task)
 
 
 def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid: bool = False) -> WorkspaceReport:
@@ -292,7 +313,7 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
 
 
 def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> dict[str, np.ndarray]:
-    """All metrics of many designs under one config, in one parallel kernel call per metric family."""
+    """All metrics of many designs under one config, in one parallel kernel call per grid."""
     return evaluate_population(
         cfg.mech,
         designs,

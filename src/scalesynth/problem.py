@@ -7,27 +7,31 @@ all of them without re-evaluating.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from pymoo.core.problem import Problem
 
+from scalesynth import metrics as _metrics
 from scalesynth.config import ConstraintConfig, ObjectiveConfig, RunConfig
-from scalesynth.evaluate import evaluate_config_population, metric_names
+from scalesynth.evaluate import evaluate_config_population
 
-# Worst possible value of each metric for a minimised objective (hypervolume reference); maximised metrics are
-# all >= 0, so their worst value is 0.
-_WORST_IF_MIN = {"fci": 0.5, "task_fci": 0.5}
+
+def metric_entry(cfg: RunConfig, item: ObjectiveConfig | ConstraintConfig) -> _metrics.Metric:
+    """Catalogue entry of an objective's or constraint's metric (the config was validated against it)."""
+    return _metrics.catalogue(cfg.mech, cfg.units.length)[item.metric]
 
 
 def metric_key(cfg: RunConfig, item: ObjectiveConfig | ConstraintConfig) -> str:
     """Column name of an objective's or constraint's metric, e.g. 'volume_m3', 'band2_share'."""
-    mkey = cfg.mech.measure_key(cfg.units.length)
-    if item.metric == "volume":
-        return mkey
-    if item.metric == "band_share":
-        return f"band{item.band}_share"
-    if item.metric == "band_volume":
-        return f"band{item.band}_{mkey}"
-    return item.metric
+    return metric_entry(cfg, item).column_for(item.band)
+
+
+def result_columns(cfg: RunConfig) -> list[str]:
+    """Every metric column of the config's results (catalogue order)."""
+    has_task = cfg.task is not None
+    return _metrics.result_columns(cfg.mech, cfg.units.length, len(cfg.dexterity.band_edges) - 1, has_task,
+                                   has_task and cfg.task.path is not None, cfg.resolved_options())
 
 
 def objective_label(cfg: RunConfig, obj: ObjectiveConfig) -> str:
@@ -49,12 +53,7 @@ class SynthesisProblem(Problem):
         self.objective_keys = [metric_key(cfg, o) for o in cfg.objectives]
         self.signs = np.array([-1.0 if o.sense == "max" else 1.0 for o in cfg.objectives])
         self.constraint_keys = [metric_key(cfg, c) for c in cfg.constraints]
-        names = metric_names(cfg.mech, cfg.units.length, cfg.dexterity.band_edges)
-        if cfg.task is not None:
-            names += ["task_coverage", "task_gci", "task_fci", "task_min_lci"]
-            if cfg.task.path is not None:
-                names += ["path_reachable", "path_min_lci", "path_mean_lci"]
-        self.metric_columns = names
+        self.metric_columns = result_columns(cfg)
         n_constr = sum((c.min is not None) + (c.max is not None) for c in cfg.constraints)
         xl = np.array([cfg.bounds[k][0] for k in self.var_names], dtype=float)
         xu = np.array([cfg.bounds[k][1] for k in self.var_names], dtype=float)
@@ -98,22 +97,38 @@ class SynthesisProblem(Problem):
     def hv_reference(self) -> np.ndarray:
         """Fixed hypervolume reference point in the minimisation form of F (written to the manifest).
 
-        Maximised metrics are >= 0, so 0 is their worst value; minimised ones use their largest possible value
-        (1 for LCI-type shares and indices, 0.5 for FCI, the bounding-box measure of the largest design for
-        volumes)."""
+        A maximised metric's worst value is the lower end of its catalogue range (0 for all of them, entering
+        negated); a minimised one uses the catalogue's worst value: a number (1 for LCI-type shares and indices,
+        0.5 for FCI), the bounding-box measure of the largest design (volumes), or the largest value over the
+        corners of the bounds (design-level metrics)."""
         ref = []
-        for obj, key in zip(self.cfg.objectives, self.objective_keys, strict=True):
+        for obj in self.cfg.objectives:
+            m = metric_entry(self.cfg, obj)
             if obj.sense == "max":
-                ref.append(0.0)
-            elif obj.metric in ("volume", "band_volume"):
+                ref.append(-float(m.range[0]) if m.range[0] != 0 else 0.0)
+            elif m.worst == _metrics.WORST_BOUNDING_BOX:
                 upper = dict(self.base_design)
                 upper.update({k: self.cfg.bounds[k][1] for k in self.var_names})
                 lo, hi = self.cfg.mech.bounding_box(upper, self.cfg.resolved_options())
                 n = len(self.cfg.mech.task_axes)
                 ref.append(float(np.prod((hi - lo)[:n])))
+            elif m.worst == _metrics.WORST_BOUNDS_CORNERS:
+                ref.append(float(max(m.compute(self._corner_context()))))
             else:
-                ref.append(_WORST_IF_MIN.get(key, 1.0))
+                ref.append(float(m.worst))
         return np.array(ref, dtype=float)
+
+    def _corner_context(self) -> _metrics.EvalContext:
+        """The designs at every corner of the optimisation bounds, for design-level worst values."""
+        corners = []
+        for combo in itertools.product(*[self.cfg.bounds[k] for k in self.var_names]):
+            d = dict(self.base_design)
+            d.update({k: float(v) for k, v in zip(self.var_names, combo, strict=True)})
+            corners.append(d)
+        options = self.cfg.resolved_options()
+        packed = np.stack([self.cfg.mech.pack(d, options) for d in corners])
+        return _metrics.EvalContext(self.cfg.mech, corners, options, packed, self.cfg.task, self.cfg.grid.resolution,
+                                    self.cfg.dexterity.band_edges, self.cfg.units.length)
 
     def canonical(self, X: np.ndarray) -> np.ndarray:
         """Design vectors mapped to the mechanism's canonical parameters (identical models -> identical rows)."""

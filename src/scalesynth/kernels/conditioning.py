@@ -1,7 +1,11 @@
-"""Closed-form local conditioning index LCI = 1/kappa_2 = sigma_min / sigma_max for small matrices.
+"""Closed-form extreme singular values of small matrices, and LCI = 1/kappa_2 = sigma_min / sigma_max.
 
 Written without SVD so that the point kernels stay cheap and branch-free; each function has a NumPy twin in
-``tests/naive.py`` (``np.linalg.cond``) and the tests compare them.
+``tests/naive.py`` / ``np.linalg.svd`` and the tests compare them.
+
+``sv_3x3`` / ``sv_2x2`` return ``(lci, s_min, s_max)`` of the matrix. Point kernels whose conditioning matrix A
+is the inverse Jacobian dq/dx report the singular values of J = dx/dq as ``inverse_singular_values``: 1/s_max(A)
+and 1/s_min(A), the latter capped at ``SIGMA_CAP`` where A is singular (J unbounded).
 """
 
 import math
@@ -12,8 +16,8 @@ from scalesynth.kernels.flags import FASTMATH
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
-    """sigma_min/sigma_max of the 3x3 matrix with rows (a11, a12, a13), (a21, ...), (a31, ...).
+def sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
+    """(sigma_min/sigma_max, sigma_min, sigma_max) of the 3x3 matrix with rows (a11, a12, a13), (a21, ...), (a31, ...).
 
     With G = A A^T (eigenvalues l1 >= l2 >= l3 = squared singular values): lmax from the trigonometric cubic
     solution (well conditioned for the largest root); then the two smaller ones from
@@ -41,7 +45,7 @@ def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
     det = a11 * x23 + a12 * y23 + a13 * z23
     tr = g11 + g22 + g33
     if not tr > 0.0:
-        return 0.0
+        return 0.0, 0.0, 0.0
     q = tr / 3.0
     p1 = g12 * g12 + g13 * g13 + g23 * g23
     b11 = g11 - q
@@ -49,7 +53,8 @@ def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
     b33 = g33 - q
     p2 = b11 * b11 + b22 * b22 + b33 * b33 + 2.0 * p1
     if p2 <= 1e-300 * q * q:
-        return 1.0  # G = q I: all singular values equal
+        sq = math.sqrt(q)
+        return 1.0, sq, sq  # G = q I: all singular values equal
     p = math.sqrt(p2 / 6.0)
     inv_p = 1.0 / p
     b11 *= inv_p
@@ -67,35 +72,61 @@ def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
         phi = math.acos(r) / 3.0
     lmax = q + 2.0 * p * math.cos(phi)
     if not lmax > 0.0:
-        return 0.0
+        return 0.0, 0.0, 0.0
+    smax = math.sqrt(lmax)
     prod = det * det / lmax  # l2 * l3
     s = (c2 - prod) / lmax  # l2 + l3
     if s <= 0.0 or prod <= 0.0:
-        return 0.0
+        return 0.0, 0.0, smax
     disc = s * s - 4.0 * prod
     if disc < 0.0:
         disc = 0.0
     lmid = 0.5 * (s + math.sqrt(disc))
     ratio = prod / lmid / lmax
     if ratio >= 1.0:
-        return 1.0
-    return math.sqrt(ratio)
+        return 1.0, smax, smax
+    return math.sqrt(ratio), math.sqrt(prod / lmid), smax
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def lci_2x2(a, b, c, d):
-    """sigma_min/sigma_max of [[a, b], [c, d]] in closed form."""
+def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
+    """sigma_min/sigma_max of the 3x3 matrix with rows (a11, a12, a13), (a21, ...), (a31, ...) (see sv_3x3)."""
+    return sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33)[0]
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def sv_2x2(a, b, c, d):
+    """(sigma_min/sigma_max, sigma_min, sigma_max) of [[a, b], [c, d]] in closed form."""
     f = a * a + b * b + c * c + d * d
     det = a * d - b * c
     if not f > 0.0:
-        return 0.0
+        return 0.0, 0.0, 0.0
     # sigma_max^2 + sigma_min^2 = f, sigma_max * sigma_min = |det|
     disc = f * f - 4.0 * det * det
     if disc < 0.0:
         disc = 0.0
     smax2 = 0.5 * (f + math.sqrt(disc))
     smin2 = det * det / smax2
+    smax = math.sqrt(smax2)
     ratio = smin2 / smax2
     if ratio >= 1.0:
-        return 1.0
-    return math.sqrt(ratio)
+        return 1.0, smax, smax
+    return math.sqrt(ratio), math.sqrt(smin2), smax
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def lci_2x2(a, b, c, d):
+    """sigma_min/sigma_max of [[a, b], [c, d]] in closed form (see sv_2x2)."""
+    return sv_2x2(a, b, c, d)[0]
+
+
+# Stands for an unbounded singular value (J = dx/dq at a singularity of dq/dx), so that every statistic stays finite.
+SIGMA_CAP = 1e12
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def inverse_singular_values(smin_a, smax_a):
+    """(sigma_min, sigma_max) of J = A^-1 from A's extreme singular values: 1/smax_a and 1/smin_a (capped)."""
+    lo = 1.0 / smax_a if smax_a > 1.0 / SIGMA_CAP else SIGMA_CAP
+    hi = 1.0 / smin_a if smin_a > 1.0 / SIGMA_CAP else SIGMA_CAP
+    return min(lo, SIGMA_CAP), min(hi, SIGMA_CAP)

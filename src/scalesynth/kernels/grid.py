@@ -1,24 +1,86 @@
-"""Generic voxel-grid evaluator, parallel over (design, x-slab) and deterministic.
+"""Generic voxel-grid evaluator over multi-field point kernels, parallel over (design, x-slab) and deterministic.
 
-Each x-slab of each design writes its partial sums into its own row; the rows are then reduced in a fixed
-order, so results do not depend on thread scheduling. Grids are cell-centred: node i of an axis sits at
-``lo + (i + 0.5) * step``.
+Point-kernel contract (every mechanism's ``field_kernel``; Numba ``@njit``)::
+
+    kernel(p, x, y, z, out) -> None
+
+``p`` is the float64 vector of ``Mechanism.pack``; ``out`` a float64 array of the mechanism's ``n_fields`` local
+fields, written in the order of ``Mechanism.fields``. Slot 0 is the LCI in [0, 1], or ``-1.0`` when the pose is
+unreachable under any limit (then the other slots are written 0 and ignored). Slots 1 and 2 are sigma_min and
+sigma_max of the homogenised Jacobian dx/dq; a mechanism may append its own fields. A kernel never writes NaN.
+``write_unreachable`` / ``write_singular`` fill the slots the same way for every mechanism.
+
+Each x-slab of each design accumulates into its own statistics row; the rows are reduced in a fixed order, so
+results do not depend on thread scheduling. Grids are cell-centred: node i of an axis sits at
+``lo + (i + 0.5) * step``. ``accumulate_column`` is THE accumulator: the generic kernel and every mechanism's
+fast path (seed 000) feed it columns of field values, so both produce the same statistics.
+
+Statistics row layout for ``n_fields`` fields and ``n_bands`` dexterity bands (``stat_columns``)::
+
+    [count, (sum, sum_sq, min, max) of field 0, ... of field n_fields-1, band_0, ..., band_{n_bands-1}]
+
+so ``field_column(f, STAT_SUM)`` = 1 + 4 f; bands start at ``band_column(n_fields, 0)`` = 1 + 4 n_fields; the
+band counts (and count) are weighted cell counts, bands classify LCI (field 0).
 
 The functions that take a point kernel as an argument are compiled per mechanism and NOT cached on disk: Numba
 keys such cache entries by the dispatcher object, so they never hit in a new process and a stale entry can break
 later saves. Mechanisms that need a fast start provide their own cached ``grid_stats`` (seed 000 does).
-
-Statistics row layout (``N_FIXED`` leading columns, then one count per dexterity band):
-``[count, sum_lci, sum_lci2, min_lci, max_lci, band_0, ..., band_{k-1}]``.
 """
+
+import math
 
 import numpy as np
 from numba import njit, prange
 
+from scalesynth.kernels.conditioning import SIGMA_CAP
 from scalesynth.kernels.flags import FASTMATH
 
-COL_COUNT, COL_SUM, COL_SUMSQ, COL_MIN, COL_MAX = 0, 1, 2, 3, 4
-N_FIXED = 5
+# field slots every mechanism provides
+FIELD_LCI, FIELD_SIGMA_MIN, FIELD_SIGMA_MAX = 0, 1, 2
+N_BASE_FIELDS = 3
+
+# statistics row: count, then 4 columns per field
+COL_COUNT = 0
+STAT_SUM, STAT_SUMSQ, STAT_MIN, STAT_MAX = 0, 1, 2, 3
+N_STATS = 4
+# LCI's columns (field 0), as in the one-field layout of earlier versions
+COL_SUM, COL_SUMSQ, COL_MIN, COL_MAX = 1, 2, 3, 4
+
+
+@njit(cache=True)
+def field_column(field: int, stat: int) -> int:
+    """Column of statistic ``stat`` (STAT_*) of field ``field`` in a statistics row."""
+    return 1 + N_STATS * field + stat
+
+
+@njit(cache=True)
+def band_column(n_fields: int, band: int) -> int:
+    return 1 + N_STATS * n_fields + band
+
+
+@njit(cache=True)
+def stat_columns(n_fields: int, n_bands: int) -> int:
+    return 1 + N_STATS * n_fields + n_bands
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def write_unreachable(out):
+    """The pose is not reachable: LCI -1, every other field 0."""
+    out[0] = -1.0
+    for f in range(1, out.shape[0]):
+        out[f] = 0.0
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def write_singular(out):
+    """An exact singular pose where the conditioning matrix is not formed (a zero-length leg, a folded chain):
+    LCI 0, sigma_min 0 and sigma_max SIGMA_CAP (unbounded or undetermined), other fields 0. Grids meet such
+    poses only by coincidence (a set of measure zero)."""
+    out[0] = 0.0
+    out[1] = 0.0
+    out[2] = SIGMA_CAP
+    for f in range(3, out.shape[0]):
+        out[f] = 0.0
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -31,77 +93,155 @@ def _band_index(lci, edges):
     return nb - 1
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def init_row(row, n_fields):
+    """Empty statistics row: zero sums and counts, min +inf, max -inf."""
+    row[:] = 0.0
+    for f in range(n_fields):
+        row[1 + 4 * f + 2] = math.inf
+        row[1 + 4 * f + 3] = -math.inf
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def accumulate_column(row, vals, k0, k1, w, edges):
+    """Add cells k0..k1 of a column to a statistics row, each with weight ``w`` (symmetric grids visit a part).
+
+    vals: (n_fields, nz) field values, vals[0, k] < 0 marks an unreachable cell. Per field the cells are summed in
+    k order into locals, then added to the row (the same order for every caller).
+    """
+    nf = vals.shape[0]
+    if k1 < k0:
+        return
+    band0 = 1 + 4 * nf
+    count = 0.0
+    for k in range(k0, k1 + 1):
+        v = vals[0, k]
+        if v >= 0.0:
+            count += w
+            row[band0 + _band_index(v, edges)] += w
+    if count == 0.0:
+        return
+    row[0] += count
+    for f in range(nf):
+        c = 1 + 4 * f
+        s1 = 0.0
+        s2 = 0.0
+        vmin = row[c + 2]
+        vmax = row[c + 3]
+        for k in range(k0, k1 + 1):
+            if vals[0, k] >= 0.0:
+                x = vals[f, k]
+                s1 += w * x
+                s2 += w * x * x
+                vmin = min(vmin, x)
+                vmax = max(vmax, x)
+        row[c] += s1
+        row[c + 1] += s2
+        row[c + 2] = vmin
+        row[c + 3] = vmax
+
+
+@njit(cache=True)
+def reduce_partials(partial, n_designs, nx, n_fields):
+    """Combine the per-slab rows of each design in slab order (deterministic, whatever the thread schedule)."""
+    ncol = partial.shape[1]
+    out = np.zeros((n_designs, ncol))
+    for d in range(n_designs):
+        acc = out[d]
+        init_row(acc, n_fields)
+        for i in range(nx):
+            row = partial[d * nx + i]
+            acc[0] += row[0]
+            for f in range(n_fields):
+                c = 1 + 4 * f
+                acc[c] += row[c]
+                acc[c + 1] += row[c + 1]
+                acc[c + 2] = min(acc[c + 2], row[c + 2])
+                acc[c + 3] = max(acc[c + 3], row[c + 3])
+            for b in range(1 + 4 * n_fields, ncol):
+                acc[b] += row[b]
+    return out
+
+
 @njit(parallel=True, fastmath=FASTMATH)
-def population_stats(point_kernel, params, lo, step, shape, edges):
-    """Workspace statistics for every design on its own grid.
+def population_stats(field_kernel, n_fields, params, lo, step, shape, edges):
+    """Workspace statistics of every field for every design on its own grid.
 
     params: (n_designs, k) packed designs; lo, step: (n_designs, 3); shape: int64[3] (nx, ny, nz);
-    edges: dexterity band edges. Returns (n_designs, N_FIXED + n_bands) float64.
+    edges: dexterity band edges. Returns (n_designs, stat_columns(n_fields, n_bands)) float64.
     """
     n_designs = params.shape[0]
     nx, ny, nz = shape[0], shape[1], shape[2]
     nb = edges.shape[0] - 1
-    ncol = N_FIXED + nb
+    ncol = 1 + 4 * n_fields + nb
     partial = np.zeros((n_designs * nx, ncol))
     for task in prange(n_designs * nx):
         d = task // nx
         i = task - d * nx
         p = params[d]
         x = lo[d, 0] + (i + 0.5) * step[d, 0]
-        count = 0.0
-        s1 = 0.0
-        s2 = 0.0
-        vmin = 2.0
-        vmax = -1.0
         row = partial[task]
+        init_row(row, n_fields)
+        vals = np.empty((n_fields, nz))
+        cell = np.empty(n_fields)
         for j in range(ny):
             y = lo[d, 1] + (j + 0.5) * step[d, 1]
             for k in range(nz):
-                z = lo[d, 2] + (k + 0.5) * step[d, 2]
-                v = point_kernel(p, x, y, z)
-                if v >= 0.0:
-                    count += 1.0
-                    s1 += v
-                    s2 += v * v
-                    if v < vmin:
-                        vmin = v
-                    if v > vmax:
-                        vmax = v
-                    row[N_FIXED + _band_index(v, edges)] += 1.0
-        row[COL_COUNT] = count
-        row[COL_SUM] = s1
-        row[COL_SUMSQ] = s2
-        row[COL_MIN] = vmin
-        row[COL_MAX] = vmax
-    return reduce_partials(partial, n_designs, nx)
+                field_kernel(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
+                for f in range(n_fields):
+                    vals[f, k] = cell[f]
+            accumulate_column(row, vals, 0, nz - 1, 1.0, edges)
+    return reduce_partials(partial, n_designs, nx, n_fields)
 
 
-@njit(cache=True)
-def reduce_partials(partial, n_designs, nx):
-    """Sum the per-slab rows of each design in slab order (deterministic, whatever the thread schedule)."""
-    ncol = partial.shape[1]
-    out = np.zeros((n_designs, ncol))
-    for d in range(n_designs):
-        acc = out[d]
-        acc[COL_MIN] = 2.0
-        acc[COL_MAX] = -1.0
-        for i in range(nx):
-            row = partial[d * nx + i]
-            acc[COL_COUNT] += row[COL_COUNT]
-            acc[COL_SUM] += row[COL_SUM]
-            acc[COL_SUMSQ] += row[COL_SUMSQ]
-            if row[COL_MIN] < acc[COL_MIN]:
-                acc[COL_MIN] = row[COL_MIN]
-            if row[COL_MAX] > acc[COL_MAX]:
-                acc[COL_MAX] = row[COL_MAX]
-            for b in range(N_FIXED, ncol):
-                acc[b] += row[b]
+@njit(parallel=True, fastmath=FASTMATH)
+def sample_fields(field_kernel, n_fields, p, lo, step, shape):
+    """Every field at every node of one design's grid: (nx, ny, nz, n_fields); field 0 (LCI) -1 = unreachable."""
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    out = np.empty((nx, ny, nz, n_fields))
+    for i in prange(nx):
+        x = lo[0] + (i + 0.5) * step[0]
+        cell = np.empty(n_fields)
+        for j in range(ny):
+            y = lo[1] + (j + 0.5) * step[1]
+            for k in range(nz):
+                field_kernel(p, x, y, lo[2] + (k + 0.5) * step[2], cell)
+                out[i, j, k, :] = cell
     return out
 
 
 @njit(parallel=True, fastmath=FASTMATH)
+def population_points_fields(field_kernel, n_fields, params, pts):
+    """Every field of every design at the same points: params (n_designs, k), pts (n, 3) ->
+    (n_designs, n, n_fields); field 0 (LCI) -1 where unreachable."""
+    n_designs = params.shape[0]
+    n = pts.shape[0]
+    out = np.empty((n_designs, n, n_fields))
+    for d in prange(n_designs):
+        p = params[d]
+        cell = np.empty(n_fields)
+        for i in range(n):
+            field_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2], cell)
+            out[d, i, :] = cell
+    return out
+
+
+def lci_kernel(field_kernel, n_fields: int):
+    """A scalar kernel ``f(p, x, y, z) -> LCI or -1`` over a field kernel (for single points and the LCI-only
+    helpers below; the evaluators use the field kernel itself)."""
+
+    @njit(fastmath=FASTMATH)
+    def point_lci(p, x, y, z):
+        out = np.empty(n_fields)
+        field_kernel(p, x, y, z, out)
+        return out[0]
+
+    return point_lci
+
+
+@njit(parallel=True, fastmath=FASTMATH)
 def sample_grid(point_kernel, p, lo, step, shape):
-    """LCI at every node of one design's grid, shape (nx, ny, nz); -1 marks unreachable nodes."""
+    """LCI at every node of one design's grid, shape (nx, ny, nz), from a scalar LCI kernel; -1 = unreachable."""
     nx, ny, nz = shape[0], shape[1], shape[2]
     out = np.empty((nx, ny, nz))
     for i in prange(nx):
@@ -116,22 +256,9 @@ def sample_grid(point_kernel, p, lo, step, shape):
 
 @njit(fastmath=FASTMATH)
 def points_lci(point_kernel, p, pts):
-    """LCI (or -1) at arbitrary points, pts shape (n, 3)."""
+    """LCI (or -1) at arbitrary points, pts shape (n, 3), from a scalar LCI kernel."""
     n = pts.shape[0]
     out = np.empty(n)
     for i in range(n):
         out[i] = point_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2])
-    return out
-
-
-@njit(parallel=True, fastmath=FASTMATH)
-def population_points_lci(point_kernel, params, pts):
-    """LCI (or -1) of every design at the same points: params (n_designs, k), pts (n, 3) -> (n_designs, n)."""
-    n_designs = params.shape[0]
-    n = pts.shape[0]
-    out = np.empty((n_designs, n))
-    for d in prange(n_designs):
-        p = params[d]
-        for i in range(n):
-            out[d, i] = point_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2])
     return out

@@ -1,12 +1,16 @@
 """The Mechanism interface: what every registered mechanism provides.
 
 A mechanism is a small object describing one parallel-mechanism type: its design parameters, its options
-(working mode, joint limits, ...), a Numba *point kernel* used by the voxel evaluator, and plain NumPy
-kinematics (IK with all branches, FK with all assembly modes, Jacobian, singularity type) for the CLI and tests.
+(working mode, joint limits, ...), the local fields its Numba *field kernel* computes per voxel, its design-level
+metrics, and plain NumPy kinematics (IK with all branches, FK with all assembly modes, Jacobian, singularity
+type) for the CLI and tests.
 
-Point-kernel contract (Numba ``@njit``): ``kernel(p, x, y, z) -> float``, where ``p`` is the float64 array
-returned by :meth:`Mechanism.pack`; the result is the LCI (in [0, 1]) of the pose if it is reachable under every
-limit, else ``-1.0``. Planar mechanisms ignore ``z``. The kernel must never return NaN.
+Field-kernel contract (Numba ``@njit``, details in ``scalesynth.kernels.grid``): ``kernel(p, x, y, z, out)``,
+where ``p`` is the float64 array returned by :meth:`Mechanism.pack` and ``out`` has one slot per entry of
+``Mechanism.fields`` (in that order): ``out[0]`` the LCI in [0, 1] of the pose if it is reachable under every
+limit, else ``-1.0``; ``out[1]``, ``out[2]`` sigma_min and sigma_max of the homogenised Jacobian dx/dq; then the
+mechanism's own fields. Planar mechanisms ignore ``z``. The kernel must never write NaN. ``point_kernel`` is the
+derived scalar LCI kernel ``f(p, x, y, z) -> LCI or -1``.
 """
 
 from __future__ import annotations
@@ -43,6 +47,50 @@ class Option:
 
 
 @dataclass(frozen=True)
+class Field:
+    """A local field the field kernel writes per voxel (its slot = its index in ``Mechanism.fields``).
+
+    ``unit`` may contain ``{length}`` (the config's length unit); '1' = dimensionless. ``better`` is the sense an
+    engineer prefers ('max' or 'min'); ``range`` the values it can take. ``needs_options``: options that must be
+    set (not null) for the field to mean something (e.g. a material constant the kernel reads from ``pack``).
+    """
+
+    name: str
+    unit: str
+    description: str
+    better: str = "max"
+    range: tuple[float, float] = (0.0, math.inf)
+    needs_options: tuple[str, ...] = ()
+
+
+def base_fields(sigma_unit: str, jacobian: str) -> tuple[Field, Field, Field]:
+    """The three fields every mechanism provides, in slots 0, 1, 2. ``jacobian`` says which homogenised dx/dq
+    the singular values belong to (its units), for the catalogue's descriptions."""
+    return (
+        Field("lci", "1", "local conditioning index 1/kappa_2 of the Jacobian", "max", (0.0, 1.0)),
+        Field("sigma_min", sigma_unit, f"smallest singular value of {jacobian}: worst-direction velocity "
+              "amplification (force amplification is its inverse)", "max"),
+        Field("sigma_max", sigma_unit, f"largest singular value of {jacobian}: largest output motion per unit "
+              "input (kinematic resolution = sigma_max x actuator resolution)", "min"),
+    )
+
+
+@dataclass(frozen=True)
+class DesignMetric:
+    """A design-level metric computed from the resolved design and options alone (no grid): ``value(design,
+    options) -> float``. ``unit`` as in Field. The hypervolume reference (worst value) of a minimised design metric
+    is its value at the upper corner of the optimisation bounds, so ``value`` must not decrease in any parameter.
+    """
+
+    name: str
+    unit: str
+    description: str
+    value: Any  # Callable[[Mapping[str, float], Mapping[str, Any]], float]
+    better: str = "min"
+    range: tuple[float, float] = (0.0, math.inf)
+
+
+@dataclass(frozen=True)
 class Solution:
     """One IK branch or FK assembly mode: a label (e.g. '+-') and its value vector."""
 
@@ -68,6 +116,16 @@ class Mechanism(ABC):
     parameters: tuple[Parameter, ...]
     options: tuple[Option, ...] = field(default_factory=tuple)
     default_length_unit: str = "m"
+    fields: tuple[Field, ...] = field(default_factory=tuple)  # slots of the field kernel; starts with base_fields
+    design_metrics: tuple[DesignMetric, ...] = field(default_factory=tuple)
+
+    @property
+    def n_fields(self) -> int:
+        return len(self.fields)
+
+    @property
+    def field_names(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self.fields)
 
     # ----- parameters ---------------------------------------------------------------------------
     @property
@@ -127,8 +185,18 @@ class Mechanism(ABC):
 
     @property
     @abstractmethod
+    def field_kernel(self):
+        """The Numba field kernel ``kernel(p, x, y, z, out)`` writing ``n_fields`` slots (module docstring)."""
+
+    @property
     def point_kernel(self):
-        """The Numba point kernel ``kernel(p, x, y, z) -> LCI or -1`` (module docstring)."""
+        """Scalar LCI kernel ``f(p, x, y, z) -> LCI or -1`` derived from the field kernel (single points, plots)."""
+        kernel = _LCI_KERNELS.get(self.name)
+        if kernel is None:
+            from scalesynth.kernels.grid import lci_kernel
+
+            kernel = _LCI_KERNELS[self.name] = lci_kernel(self.field_kernel, self.n_fields)
+        return kernel
 
     @abstractmethod
     def bounding_box(self, design: Mapping[str, float], options: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
@@ -155,11 +223,11 @@ class Mechanism(ABC):
         """'none', 'inverse', 'forward' or 'both'."""
 
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
-        """Workspace statistics of many designs (layout of kernels.grid.population_stats). A mechanism may override
-        this with a faster kernel that must give the same numbers."""
+        """Statistics rows of every field for many designs (layout in kernels.grid). A mechanism may override this
+        with a faster kernel that feeds the same accumulator (kernels.grid.accumulate_column)."""
         from scalesynth.kernels import grid as _grid
 
-        return _grid.population_stats(self.point_kernel, packed, lo, step, shape, edges)
+        return _grid.population_stats(self.field_kernel, self.n_fields, packed, lo, step, shape, edges)
 
     def derived_columns(self, design: Mapping[str, float]) -> dict[str, float]:
         """Extra result columns derived from a design (e.g. m_minus_n); none by default."""
@@ -192,6 +260,35 @@ class Mechanism(ABC):
         if arr.shape != (expected,) or not np.all(np.isfinite(arr)):
             raise InvalidPose(f"{what}: expected {expected} finite numbers, got {values!r}")
         return arr
+
+
+_LCI_KERNELS: dict[str, Any] = {}
+
+
+def enclosing_circle_radius(points) -> float:
+    """Radius of the smallest circle holding every 2-D point (a few points: the best circle through two or three
+    of them that holds all; exact)."""
+    pts = [np.asarray(p, dtype=float) for p in points]
+    if len(pts) < 2:
+        return 0.0
+    best = math.inf
+    cands = []
+    for i in range(len(pts)):
+        for j in range(i + 1, len(pts)):
+            cands.append((0.5 * (pts[i] + pts[j]), 0.5 * float(np.hypot(*(pts[i] - pts[j])))))
+            for k in range(j + 1, len(pts)):
+                a, b, c = pts[i], pts[j], pts[k]
+                d = 2.0 * (a[0] * (b[1] - c[1]) + b[0] * (c[1] - a[1]) + c[0] * (a[1] - b[1]))
+                if d == 0.0:
+                    continue
+                sa, sb, sc = a @ a, b @ b, c @ c
+                centre = np.array([sa * (b[1] - c[1]) + sb * (c[1] - a[1]) + sc * (a[1] - b[1]),
+                                   sa * (c[0] - b[0]) + sb * (a[0] - c[0]) + sc * (b[0] - a[0])]) / d
+                cands.append((centre, float(np.hypot(*(a - centre)))))
+    for centre, radius in cands:
+        if radius < best and all(np.hypot(*(p - centre)) <= radius * (1 + 1e-12) + 1e-300 for p in pts):
+            best = radius
+    return best
 
 
 def wrap_angle(a):

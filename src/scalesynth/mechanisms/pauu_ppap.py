@@ -17,13 +17,15 @@ from numba import njit, prange
 
 from scalesynth.errors import InvalidParameter
 from scalesynth.kernels import grid as _grid
-from scalesynth.kernels.conditioning import lci_3x3
+from scalesynth.kernels.conditioning import SIGMA_CAP, inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
+    DesignMetric,
     Mechanism,
     Option,
     Parameter,
     Solution,
+    base_fields,
     parse_range,
     singularity_label,
     svd_lci,
@@ -36,6 +38,7 @@ MODES = ("++", "+-", "-+", "--")
 _DELTA, _L1, _L2, _E, _S1, _S2 = 0, 1, 2, 3, 4, 5
 _T1LO, _T1HI, _T2LO, _T2HI, _DLO, _DHI, _ZMIN, _HAS_THETA = 6, 7, 8, 9, 10, 11, 12, 13
 N_PACKED = 14
+N_FIELDS = 3  # lci, sigma_min, sigma_max (MECHANISM.fields)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -64,39 +67,48 @@ def _angle_in(c, s, lo, hi):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def point_lci(p, x, y, z):
-    """LCI (1/kappa_2 of J) at P = (x, y, z) in the packed working mode, or -1 if unreachable."""
+def point_fields(p, x, y, z, out):
+    """Fields at P = (x, y, z) in the packed working mode (kernels.grid contract): LCI (1/kappa_2 of J), sigma_min
+    and sigma_max of J = dx/dq; LCI -1 if unreachable."""
     if z < p[_ZMIN] or y < p[_DLO] or y > p[_DHI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     delta = p[_DELTA]
     l1 = p[_L1]
     l2 = p[_L2]
     b = z - p[_E]
     yy = y * y
     if yy >= l2 * l2:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     a1 = x - delta
     a2 = -x - delta
     ok1, c1, s1, q1 = _chain(a1, b, yy, l1, l2, p[_S1])
     if not ok1:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     ok2, c2, s2, q2 = _chain(a2, b, yy, l1, l2, p[_S2])
     if not ok2:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if p[_HAS_THETA] > 0.0:
         if not _angle_in(c1, s1, p[_T1LO], p[_T1HI]) or not _angle_in(c2, s2, p[_T2LO], p[_T2HI]):
-            return -1.0
+            _grid.write_unreachable(out)
+            return
     # w_i = D_i - C_i; chain 2 mirrored in x
     w1x = a1 - l1 * c1
     w1z = b + l1 * s1
     w2x = -(a2 - l1 * c2)
     w2z = b + l1 * s2
     if q1 == 0.0 or q2 == 0.0:
-        return 0.0  # inverse (type-1) singularity
-    # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J)
+        _grid.write_singular(out)  # inverse (type-1) singularity
+        return
+    # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J), sigma(J) = 1 / sigma(M)
     iq1 = 1.0 / q1
     iq2 = 1.0 / q2
-    return lci_3x3(w1x * iq1, y * iq1, w1z * iq1, w2x * iq2, y * iq2, w2z * iq2, 0.0, 1.0, 0.0)
+    lci, smin, smax = sv_3x3(w1x * iq1, y * iq1, w1z * iq1, w2x * iq2, y * iq2, w2z * iq2, 0.0, 1.0, 0.0)
+    out[0] = lci
+    out[1], out[2] = inverse_singular_values(smin, smax)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -125,7 +137,7 @@ def _mirror_plan(lo, step, n):
 
 @njit(cache=True, fastmath=FASTMATH)
 def _column_pass1(x, y, k0, k1, lo_z, step_z, p, flag, targ, tq, tp, tc2, td2):
-    """Cells k0..k1 of column (x, y), no theta limits: everything of point_lci up to the trigonometric step of
+    """Cells k0..k1 of column (x, y), no theta limits: everything of point_fields up to the trigonometric step of
     lci_3x3, written branch-free into scratch arrays so that the compiler can vectorise the loop.
 
     flag: 1 reachable, 2 reachable but inverse-singular (LCI 0), 0 unreachable; targ: argument of acos; tq, tp: the
@@ -212,8 +224,10 @@ def _column_pass2(k0, k1, targ):
         targ[k] = math.cos(math.acos(targ[k]) / 3.0)
 
 @njit(cache=True, fastmath=FASTMATH)
-def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, out):
-    """LCI from the largest eigenvalue and the sum/product of the other two (as in lci_3x3); -1 if unreachable."""
+def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, vals):
+    """Fields of cells k0..k1 into vals (N_FIELDS, nz), as point_fields: LCI from the largest eigenvalue and the
+    sum/product of the other two (as in sv_3x3), sigma_min = 1/sqrt(lmax) and sigma_max = sqrt(lmid/prod) of
+    J = M^-1; LCI -1 if unreachable."""
     for k in range(k0, k1 + 1):
         lmax = tq[k] + 2.0 * tp[k] * targ[k]
         lmax = max(lmax, 1e-300)
@@ -222,34 +236,40 @@ def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, out):
         disc = max(s * s - 4.0 * prod, 0.0)
         lmid = max(0.5 * (s + math.sqrt(disc)), 1e-300)
         ratio = min(max(prod / lmid / lmax, 0.0), 1.0)
-        v = math.sqrt(ratio)
-        v = v if (s > 0.0) & (prod > 0.0) else 0.0
+        regular = (s > 0.0) & (prod > 0.0)
+        v = math.sqrt(ratio) if regular else 0.0
+        smin = math.sqrt(prod / lmid) if regular else 0.0
+        sig_lo, sig_hi = inverse_singular_values(smin, math.sqrt(lmax))
         f = flag[k]
-        out[k] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
+        vals[0, k] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
+        vals[1, k] = sig_lo if f == 1.0 else 0.0
+        vals[2, k] = sig_hi if f == 1.0 else (SIGMA_CAP if f == 2.0 else 0.0)
+
 
 @njit(cache=True, parallel=True, fastmath=FASTMATH)
 def population_stats_fast(params, lo, step, shape, edges):
-    """Same statistics as kernels.grid.population_stats(point_lci, ...), computed faster.
+    """Same statistics as kernels.grid.population_stats(point_fields, N_FIELDS, ...), computed faster and fed to the
+    same accumulator (kernels.grid.accumulate_column).
 
     Three savings: (1) for each (x, y) column the reachable z are the intersection of the two chains' annuli
     (spec §1.9), so only the cells of (at most two) z-intervals are visited, widened by one cell and then tested
     cell by cell, so the counted cells are the pointwise ones; (2) LCI is even in y, and in x for the
     mirror-symmetric modes (++, --) with equal theta limits, so a symmetric grid is visited over a half or a
     quarter and weighted; (3) without theta limits the cells of a column go through branch-free passes that the
-    compiler vectorises, with acos/cos alone in a scalar loop (designs with theta limits use point_lci per cell).
+    compiler vectorises, with acos/cos alone in a scalar loop (designs with theta limits use point_fields per cell).
+    Every field is invariant under both mirror symmetries (they permute rows and flip signs of columns of J).
     """
     n_designs = params.shape[0]
     nx, ny, nz = shape[0], shape[1], shape[2]
     nb = edges.shape[0] - 1
-    ncol = _grid.N_FIXED + nb
+    ncol = _grid.stat_columns(N_FIELDS, nb)
     partial = np.zeros((n_designs * nx, ncol))
     for task in prange(n_designs * nx):
         d = task // nx
         i = task - d * nx
         p = params[d]
         row = partial[task]
-        row[_grid.COL_MIN] = 2.0
-        row[_grid.COL_MAX] = -1.0
+        _grid.init_row(row, N_FIELDS)
         x_sym = p[_S1] == p[_S2] and p[_T1LO] == p[_T2LO] and p[_T1HI] == p[_T2HI]
         i0, wx, _ = _mirror_plan(lo[d, 0], step[d, 0], nx)
         if not x_sym:
@@ -269,7 +289,8 @@ def population_stats_fast(params, lo, step, shape, edges):
         tp = np.empty(nz)
         tc2 = np.empty(nz)
         td2 = np.empty(nz)
-        out = np.empty(nz)
+        vals = np.empty((N_FIELDS, nz))
+        cell = np.empty(N_FIELDS)
         x = lo[d, 0] + (i + 0.5) * step[d, 0]
         l1 = p[_L1]
         l2 = p[_L2]
@@ -280,11 +301,6 @@ def population_stats_fast(params, lo, step, shape, edges):
         a2s = a2 * a2
         amax = a1s if a1s > a2s else a2s
         amin = a1s if a1s < a2s else a2s
-        count = 0.0
-        s1 = 0.0
-        s2 = 0.0
-        vmin = 2.0
-        vmax = -1.0
         for j in range(j0, ny):
             w = wx * (1.0 if j == j_mid else wy_half)
             y = lo[d, 1] + (j + 0.5) * step[d, 1]
@@ -316,28 +332,40 @@ def population_stats_fast(params, lo, step, shape, edges):
                     continue
                 if scalar:
                     for k in range(k0, k1 + 1):
-                        out[k] = point_lci(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2])
+                        point_fields(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
+                        for fi in range(N_FIELDS):
+                            vals[fi, k] = cell[fi]
                 else:
                     _column_pass1(x, y, k0, k1, lo[d, 2], step[d, 2], p, flag, targ, tq, tp, tc2, td2)
                     _column_pass2(k0, k1, targ)
-                    _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, out)
-                for k in range(k0, k1 + 1):
-                    v = out[k]
-                    if v >= 0.0:
-                        count += w
-                        s1 += w * v
-                        s2 += w * v * v
-                        if v < vmin:
-                            vmin = v
-                        if v > vmax:
-                            vmax = v
-                        row[_grid.N_FIXED + _grid._band_index(v, edges)] += w
-        row[_grid.COL_COUNT] = count
-        row[_grid.COL_SUM] = s1
-        row[_grid.COL_SUMSQ] = s2
-        row[_grid.COL_MIN] = vmin
-        row[_grid.COL_MAX] = vmax
-    return _grid.reduce_partials(partial, n_designs, nx)
+                    _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, vals)
+                _grid.accumulate_column(row, vals, k0, k1, w, edges)
+    return _grid.reduce_partials(partial, n_designs, nx, N_FIELDS)
+
+
+def _stroke_d(design: Mapping[str, float], options: Mapping[str, Any]) -> float:
+    """Stroke the prismatic input d = y needs: the reachable |y| < l2 within the stroke limits."""
+    lo, hi = -design["l2"], design["l2"]
+    limits = options.get("stroke_limits")
+    if limits is not None:
+        lo, hi = max(lo, limits[0]), min(hi, limits[1])
+    return max(hi - lo, 0.0)
+
+
+DESIGN_METRICS = (
+    DesignMetric(
+        "link_length_sum", "{length}",
+        "moving links of the two PaUU chains: 2 (2 l1 + c + l2), each chain's two parallelogram bars l1, its moving "
+        "short bar c and the link l2 (the PPaP chain is not dimensioned in the paper)",
+        lambda d, o: 2.0 * (2.0 * d["l1"] + d["c"] + d["l2"]),
+    ),
+    DesignMetric(
+        "footprint_radius", "{length}",
+        "radius of the smallest base-plane circle holding the base joints: m (the PaUU pivots at x = +-m)",
+        lambda d, o: d["m"],
+    ),
+    DesignMetric("stroke_d", "{length}", "stroke of the input d = y: 2 l2, clipped by stroke_limits", _stroke_d),
+)
 
 
 class PauuPpap(Mechanism):
@@ -380,8 +408,8 @@ class PauuPpap(Mechanism):
         return p
 
     @property
-    def point_kernel(self):
-        return point_lci
+    def field_kernel(self):
+        return point_fields
 
     def kernel_branch(self, options) -> str:
         return options["mode"]
@@ -608,4 +636,7 @@ MECHANISM = PauuPpap(
         Option("z_min", None, "keep only z >= z_min, null = none"),
     ),
     default_length_unit="m",
+    fields=base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is dimensionless; "
+                       "not rescaled, as in the LCI)"),
+    design_metrics=DESIGN_METRICS,
 )

@@ -30,13 +30,16 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
-from scalesynth.kernels.conditioning import lci_2x2
+from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.conditioning import SIGMA_CAP, sv_2x2
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
+    DesignMetric,
     Mechanism,
     Option,
     Parameter,
     Solution,
+    base_fields,
     parse_range,
     singularity_label,
     svd_lci,
@@ -94,8 +97,9 @@ def _arc_ok(p, k, c, s):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def point_lci(p, x, y, z):
-    """LCI (sigma_min/sigma_max of J) at P = (x, y) in the packed working mode, or -1 if unreachable; z unused."""
+def point_fields(p, x, y, z, out):
+    """Fields at P = (x, y) in the packed working mode (kernels.grid contract): LCI (sigma_min/sigma_max of J),
+    sigma_min and sigma_max of J = dx/dq (mm/rad); LCI -1 if unreachable; z unused."""
     r = p[_R]
     l1 = p[_L1]
     l2 = p[_L2]
@@ -103,12 +107,15 @@ def point_lci(p, x, y, z):
     u2 = x + r
     ok1, c1, s1, g1 = _arm(u1, y, l1, l2, p[_S1])
     if not ok1:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     ok2, c2, s2, g2 = _arm(u2, y, l1, l2, p[_S2])
     if not ok2:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1
@@ -117,7 +124,31 @@ def point_lci(p, x, y, z):
     # J = Jx^-1 Jq = adj(Jx) Jq / det(Jx) with Jx rows w_i / l2 and Jq = diag(-sigma_i g_i) / (2 l2) (spec §2.4).
     # LCI ignores the common scale and the column signs, so adj(Jx) diag(g1, g2) suffices; it stays finite at a
     # forward singularity (det Jx = 0), where its rank drops to 1 and the LCI is 0, the limit of J's.
-    return lci_2x2(w2y * g1, -w1y * g2, -w2x * g1, w1x * g2)
+    # With W the matrix of rows w_i, J = adj(W) diag(-sigma_i g_i) / (2 det W): sigma(J) = sigma(B) / (2 |det W|).
+    lci, smin, smax = sv_2x2(w2y * g1, -w1y * g2, -w2x * g1, w1x * g2)
+    out[0] = lci
+    det2 = 2.0 * abs(w1x * w2y - w1y * w2x)
+    if not det2 * SIGMA_CAP > smax:  # forward singularity: J unbounded
+        out[1] = 0.0
+        out[2] = SIGMA_CAP
+        return
+    out[1] = smin / det2
+    out[2] = smax / det2
+
+
+DESIGN_METRICS = (
+    DesignMetric(
+        "link_length_sum", "{length}",
+        "arms and forearms of both chains: 2 (l1 + l2) (the parallelograms' second bars only keep the platform's "
+        "orientation and are not counted)",
+        lambda d, o: 2.0 * (d["l1"] + d["l2"]),
+    ),
+    DesignMetric(
+        "footprint_radius", "{length}",
+        "radius of the smallest circle in the base plane holding the active pivots B1, B2 = (+-r, 0): r",
+        lambda d, o: d["r"],
+    ),
+)
 
 
 class PlanarFivebar(Mechanism):
@@ -145,8 +176,8 @@ class PlanarFivebar(Mechanism):
         return p
 
     @property
-    def point_kernel(self):
-        return point_lci
+    def field_kernel(self):
+        return point_fields
 
     def kernel_branch(self, options) -> str:
         return options["mode"]
@@ -339,4 +370,6 @@ MECHANISM = PlanarFivebar(
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
     ),
     default_length_unit="mm",
+    fields=base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"),
+    design_metrics=DESIGN_METRICS,
 )

@@ -32,12 +32,16 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
+    DesignMetric,
     Mechanism,
     Option,
     Parameter,
     Solution,
+    base_fields,
     parse_range,
     singularity_label,
     wrap_angle,
@@ -62,8 +66,9 @@ N_PACKED = 27
 
 # ----- Numba kernels -----------------------------------------------------------------------------------------
 @njit(cache=True, fastmath=FASTMATH)
-def _lci_6x6(a):
-    """sigma_min / sigma_max of the 6x6 matrix ``a`` (overwritten), by one-sided (Hestenes) Jacobi.
+def _sv_6x6(a):
+    """(sigma_min / sigma_max, sigma_min, sigma_max) of the 6x6 matrix ``a`` (overwritten), by one-sided
+    (Hestenes) Jacobi.
 
     Plane rotations orthogonalise the columns; the singular values are then the column norms. Working on A
     itself, not on A^T A, keeps small singular values accurate relative to the large ones.
@@ -106,8 +111,14 @@ def _lci_6x6(a):
         smax = max(smax, norm)
         smin = min(smin, norm)
     if not smax > 0.0:
-        return 0.0
-    return min(smin / smax, 1.0)
+        return 0.0, 0.0, 0.0
+    return min(smin / smax, 1.0), smin, smax
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _lci_6x6(a):
+    """sigma_min / sigma_max of the 6x6 matrix ``a`` (overwritten); see _sv_6x6."""
+    return _sv_6x6(a)[0]
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -123,9 +134,11 @@ def _put_row(a, row, scale, gx, gy, gz, rx, ry, rz, inv_alen):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def point_lci(p, x, y, z):
+def point_fields(p, x, y, z, out):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
-    IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity."""
+    IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
+    Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq, x = (O1, angle_length x angular
+    velocity), the beta input times beta_length (dimensionless)."""
     c1x = x + p[_R1]
     c1y = y + p[_R1 + 1]
     c1z = z + p[_R1 + 2]
@@ -144,30 +157,36 @@ def point_lci(p, x, y, z):
     # rails: u1 = (1, 0, 0), u2 = (-1/2, sqrt3/2, 0)
     w1 = rail - c1x if conv_r else c1x
     if w1 < wlo or w1 > whi:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     p2 = -0.5 * c2x + SQRT3_2 * c2y
     w2 = rail - p2 if conv_r else p2
     if w2 < wlo or w2 > whi:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     # chains 1, 2: lambda_i = e_i . C_i with e1 = (0, 1, 0), e2 = (-sqrt3/2, -1/2, 0)
     l1 = p[_L1]
     lam1 = c1y
     k1sq = l1 * l1 - lam1 * lam1
     if k1sq < 0.0:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     k1 = math.sqrt(k1sq)
     s1 = c1z - p[_SG1] * k1
     if s1 < slo or s1 > shi:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     l2 = p[_L2]
     lam2 = -SQRT3_2 * c2x - 0.5 * c2y
     k2sq = l2 * l2 - lam2 * lam2
     if k2sq < 0.0:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     k2 = math.sqrt(k2sq)
     s2 = c2z - p[_SG2] * k2
     if s2 < slo or s2 > shi:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     # chain 3 in its plane: rho3 = R - u3.C3, h3 = z_C3, beta = atan2(h3, rho3), s3 = mu3 - sigma3 kappa3
     u3x = p[_U3X]
     u3y = p[_U3Y]
@@ -177,22 +196,28 @@ def point_lci(p, x, y, z):
     h3 = c3z
     mu3sq = rho3 * rho3 + h3 * h3
     if not mu3sq > 0.0:
-        return -1.0  # C3 on the revolute axis at B3: beta undefined, cannot be checked against its limits
+        # C3 on the revolute axis at B3: beta undefined, cannot be checked against its limits
+        _grid.write_unreachable(out)
+        return
     beta = math.atan2(h3, rho3)
     if beta < p[_BLO] or beta > p[_BHI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     mu3 = math.sqrt(mu3sq)
     l3 = p[_L3]
     lam3 = e3x * c3x + e3y * c3y
     k3sq = l3 * l3 - lam3 * lam3
     if k3sq < 0.0:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     k3 = math.sqrt(k3sq)
     s3 = mu3 - p[_SG3] * k3
     if s3 < slo or s3 > shi:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
-        return 0.0  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
+        _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
+        return
     # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
     inv_alen = 1.0 / p[_ALEN]
     a = np.empty((6, 6))
@@ -214,7 +239,9 @@ def point_lci(p, x, y, z):
     gx = -rho3 * u3x * inv_mu + t3 * e3x
     gy = -rho3 * u3y * inv_mu + t3 * e3y
     _put_row(a, 5, 1.0, gx, gy, h3 * inv_mu, r3x, r3y, r3z, inv_alen)
-    return _lci_6x6(a)
+    lci, smin, smax = _sv_6x6(a)
+    out[0] = lci
+    out[1], out[2] = inverse_singular_values(smin, smax)
 
 
 # ----- NumPy kinematics ----------------------------------------------------------------------------------
@@ -513,8 +540,8 @@ class PprsRprs(Mechanism):
         return p
 
     @property
-    def point_kernel(self):
-        return point_lci
+    def field_kernel(self):
+        return point_fields
 
     def kernel_branch(self, options) -> str:
         return options["sigma"]
@@ -775,7 +802,7 @@ def drive_curves(
         if not st.ok[k]:
             raise InvalidPose(f"{where} is out of reach")
         raise InvalidPose(f"{where} puts {', '.join(mech.limit_violations(options, q[k]))} outside the limits")
-    lci = points_lci(point_lci, mech.pack(design, options), path)
+    lci = points_lci(mech.point_kernel, mech.pack(design, options), path)
     # continuation: FK of each sample's q by Newton from the previous sample's pose
     fk, conv = newton_fk(geo, sigma, q[1:], poses[:-1])
     err = np.max(np.abs(fk - poses[1:]) * np.array([1, 1, 1, geo.r, geo.r, geo.r]), axis=1)
@@ -818,4 +845,19 @@ MECHANISM = PprsRprs(
         Option("angle_length", None, "mm dividing the angular-velocity columns of J_t for the LCI; null = r"),
     ),
     default_length_unit="mm",
+    fields=base_fields("1", "J = dx/dq, the twist of O1 with its angular part times angle_length and the beta input "
+                       "times beta_length (mm/mm)"),
+    design_metrics=(
+        DesignMetric(
+            "link_length_sum", "{length}",
+            "moving links of fixed length: the links L1 + L2 + L3 and the moving triangle's edges 3 sqrt(3) r",
+            lambda d, o: d["L1"] + d["L2"] + d["L3"] + 3.0 * math.sqrt(3.0) * d["r"],
+        ),
+        DesignMetric(
+            "footprint_radius", "{length}",
+            "radius of the smallest circle in the base plane holding the rails and chain 3's revolute, all within R "
+            "of O: R",
+            lambda d, o: d["R"],
+        ),
+    ),
 )

@@ -37,13 +37,17 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
-from scalesynth.kernels.conditioning import lci_3x3
+from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
+    DesignMetric,
     Mechanism,
     Option,
     Parameter,
     Solution,
+    base_fields,
+    enclosing_circle_radius,
     parse_range,
     singularity_label,
     svd_lci,
@@ -162,9 +166,10 @@ def _leg_ok(qs, lo, hi):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def point_lci(p, x, y, z):
+def point_fields(p, x, y, z, out):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
-    length leaves the stroke limits or the parametrisation is degenerate (C-model)."""
+    length leaves the stroke limits or the parametrisation is degenerate (C-model). Fields (kernels.grid contract):
+    LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless)."""
     g = p[_G]
     h = p[_H]
     c = p[_C]
@@ -178,7 +183,8 @@ def point_lci(p, x, y, z):
             g, h, c, e, p[_UPU] > 0.0, x, st, ct, sp, cp
         )
         if not ok:
-            return -1.0
+            _grid.write_unreachable(out)
+            return
     else:
         ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _p_model_rows(g, h, c, e, x, st, ct, sp, cp)
     lo = p[_QLO]
@@ -187,19 +193,23 @@ def point_lci(p, x, y, z):
     ok2, q2 = _leg_ok(q2s, lo, hi)
     ok3, q3 = _leg_ok(q3s, lo, hi)
     if not (ok1 and ok2 and ok3):
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0:
-        return 0.0  # inverse singularity: a leg of zero length has no direction
+        _grid.write_singular(out)  # inverse singularity: a leg of zero length has no direction
+        return
     # row i of dq/dx is (q_i dq_i/dx) / q_i; the angle columns are divided by L (homogenisation)
     i1 = 1.0 / q1
     i2 = 1.0 / q2
     i3 = 1.0 / q3
     il = p[_INV_L]
-    return lci_3x3(
+    lci, smin, smax = sv_3x3(
         a11 * i1, a12 * i1 * il, a13 * i1 * il,
         a21 * i2, a22 * i2 * il, a23 * i2 * il,
         a31 * i3, a32 * i3 * il, a33 * i3 * il,
     )  # fmt: skip
+    out[0] = lci
+    out[1], out[2] = inverse_singular_values(smin, smax)
 
 
 # ----- NumPy kinematics (vectorised over poses; CLI, FK and tests) ----------------------------------------
@@ -578,8 +588,8 @@ class RpsUpu(Mechanism):
         return p
 
     @property
-    def point_kernel(self):
-        return point_lci
+    def field_kernel(self):
+        return point_fields
 
     def kernel_branch(self, options) -> str:
         return BRANCH
@@ -754,6 +764,21 @@ class RpsUpu(Mechanism):
         return chains
 
 
+DESIGN_METRICS = (
+    DesignMetric(
+        "link_length_sum", "{length}",
+        "edges of the moving platform triangle B1B2B3: 2 h + 2 sqrt(h^2 + c^2) (the legs are the prismatic inputs, "
+        "their lengths set by the stroke limits, not by the design)",
+        lambda d, o: 2.0 * d["h"] + 2.0 * math.hypot(d["h"], d["c"]),
+    ),
+    DesignMetric(
+        "footprint_radius", "{length}",
+        "radius of the smallest circle in the base plane holding A1 = (0, -g), A2 = (0, g), A3 = (e, 0)",
+        lambda d, o: enclosing_circle_radius([(0.0, -d["g"]), (0.0, d["g"]), (d["e"], 0.0)]),
+    ),
+)
+FIELDS = base_fields("1", "J = dx/dq, x = (z, L theta, L psi) homogenised by the characteristic length L (mm/mm)")
+
 MECHANISM = RpsUpu(
     name="rps-upu",
     title="2-RPS-UPU 2R1T parallel mechanism (seed 002)",
@@ -780,6 +805,8 @@ MECHANISM = RpsUpu(
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
     ),
     default_length_unit="mm",
+    fields=FIELDS,
+    design_metrics=DESIGN_METRICS,
 )
 
 
@@ -790,30 +817,35 @@ N_PACKED_TOOL = N_PACKED + 7
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def tool_point_lci(p, x, y, z):
+def tool_point_fields(p, x, y, z, out):
     """LCI of dq/dT (dimensionless) at tool point T = (x, y, z) mm of the P-model, principal branch
     (cos theta > 0, cos psi > 0), or -1 when T is out of reach of that branch, its pose leaves the z/theta/psi
     ranges or a leg leaves the stroke limits.
 
     Pose from T (spec §2.8): sin psi = T_y/d, sin theta = -T_x/(d cos psi), z0 = T_z + d cos theta cos psi; then
     dq/dT = dq/d(z0, theta, psi) . d(z0, theta, psi)/dT with the closed-form inverse of dT/d(z0, theta, psi).
+    Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dT/dq (dimensionless).
     """
     d = p[_D]
     sp = y / d
     if sp > 1.0 or sp < -1.0:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     cp = math.sqrt(1.0 - sp * sp)
     if cp <= 1e-12:
-        return -1.0  # psi = +-pi/2: theta is undetermined, the branch is not defined
+        _grid.write_unreachable(out)  # psi = +-pi/2: theta is undetermined, the branch is not defined
+        return
     st = -x / (d * cp)
     if st > 1.0 or st < -1.0:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     ct = math.sqrt(1.0 - st * st)
     z0 = z + d * ct * cp
     th = math.asin(st)
     ps = math.asin(sp)
     if not (p[_ZLO] <= z0 <= p[_ZHI] and p[_TLO] <= th <= p[_THI] and p[_PLO] <= ps <= p[_PHI]):
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     _, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _p_model_rows(
         p[_G], p[_H], p[_C], p[_E], z0, st, ct, sp, cp
     )
@@ -823,9 +855,11 @@ def tool_point_lci(p, x, y, z):
     ok2, q2 = _leg_ok(q2s, lo, hi)
     ok3, q3 = _leg_ok(q3s, lo, hi)
     if not (ok1 and ok2 and ok3):
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0 or ct <= 1e-12:
-        return 0.0  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
+        _grid.write_singular(out)  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
+        return
     # d(z0, theta, psi)/dT, rows z0, theta, psi; columns T_x, T_y, T_z
     inv = 1.0 / (d * ct * cp)
     m11 = st / ct
@@ -837,11 +871,13 @@ def tool_point_lci(p, x, y, z):
     i1 = 1.0 / q1
     i2 = 1.0 / q2
     i3 = 1.0 / q3
-    return lci_3x3(
+    lci, smin, smax = sv_3x3(
         (a11 * m11 + a12 * m21) * i1, (a11 * m12 + a12 * m22 + a13 * m32) * i1, a11 * i1,
         (a21 * m11 + a22 * m21) * i2, (a21 * m12 + a22 * m22 + a23 * m32) * i2, a21 * i2,
         (a31 * m11 + a32 * m21) * i3, (a31 * m12 + a32 * m22 + a33 * m32) * i3, a31 * i3,
     )  # fmt: skip
+    out[0] = lci
+    out[1], out[2] = inverse_singular_values(smin, smax)
 
 
 def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -888,8 +924,8 @@ class RpsUpuTool(RpsUpu):
         return p
 
     @property
-    def point_kernel(self):
-        return tool_point_lci
+    def field_kernel(self):
+        return tool_point_fields
 
     def kernel_branch(self, options) -> str:
         return "++"
@@ -1030,4 +1066,6 @@ TOOL_MECHANISM = RpsUpuTool(
         *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
     ),
     default_length_unit="mm",
+    fields=base_fields("1", "J = dT/dq of the tool point (mm/mm)"),
+    design_metrics=DESIGN_METRICS,
 )

@@ -28,13 +28,17 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter
-from scalesynth.kernels.conditioning import lci_3x3
+from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
+    DesignMetric,
     Mechanism,
     Option,
     Parameter,
     Solution,
+    base_fields,
+    enclosing_circle_radius,
     parse_range,
     singularity_label,
     wrap_angle,
@@ -80,23 +84,28 @@ def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def point_lci(p, alpha, beta, yy):
+def point_fields(p, alpha, beta, yy, out):
     """LCI at task point (alpha [rad], beta [rad], Y [mm]) if it lies in the workspace box with every actuator
     length within its limits, else -1. LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the angle columns divided by
-    the characteristic length."""
+    the characteristic length. Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq,
+    x = (L alpha, L beta, Y) (dimensionless)."""
     if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if yy < p[_YLO] or yy > p[_YHI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     c = p[_C]
     rho2 = c * c - yy * yy
     if not rho2 > 0.0:
-        return -1.0  # |Y| >= c: no Z > 0 assembly
+        _grid.write_unreachable(out)  # |Y| >= c: no Z > 0 assembly
+        return
     am = p[_AM]
     # spec §3.3: l1 = |(2/3) P - M| depends on Y only; > 0 whenever |Y| < c
     l1 = math.sqrt(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy)
     if l1 < p[_L1LO] or l1 > p[_L1HI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     rho = math.sqrt(rho2)
     sa = math.sin(alpha)
     ca = math.cos(alpha)
@@ -110,14 +119,19 @@ def point_lci(p, alpha, beta, yy):
     by = p[_BY]
     l2, j2a, j2b, j2y = _ups_row(-ax, ay, -bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l2 < p[_L2LO] or l2 > p[_L2HI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     l3, j3a, j3b, j3y = _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l3 < p[_L3LO] or l3 > p[_L3HI]:
-        return -1.0
+        _grid.write_unreachable(out)
+        return
     if l2 <= 0.0 or l3 <= 0.0:
-        return 0.0  # zero-length leg: inverse singularity
+        _grid.write_singular(out)  # zero-length leg: inverse singularity
+        return
     s = p[_INV_L]
-    return lci_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
+    lci, smin, smax = sv_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
+    out[0] = lci
+    out[1], out[2] = inverse_singular_values(smin, smax)
 
 
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
@@ -210,8 +224,8 @@ class UpsSspr(Mechanism):
         return p
 
     @property
-    def point_kernel(self):
-        return point_lci
+    def field_kernel(self):
+        return point_fields
 
     def kernel_branch(self, options) -> str:
         return IK_LABEL
@@ -467,4 +481,20 @@ MECHANISM = UpsSspr(
         ),
     ),
     default_length_unit="mm",
+    fields=base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+    design_metrics=(
+        DesignMetric(
+            "link_length_sum", "{length}",
+            "fixed-length moving links: the SR link c and the platform legs B1B2, B1B3 (b each): c + 2 b (the "
+            "actuators l1..l3 are prismatic inputs)",
+            lambda d, o: d["c"] + 2.0 * d["b"],
+        ),
+        DesignMetric(
+            "footprint_radius", "{length}",
+            "radius of the smallest circle in the base plane holding A0 = (0, 0), A2, A3 = (-+sqrt(3) a/2, -a/2) "
+            "and M = (0, -a/2), the base joints of the SR link and the three actuators",
+            lambda d, o: enclosing_circle_radius([(0.0, 0.0), (-math.sqrt(3) * d["a"] / 2, -d["a"] / 2),
+                                                  (math.sqrt(3) * d["a"] / 2, -d["a"] / 2), (0.0, -d["a"] / 2)]),
+        ),
+    ),
 )

@@ -1,0 +1,390 @@
+"""The metric catalogue: every metric a config can optimise or constrain and every metric column of the results.
+
+One place lists metric names. Config validation, the problem's columns, the report, the results validator,
+``docs/metrics.md`` and ``scalesynth metrics [MECH] [--json]`` all read :func:`catalogue`.
+
+Families:
+
+* ``workspace``: a statistic of a per-voxel field over the reachable workspace (the grid over the mechanism's
+  bounding box): its measure, count, dexterity bands, and mean / std / min / max of every field the mechanism's
+  field kernel writes (``Mechanism.fields``; LCI's are named gci, fci, min_lci, max_lci);
+* ``task``: the same statistics over the reachable part of the config's task box, plus its coverage;
+* ``path``: along the config's task path;
+* ``design``: from the design parameters alone (``Mechanism.design_metrics``: link_length_sum, footprint_radius,
+  strokes);
+* ``cycle``: reserved for metrics of a motion cycle (none yet).
+
+Per-voxel field statistics are generated from each mechanism's ``fields``: adding a field to a mechanism (its
+field kernel and its ``fields`` entry) adds ``mean_<f>``, ``std_<f>``, ``min_<f>``, ``max_<f>`` and their
+``task_`` twins here without editing this module. Other families are entries with a ``compute(ctx)`` function.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from scalesynth.mechanisms.base import Field, Mechanism
+
+FAMILIES = ("workspace", "task", "path", "design", "cycle")
+STATISTICS = ("mean", "std", "min", "max")
+# worst-value keywords (see Metric.worst)
+WORST_BOUNDING_BOX = "bounding_box"  # measure of the bounding box of the largest design within the bounds
+WORST_BOUNDS_CORNERS = "bounds_corners"  # largest value over the corners of the optimisation bounds
+
+# the LCI statistics keep the names the dexterity literature uses
+_LCI_NAMES = {"mean": "gci", "std": "fci", "min": "min_lci", "max": "max_lci"}
+_STAT_WORDS = {"mean": "mean", "std": "standard deviation", "min": "minimum", "max": "maximum"}
+
+
+@dataclass
+class EvalContext:
+    """What a ``compute`` function of a non-voxel metric gets: n resolved designs under one config."""
+
+    mech: Mechanism
+    designs: list[dict[str, float]]
+    options: dict[str, Any]
+    packed: np.ndarray  # (n, k) Mechanism.pack of every design
+    task: Any  # config TaskConfig or None
+    resolution: int
+    band_edges: Sequence[float]
+    length_unit: str
+    cache: dict[str, Any] = field(default_factory=dict)  # shared between compute functions (e.g. path samples)
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One catalogue entry (per mechanism and length unit).
+
+    ``column``: result column (units in the name; band metrics contain ``{band}``). ``field``/``statistic``: the
+    per-voxel field and the statistic over it (workspace, task, path families). ``range``: values it can take.
+    ``better``: the sense an engineer usually prefers. ``worst``: worst value of a *minimised* objective (the
+    hypervolume reference): a number, WORST_BOUNDING_BOX, WORST_BOUNDS_CORNERS, or None when unbounded (it can
+    then be maximised or constrained, not minimised); a maximised objective's worst value is ``range[0]``.
+    ``needs``: 'task', 'path', 'band' or 'options.<name>'. ``compute(ctx) -> (n,) array`` for metrics that are
+    not statistics of the voxel grids.
+    """
+
+    name: str
+    column: str
+    family: str
+    field: str | None
+    statistic: str | None
+    unit: str
+    range: tuple[float, float]
+    better: str | None
+    worst: float | str | None
+    needs: tuple[str, ...]
+    description: str
+    compute: Callable[[EvalContext], np.ndarray] | None = field(default=None, compare=False, repr=False)
+
+    def columns(self, n_bands: int) -> list[str]:
+        """Every result column of the metric (one per band for band metrics)."""
+        if "band" in self.needs:
+            return [self.column.format(band=b) for b in range(n_bands)]
+        return [self.column]
+
+    def column_for(self, band: int | None = None) -> str:
+        return self.column.format(band=band) if "band" in self.needs else self.column
+
+    def to_dict(self) -> dict[str, Any]:
+        def num(v):
+            return None if v is None else (v if isinstance(v, str) else (None if math.isinf(v) else float(v)))
+
+        return {
+            "name": self.name,
+            "column": self.column,
+            "family": self.family,
+            "field": self.field,
+            "statistic": self.statistic,
+            "unit": self.unit,
+            "range": [num(self.range[0]), num(self.range[1])],  # null = unbounded
+            "better": self.better,
+            "worst": num(self.worst),
+            "needs": list(self.needs),
+            "description": self.description,
+        }
+
+
+def unit_text(unit: str, length_unit: str) -> str:
+    return unit.replace("{length}", length_unit)
+
+
+def unit_slug(unit: str) -> str:
+    """Unit as a column-name suffix: 'mm/rad' -> 'mm_per_rad'; '' for dimensionless ('1')."""
+    if unit in ("1", ""):
+        return ""
+    return unit.replace("/", "_per_").replace("^", "").replace(" ", "_")
+
+
+def _with_unit(base: str, unit: str) -> str:
+    slug = unit_slug(unit)
+    return f"{base}_{slug}" if slug else base
+
+
+def _std_range(f: Field) -> tuple[float, float]:
+    lo, hi = f.range
+    return (0.0, 0.5 * (hi - lo)) if math.isfinite(hi) and math.isfinite(lo) else (0.0, math.inf)
+
+
+def _field_entries(mech: Mechanism, f: Field, length_unit: str, family: str) -> list[Metric]:
+    """mean/std/min/max of one field over the workspace or the task box."""
+    unit = unit_text(f.unit, length_unit)
+    region = "the reachable workspace" if family == "workspace" else "the reachable part of the task box"
+    needs = (("task",) if family == "task" else ()) + tuple(f"options.{o}" for o in f.needs_options)
+    out = []
+    for stat in STATISTICS:
+        if f.name == "lci":
+            name = _LCI_NAMES[stat]
+            column = name
+        else:
+            name = f"{stat}_{f.name}"
+            column = _with_unit(name, unit)
+        if family == "task":
+            name, column = f"task_{name}", f"task_{column}"
+        rng = _std_range(f) if stat == "std" else f.range
+        better = ("min" if stat == "std" else f.better)
+        out.append(Metric(
+            name=name, column=column, family=family, field=f.name, statistic=stat, unit=unit, range=rng,
+            better=better, worst=rng[1] if math.isfinite(rng[1]) else None, needs=needs,
+            description=f"{_STAT_WORDS[stat]} of {f.name} over {region}" + (f" ({unit})" if unit != "1" else ""),
+        ))
+    return out
+
+
+def _design_entry(mech: Mechanism, dm, length_unit: str) -> Metric:
+    unit = unit_text(dm.unit, length_unit)
+    value = dm.value
+
+    def compute(ctx: EvalContext, value=value) -> np.ndarray:
+        return np.array([float(value(d, ctx.options)) for d in ctx.designs], dtype=float)
+
+    return Metric(
+        name=dm.name, column=_with_unit(dm.name, unit), family="design", field=None, statistic=None, unit=unit,
+        range=dm.range, better=dm.better, worst=WORST_BOUNDS_CORNERS, needs=(),
+        description=f"{dm.description} ({unit})", compute=compute,
+    )
+
+
+def sample_path(points: Sequence[Sequence[float]], samples: int) -> np.ndarray:
+    """``samples`` points evenly spaced by arc length along a polyline (ends included), padded to 3 columns."""
+    pts = np.asarray(points, dtype=float)
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    if s[-1] == 0.0:
+        out = np.repeat(pts[:1], samples, axis=0)
+    else:
+        t = np.linspace(0.0, s[-1], samples)
+        out = np.stack([np.interp(t, s, pts[:, a]) for a in range(pts.shape[1])], axis=1)
+    return np.pad(out, ((0, 0), (0, 3 - out.shape[1])))
+
+
+def _path_fields(ctx: EvalContext) -> np.ndarray:
+    """Fields of every design at the path samples, (n, samples, n_fields), computed once per context."""
+    if "path_fields" not in ctx.cache:
+        from scalesynth.kernels import grid as _grid
+
+        pts = sample_path(ctx.task.path, ctx.task.path_samples)
+        ctx.cache["path_fields"] = _grid.population_points_fields(
+            ctx.mech.field_kernel, ctx.mech.n_fields, ctx.packed, pts
+        )
+    return ctx.cache["path_fields"]
+
+
+def _path_reachable(ctx: EvalContext) -> np.ndarray:
+    return (_path_fields(ctx)[:, :, 0] >= 0).mean(axis=1)
+
+
+def _path_min_lci(ctx: EvalContext) -> np.ndarray:
+    lci = _path_fields(ctx)[:, :, 0]
+    reach = lci >= 0
+    return np.where(reach.all(axis=1), lci.min(axis=1), 0.0)
+
+
+def _path_mean_lci(ctx: EvalContext) -> np.ndarray:
+    lci = _path_fields(ctx)[:, :, 0]
+    return np.where(lci >= 0, lci, 0.0).mean(axis=1)
+
+
+_CACHE: dict[tuple[str, str], dict[str, Metric]] = {}
+
+
+def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metric]:
+    """Every metric of ``mech`` with columns in ``length_unit`` (default the mechanism's), in result-column order."""
+    unit = length_unit or mech.default_length_unit
+    key = (mech.name, unit)
+    if key in _CACHE:
+        return _CACHE[key]
+    mkey = mech.measure_key(unit)
+    munit = mech.measure_unit(unit)
+    mname = mech.measure_name()
+    lci = next(f for f in mech.fields if f.name == "lci")
+    entries: list[Metric] = [
+        Metric("volume", mkey, "workspace", None, "measure", munit, (0.0, math.inf), "max", WORST_BOUNDING_BOX, (),
+               f"workspace {mname}: reachable cells x cell {mname} ({munit})"),
+    ]
+    entries += _field_entries(mech, lci, unit, "workspace")
+    entries += [
+        Metric("voxels", "voxels", "workspace", None, "count", "1", (0.0, math.inf), "max", None, (),
+               "number of reachable grid cells"),
+        Metric("band_share", "band{band}_share", "workspace", "lci", "band_share", "1", (0.0, 1.0), "max", 1.0,
+               ("band",), "share of the reachable workspace whose LCI lies in dexterity band k"),
+        Metric("band_volume", f"band{{band}}_{mkey}", "workspace", "lci", "band_measure", munit, (0.0, math.inf),
+               "max", WORST_BOUNDING_BOX, ("band",), f"workspace {mname} whose LCI lies in dexterity band k ({munit})"),
+    ]
+    for f in mech.fields:
+        if f.name != "lci":
+            entries += _field_entries(mech, f, unit, "workspace")
+    entries.append(Metric("task_coverage", "task_coverage", "task", None, "coverage", "1", (0.0, 1.0), "max", 1.0,
+                          ("task",), "share of the task box's cells reachable within all limits"))
+    for f in mech.fields:
+        entries += _field_entries(mech, f, unit, "task")
+    entries += [
+        Metric("path_reachable", "path_reachable", "path", "lci", "reachable", "1", (0.0, 1.0), "max", 1.0,
+               ("task", "path"), "share of the task path's samples inside the workspace", compute=_path_reachable),
+        Metric("path_min_lci", "path_min_lci", "path", "lci", "min", "1", (0.0, 1.0), "max", 1.0, ("task", "path"),
+               "minimum LCI along the task path (0 if the path leaves the workspace)", compute=_path_min_lci),
+        Metric("path_mean_lci", "path_mean_lci", "path", "lci", "mean", "1", (0.0, 1.0), "max", 1.0,
+               ("task", "path"), "mean LCI along the task path, samples outside the workspace counted as 0",
+               compute=_path_mean_lci),
+    ]
+    entries += [_design_entry(mech, dm, unit) for dm in mech.design_metrics]
+    out = {}
+    for m in entries:
+        if m.name in out:
+            raise ValueError(f"metric {m.name!r} defined twice for {mech.name}")
+        out[m.name] = m
+    _CACHE[key] = out
+    return out
+
+
+def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None) -> str | None:
+    """Why ``m`` cannot be evaluated under a config (a phrase), or None if it can."""
+    for need in m.needs:
+        if need == "task" and not has_task:
+            return "needs a task section"
+        if need == "path" and not has_path:
+            return "needs task.path"
+        if need.startswith("options.") and options is not None and options.get(need[8:]) is None:
+            return f"needs {need} (null)"
+    return None
+
+
+def result_metrics(mech: Mechanism, length_unit: str, has_task: bool, has_path: bool,
+                   options: Mapping[str, Any] | None = None) -> list[Metric]:
+    """The metrics evaluated for a config (catalogue order)."""
+    return [m for m in catalogue(mech, length_unit).values() if applicable(m, has_task, has_path, options) is None]
+
+
+def result_columns(mech: Mechanism, length_unit: str, n_bands: int, has_task: bool, has_path: bool,
+                   options: Mapping[str, Any] | None = None) -> list[str]:
+    """Every metric column of a config's results, in a fixed order."""
+    return [c for m in result_metrics(mech, length_unit, has_task, has_path, options) for c in m.columns(n_bands)]
+
+
+def all_field_names() -> set[str]:
+    from scalesynth.mechanisms import available, get
+
+    return {f.name for name in available() for f in get(name).fields}
+
+
+def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_bands: int, has_task: bool,
+            has_path: bool, options: Mapping[str, Any] | None = None) -> Metric:
+    """The catalogue entry of a config's objective/constraint. Raises ValueError with a message that starts with
+    the sub-field it is about ('metric: ...' or 'band: ...') and lists the valid choices."""
+    cat = catalogue(mech, length_unit)
+    if name not in cat:
+        for prefix in ("task_", ""):
+            for stat in STATISTICS:
+                head = f"{prefix}{stat}_"
+                fname = name[len(head):]
+                if name.startswith(head) and fname in all_field_names():
+                    raise ValueError(f"metric: {name}: field {fname!r} is not provided by {mech.name} "
+                                     f"(fields: {', '.join(mech.field_names)})")
+        usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options) is None]
+        raise ValueError(f"metric: unknown metric {name!r} for {mech.name} (valid: {', '.join(usable)})")
+    m = cat[name]
+    why = applicable(m, has_task, has_path, options)
+    if why is not None:
+        raise ValueError(f"metric: {name} {why}")
+    if "band" in m.needs:
+        if band is None:
+            raise ValueError(f"band: required for metric {name} (0..{n_bands - 1})")
+        if not 0 <= band < n_bands:
+            raise ValueError(f"band: {band} out of range (valid: 0..{n_bands - 1})")
+    elif band is not None:
+        raise ValueError(f"band: metric {name} has no bands (only band_share, band_volume)")
+    return m
+
+
+# ----- listings ----------------------------------------------------------------------------------------------
+def listing(mech_name: str | None = None) -> list[dict[str, Any]]:
+    """Catalogue entries as dicts: of one mechanism (its default length unit), or of every mechanism with a
+    ``mechanisms`` list per entry (columns and units then shown for each mechanism's default unit)."""
+    from scalesynth.mechanisms import available, get
+
+    if mech_name is not None:
+        mech = get(mech_name)
+        return [dict(m.to_dict(), mechanisms=[mech.name]) for m in catalogue(mech).values()]
+    merged: dict[str, dict[str, Any]] = {}
+    for name in available():
+        for m in catalogue(get(name)).values():
+            entry = merged.setdefault(m.name, dict(m.to_dict(), mechanisms=[], columns={}, units={}))
+            entry["mechanisms"].append(name)
+            entry["columns"][name] = m.column
+            entry["units"][name] = m.unit
+    return list(merged.values())
+
+
+def to_json(mech_name: str | None = None) -> str:
+    return json.dumps(listing(mech_name), indent=None)
+
+
+def markdown() -> str:
+    """docs/metrics.md (generated: ``python -m scalesynth.metrics > docs/metrics.md``; a test checks it)."""
+    from scalesynth.mechanisms import available, get
+
+    lines = [
+        "# Metrics",
+        "",
+        "<!-- generated from src/scalesynth/metrics.py by `python -m scalesynth.metrics > docs/metrics.md`; "
+        "do not edit -->",
+        "",
+        "Every metric below can be an objective (`objectives: [{metric: NAME, sense: max|min}]`) or a constraint",
+        "(`constraints: [{metric: NAME, min: .., max: ..}]`), and appears in `pareto.csv` / `population.csv` under",
+        "its column name (units in the name; `{band}` is the band index k, chosen with `band: k`). Families:",
+        "`workspace` (statistic of a per-voxel field over the reachable workspace), `task` (over the reachable part",
+        "of `task.box`; needs a task), `path` (along `task.path`), `design` (from the design parameters). A",
+        "minimised objective needs a finite worst value for the hypervolume reference: `bounding_box` is the",
+        "bounding-box measure of the largest design in the bounds, `bounds_corners` the largest value over the",
+        "corners of the bounds; metrics without one can be maximised or constrained.",
+        "",
+        "`scalesynth metrics [MECH] [--json]` prints the same catalogue.",
+        "",
+    ]
+    for name in available():
+        mech = get(name)
+        lines += [f"## `{name}` (lengths in {mech.default_length_unit})", ""]
+        lines.append("Per-voxel fields: " + "; ".join(
+            f"`{f.name}` ({unit_text(f.unit, mech.default_length_unit)}): {f.description}" for f in mech.fields) + ".")
+        lines += ["", "| metric | column | family | unit | range | better | worst if minimised | needs | description |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        for m in catalogue(mech).values():
+            d = m.to_dict()
+            rng = "[" + ", ".join("inf" if v is None else f"{v:g}" for v in d["range"]) + "]"
+            worst = "-" if d["worst"] is None else (d["worst"] if isinstance(d["worst"], str) else f"{d['worst']:g}")
+            lines.append(f"| `{m.name}` | `{m.column}` | {m.family} | {m.unit} | {rng} | {m.better or '-'} | "
+                         f"{worst} | {', '.join(m.needs) or '-'} | {m.description} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.stdout.write(markdown())
