@@ -225,6 +225,23 @@ def test_show_of_a_run_dir_designs_formats_and_errors(small_run, tmp_path):
     assert res.exit_code == 2 and "a config shows its own design" in res.stderr
 
 
+def test_show_colours_by_any_field_of_the_kernel(tmp_path):
+    """--field sigma_min: the field kernel's slot, NaN-free where reachable, with its unit in the colour bar."""
+    from scalesynth.show import colour_range
+
+    cfg = load_config(ROOT / "configs" / "rps_upu.yaml")
+    fg = sample_fields(cfg, cfg.resolved_design(), 12)
+    v = fg.fields["sigma_min"]
+    assert np.isfinite(v[fg.reachable]).all() and np.isnan(v[~fg.reachable]).all()
+    lo, hi = colour_range(fg, "sigma_min")
+    assert lo == pytest.approx(np.percentile(v[fg.reachable], 2)) and hi > lo
+    res = runner.invoke(app, ["show", str(ROOT / "configs" / "rps_upu.yaml"), "--field", "sigma_min",
+                              "--resolution", "12", "--out", str(tmp_path), "--format", "svg"])
+    assert res.exit_code == 0, res.output
+    assert "σ_min" in (tmp_path / "sections.svg").read_text()
+    assert json.loads((tmp_path / "show.json").read_text())["field"] == "sigma_min"
+
+
 def test_plane_sampling_equals_the_full_grid_slice():
     cfg = load_config(ROOT / "configs" / "paper_2pauu_ppap.yaml")
     design = TABLE4[1]

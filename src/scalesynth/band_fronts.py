@@ -71,6 +71,7 @@ def write_band_fronts(run_dir: Path, cfg, problem, population: pd.DataFrame | No
     files, sizes = [], []
     edges = cfg.dexterity.band_edges
     feas = population[population["feasible"].astype(bool)] if "feasible" in population.columns else population
+    label = lab.labeller(cfg)
     for k in range(len(edges) - 1):
         front, cols = band_pareto(problem, population, k)
         name = f"pareto_band{k}"
@@ -80,7 +81,7 @@ def write_band_fronts(run_dir: Path, cfg, problem, population: pd.DataFrame | No
         ycol = cols[1] if len(cols) > 1 else cols[0]
         fig = plotting.band_pareto_figure(
             feas[cols[0]].to_numpy(), feas[ycol].to_numpy(), front[cols[0]].to_numpy(), front[ycol].to_numpy(),
-            lab.metric_label(cols[0]), lab.metric_label(ycol),
+            label(cols[0]), label(ycol),
             f"{cfg.name}: Pareto set of LCI band {k} {_band_label(edges, k)} ({', '.join(cols)})")
         rio.save_figure(fig, bands_dir / f"{name}.{fmt}")
         plotting.close(fig)

@@ -110,7 +110,8 @@ def compare_runs(run_dirs: Sequence[Path], out: Path | None = None, fmt: str = "
     series = [{"label": run_label(r), "x": r["pareto"][xk].to_numpy(), "y": r["pareto"][yk].to_numpy(),
                "selected": [(s, float(r["pareto"][xk].iloc[i]), float(r["pareto"][yk].iloc[i]))
                             for s, i in r["selected"]]} for r in runs]
-    fig = plotting.compare_figure(series, lab.metric_label(xk), lab.metric_label(yk),
+    label = lab.labeller(runs[0]["cfg"])  # shared columns have the same name and unit in every run
+    fig = plotting.compare_figure(series, label(xk), label(yk),
                                   f"{len(runs)} runs on their shared metrics")
     rio.save_figure(fig, target / f"compare.{fmt}")
     plotting.close(fig)

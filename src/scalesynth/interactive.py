@@ -43,25 +43,25 @@ class Figures:
                            config={"displaylogo": False, "responsive": True})
 
 
-def _hover(frame: pd.DataFrame, columns: Sequence[str]) -> tuple[np.ndarray, str]:
+def _hover(frame: pd.DataFrame, columns: Sequence[str], label=lab.metric_label) -> tuple[np.ndarray, str]:
     """customdata and a hovertemplate listing every column with its label."""
     data = frame[list(columns)].to_numpy(dtype=float)
-    lines = [f"{_html.escape(lab.metric_label(c))} ({c}) = %{{customdata[{i}]:.6g}}" for i, c in enumerate(columns)]
+    lines = [f"{_html.escape(label(c))} ({c}) = %{{customdata[{i}]:.6g}}" for i, c in enumerate(columns)]
     return data, "<br>".join(lines) + "<extra></extra>"
 
 
 def front_figure(pareto: pd.DataFrame, population: pd.DataFrame | None, xk: str, yk: str, hover_cols: Sequence[str],
-                 featured: Sequence[tuple[str, int]], title: str):
+                 featured: Sequence[tuple[str, int]], title: str, label=lab.metric_label):
     import plotly.graph_objects as go
 
     fig = go.Figure()
     if population is not None and len(population):
         cols = [c for c in hover_cols if c in population.columns]
-        data, tmpl = _hover(population, cols)
+        data, tmpl = _hover(population, cols, label)
         fig.add_trace(go.Scatter(x=population[xk], y=population[yk], mode="markers", name="final population",
                                  marker={"color": "rgba(0,0,0,0)", "line": {"color": "#8c8c8c", "width": 1}, "size": 6},
                                  customdata=data, hovertemplate=tmpl))
-    data, tmpl = _hover(pareto, hover_cols)
+    data, tmpl = _hover(pareto, hover_cols, label)
     order = np.argsort(pareto[xk].to_numpy())
     fig.add_trace(go.Scatter(x=pareto[xk].to_numpy()[order], y=pareto[yk].to_numpy()[order], mode="lines+markers",
                              name=f"Pareto front ({len(pareto)})", marker={"color": PALETTE[0], "size": 7},
@@ -73,16 +73,16 @@ def front_figure(pareto: pd.DataFrame, population: pd.DataFrame | None, xk: str,
                                  marker={"symbol": "star", "size": 15, "color": "#F0E442",
                                          "line": {"color": "black", "width": 1}},
                                  customdata=data[rows], hovertemplate=tmpl))
-    fig.update_layout(title=title, xaxis_title=lab.metric_label(xk), yaxis_title=lab.metric_label(yk))
+    fig.update_layout(title=title, xaxis_title=label(xk), yaxis_title=label(yk))
     return fig
 
 
-def parallel_figure(pareto: pd.DataFrame, columns: Sequence[str], colour: str, title: str):
+def parallel_figure(pareto: pd.DataFrame, columns: Sequence[str], colour: str, title: str, label=lab.metric_label):
     import plotly.graph_objects as go
 
-    dims = [{"label": lab.metric_label(c), "values": pareto[c].to_numpy(dtype=float)} for c in columns]
+    dims = [{"label": label(c), "values": pareto[c].to_numpy(dtype=float)} for c in columns]
     line = {"color": pareto[colour].to_numpy(dtype=float), "colorscale": "Viridis", "showscale": True,
-            "colorbar": {"title": {"text": lab.metric_label(colour)}}}
+            "colorbar": {"title": {"text": label(colour)}}}
     fig = go.Figure(go.Parcoords(dimensions=dims, line=line))
     fig.update_layout(title=title)
     fig.update_layout(margin={"t": 110})  # room for the dimension labels above the axes
@@ -99,13 +99,14 @@ def hypervolume_figure(history: pd.DataFrame, title: str):
 
 
 def workspace_figure(points: np.ndarray, values: np.ndarray, axis_labels: Sequence[str], field_label: str,
-                     title: str, equal: bool, box: np.ndarray | None = None, path: np.ndarray | None = None):
+                     title: str, equal: bool, box: np.ndarray | None = None, path: np.ndarray | None = None,
+                     vmin: float = 0.0, vmax: float = 1.0):
     """3-D scatter of a workspace's boundary cells coloured by a field (viridis), task box and path on top."""
     import plotly.graph_objects as go
 
     fig = go.Figure(go.Scatter3d(
         x=points[:, 0], y=points[:, 1], z=points[:, 2], mode="markers", name=field_label,
-        marker={"size": 2, "color": values, "colorscale": "Viridis", "cmin": 0, "cmax": 1, "showscale": True,
+        marker={"size": 2, "color": values, "colorscale": "Viridis", "cmin": vmin, "cmax": vmax, "showscale": True,
                 "colorbar": {"title": {"text": field_label}}},
         hovertemplate=f"{axis_labels[0]} %{{x:.4g}}<br>{axis_labels[1]} %{{y:.4g}}<br>{axis_labels[2]} %{{z:.4g}}"
                       f"<br>{field_label} %{{marker.color:.3f}}<extra></extra>"))
@@ -140,7 +141,7 @@ def _box_path(fig, box, path) -> None:
                                    line={"color": PALETTE[5], "width": 5}, marker={"size": 3}))
 
 
-def heatmap_figure(panel: dict, field_label: str, title: str | None = None):
+def heatmap_figure(panel: dict, field_label: str, title: str | None = None, vmin: float = 0.0, vmax: float = 1.0):
     """A section (or a planar workspace) as a heatmap, unreachable cells blank."""
     import plotly.graph_objects as go
 
@@ -150,7 +151,7 @@ def heatmap_figure(panel: dict, field_label: str, title: str | None = None):
     xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
     ys = y0 + (np.arange(ny) + 0.5) * (y1 - y0) / ny
     z = np.where(np.isfinite(values) & (values >= 0), values, np.nan).T
-    fig = go.Figure(go.Heatmap(x=xs, y=ys, z=z.tolist(), colorscale="Viridis", zmin=0, zmax=1,
+    fig = go.Figure(go.Heatmap(x=xs, y=ys, z=z.tolist(), colorscale="Viridis", zmin=vmin, zmax=vmax,
                                colorbar={"title": {"text": field_label}}))
     if panel.get("box") is not None:
         bx0, bx1, by0, by1 = panel["box"]
@@ -165,8 +166,9 @@ def heatmap_figure(panel: dict, field_label: str, title: str | None = None):
     return fig
 
 
-def table(frame: pd.DataFrame, columns: Sequence[str], index_name: str, index: Sequence[str]) -> str:
-    head = "".join(f"<th>{_html.escape(lab.metric_label(c))}</th>" for c in columns)
+def table(frame: pd.DataFrame, columns: Sequence[str], index_name: str, index: Sequence[str],
+          label=lab.metric_label) -> str:
+    head = "".join(f"<th>{_html.escape(label(c))}</th>" for c in columns)
     rows = []
     for name, (_, row) in zip(index, frame.iterrows(), strict=True):
         cells = "".join(f"<td>{row[c]:.5g}</td>" for c in columns)
@@ -174,14 +176,14 @@ def table(frame: pd.DataFrame, columns: Sequence[str], index_name: str, index: S
     return f"<table><tr><th>{_html.escape(index_name)}</th>{head}</tr>{''.join(rows)}</table>"
 
 
-def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path) -> str:
+def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path, field_label: str,
+              vmin: float = 0.0, vmax: float = 1.0) -> str:
     """The HTML of `scalesynth show --format html`: 3-D view, one 3-D view per band (regions coloured), sections."""
     import plotly.graph_objects as go
 
     from scalesynth import workspace_view as wv
 
     figs = Figures()
-    field_label = lab.metric_label(field)
     blocks = [f"<h1>{_html.escape(title)}</h1>"]
     rows = "".join(f"<tr><th>{_html.escape(b['label'])}</th><td>{100 * b['share']:.2f} %</td><td>{b['regions']}</td>"
                    f"<td>{b['regions_face_connected']}</td><td>{b['regions_over_1pct']}</td></tr>" for b in bands)
@@ -190,7 +192,7 @@ def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, pat
     if not cfg.mech.planar:
         pts, flat = wv.boundary_points(fg.reachable, fg.axes(), MAX_POINTS_3D)
         blocks.append(figs.html(workspace_figure(pts, fg.fields[field].ravel()[flat], axis_labels, field_label,
-                                                 "workspace boundary", equal, box, path), 650))
+                                                 "workspace boundary", equal, box, path, vmin, vmax), 650))
         for b in bands:
             bpts, bflat = wv.boundary_points(b["_labels"] > 0, fg.axes(), MAX_POINTS_3D)
             region = b["_labels"].ravel()[bflat] - 1
@@ -203,5 +205,5 @@ def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, pat
                                      "zaxis_title": axis_labels[2], "aspectmode": "data" if equal else "cube"})
             blocks.append(figs.html(fig, 560))
     for panel in panels:
-        blocks.append(figs.html(heatmap_figure(panel, field_label), 480))
+        blocks.append(figs.html(heatmap_figure(panel, field_label, vmin=vmin, vmax=vmax), 480))
     return page(title, blocks)

@@ -1,14 +1,15 @@
-"""Human labels with units for result columns and task axes, e.g. ``volume_m3`` -> ``V [m³]``, ``theta`` -> ``θ [rad]``.
+"""Human labels with units for result columns, fields and task axes: ``volume_m3`` -> ``V [m³]``,
+``mean_sigma_min_mm_per_rad`` -> ``mean σ_min [mm/rad]``, ``theta`` -> ``θ [rad]``.
 
-Interim home: once the metric catalogue (issue 10) exists, ``metric_label`` reads its name and unit; the axis
-labels stay here (they come from the mechanism's task axes and units).
+Names and units come from the metric catalogue (``scalesynth.metrics``) and the mechanism's fields and task axes;
+this module only turns them into text for axes, colour bars and hover labels.
 """
 
 from __future__ import annotations
 
 import re
 
-_GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "theta": "θ", "psi": "ψ", "phi": "φ"}
+_GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "theta": "θ", "psi": "ψ", "phi": "φ", "sigma": "σ"}
 _SUPER = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 _NAMES = {
@@ -32,12 +33,52 @@ _MEASURE = re.compile(r"^(?:(band\d+)_)?(volume|area)_([a-z0-9_]+)$")
 
 
 def unit_text(suffix: str) -> str:
-    """'m3' -> 'm³', 'mm_rad2' -> 'mm·rad²'."""
+    """'m3' -> 'm³', 'mm_rad2' -> 'mm·rad²', 'mm/rad' -> 'mm/rad', 'mm_per_rad' -> 'mm/rad'."""
+    suffix = suffix.replace("_per_", "/")
     parts = []
     for part in suffix.split("_"):
-        m = re.fullmatch(r"([a-z]+)(\d*)", part)
+        m = re.fullmatch(r"([A-Za-z]+)(\d*)", part)
         parts.append(m.group(1) + m.group(2).translate(_SUPER) if m else part)
     return "·".join(parts)
+
+
+def _pretty_name(name: str) -> str:
+    """'mean_sigma_min' -> 'mean σ_min' (catalogue names of field statistics)."""
+    for word, sym in (("sigma_min", "σ_min"), ("sigma_max", "σ_max")):
+        name = name.replace(word, sym)
+    return name.replace("_", " ").replace("σ min", "σ_min").replace("σ max", "σ_max")
+
+
+def labeller(cfg):
+    """A function column -> label for a run config: catalogue units for every result column it knows."""
+    from scalesynth.metrics import catalogue
+
+    n_bands = len(cfg.dexterity.band_edges) - 1
+    units: dict[str, tuple[str, str]] = {}
+    for m in catalogue(cfg.mech, cfg.units.length).values():
+        for col in m.columns(n_bands):
+            units[col] = (m.name, m.unit)
+
+    def label(column: str) -> str:
+        if column in _NAMES or _MEASURE.match(column) or re.fullmatch(r"band\d+_share", column):
+            return metric_label(column)
+        if column in units:
+            name, unit = units[column]
+            base = _NAMES.get(name, _pretty_name(name))
+            return base if unit in ("1", "") else f"{base} [{unit_text(unit)}]"
+        return metric_label(column)
+
+    return label
+
+
+def field_label(mech, name: str, length_unit: str) -> str:
+    """Colour-bar label of a per-voxel field: 'LCI', 'σ_min [mm/rad]'."""
+    for f in getattr(mech, "fields", ()):
+        if f.name == name:
+            unit = f.unit.replace("{length}", length_unit)
+            base = _NAMES.get(name, _pretty_name(name))
+            return base if unit in ("1", "") else f"{base} [{unit_text(unit)}]"
+    return _NAMES.get(name, name)
 
 
 def metric_label(column: str) -> str:

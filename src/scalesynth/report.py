@@ -99,8 +99,8 @@ def plot_front(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict
     fig = plotting.front_figure(
         pareto[xk].to_numpy(),
         pareto[yk].to_numpy(),
-        lab.metric_label(xk),
-        lab.metric_label(yk),
+        lab.labeller(cfg)(xk),
+        lab.labeller(cfg)(yk),
         f"{cfg.name}: Pareto front ({cfg.mechanism}, seed {cfg.algorithm.seed})",
         references=[(r["label"], r["metrics"][xk], r["metrics"][yk]) for r in refs],
         highlight=highlight,
@@ -189,7 +189,7 @@ def plot_bands(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict
     xk, yk = _axes(problem, cfg)
     shares = [pareto[f"band{b}_share"].to_numpy() for b in range(nb)]
     fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels,
-                                     lab.metric_label(xk), lab.metric_label(yk))
+                                     lab.labeller(cfg)(xk), lab.labeller(cfg)(yk))
     rio.save_figure(fig, plots / f"bands_front.{fmt}")
     plotting.close(fig)
     files.append(_rel(run_dir, plots / f"bands_front.{fmt}"))

@@ -34,17 +34,18 @@ def write_report_html(run_dir: Path, featured: list[tuple[str, int]] | None = No
     derived = [c for c in pareto.columns if c not in problem.var_names and c not in problem.metric_columns
                and c not in ("rank", "feasible")]
     hover = [c for c in [*problem.var_names, *derived, *problem.metric_columns] if c in pareto.columns]
+    label = lab.labeller(cfg)
     figs = ia.Figures()
     title = f"{cfg.name}: scale synthesis of {mech.name}"
-    blocks = [f"<h1>{_html.escape(title)}</h1>", _summary(cfg, problem, pareto, history, manifest)]
+    blocks = [f"<h1>{_html.escape(title)}</h1>", _summary(cfg, problem, pareto, history, manifest, label)]
     blocks.append("<h2>Pareto front</h2><p class=\"note\">Hover a point for every design variable and metric.</p>")
     if len(pareto):
         blocks.append(figs.html(ia.front_figure(pareto, population, xk, yk, hover, featured,
-                                                f"Pareto front ({len(pareto)} designs) and final population")))
+                                                f"Pareto front ({len(pareto)} designs) and final population", label)))
         obj = list(dict.fromkeys(problem.objective_keys))
         blocks.append("<h2>Design variables and objectives</h2>")
         blocks.append(figs.html(ia.parallel_figure(pareto, [*problem.var_names, *obj], obj[0],
-                                                   "parallel coordinates of the Pareto front"), 480))
+                                                   "parallel coordinates of the Pareto front", label), 480))
     else:
         blocks.append("<p>The front is empty: no feasible design.</p>")
     blocks.append("<h2>Hypervolume</h2>")
@@ -54,7 +55,7 @@ def write_report_html(run_dir: Path, featured: list[tuple[str, int]] | None = No
         cols = [c for c in [*problem.var_names, *problem.objective_keys, "gci"] if c in pareto.columns]
         cols = list(dict.fromkeys(cols))
         rows = pareto.iloc[[i for _, i in featured]]
-        blocks.append(ia.table(rows, cols, "design", [name for name, _ in featured]))
+        blocks.append(ia.table(rows, cols, "design", [name for name, _ in featured], label))
         unit = cfg.units.length
         ndim = len(mech.task_axes)
         axis_labels = [lab.axis_label(mech, a, unit) for a in range(ndim)]
@@ -89,8 +90,8 @@ def write_report_html(run_dir: Path, featured: list[tuple[str, int]] | None = No
     return target
 
 
-def _summary(cfg, problem, pareto, history, manifest) -> str:
-    objectives = ", ".join(f"{o.sense} {lab.metric_label(k)}"
+def _summary(cfg, problem, pareto, history, manifest, label) -> str:
+    objectives = ", ".join(f"{o.sense} {label(k)}"
                            for o, k in zip(cfg.objectives, problem.objective_keys, strict=True))
     items = [
         f"mechanism {cfg.mechanism}; NSGA-II population {cfg.algorithm.pop_size}, "

@@ -180,16 +180,30 @@ def show_design(
     return summary
 
 
+def colour_range(fg: wv.FieldGrid, field: str) -> tuple[float, float]:
+    """Colour scale of a field: [0, 1] for LCI, else the 2nd to 98th percentile of its reachable values (a few
+    near-singular cells would otherwise squash the scale)."""
+    if field == "lci":
+        return 0.0, 1.0
+    v = fg.fields[field][np.isfinite(fg.fields[field])]
+    if not v.size:
+        return 0.0, 1.0
+    lo, hi = (float(x) for x in np.percentile(v, [2, 98]))
+    return (lo, hi) if hi > lo else (lo, lo + 1.0)
+
+
 def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target: Path, fmt: str) -> list[str]:
     mech = cfg.mech
     edges = cfg.dexterity.band_edges
-    field_label = lab.metric_label(field)
+    field_label = lab.field_label(mech, field, cfg.units.length)
+    vmin, vmax = colour_range(fg, field)
     box, path = _task_geometry(cfg)
     files = []
     if fmt == "html":
         from scalesynth import interactive
 
-        html = interactive.show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path)
+        html = interactive.show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path,
+                                     field_label, vmin, vmax)
         rio.write_text(target / "show.html", html)
         return ["show.html"]
     from scalesynth import plotting
@@ -199,7 +213,7 @@ def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, targe
         pts, flat = wv.boundary_points(mask, fg.axes())
         fig = plotting.surface_scatter_figure(pts, fg.fields[field].ravel()[flat], axis_labels,
                                               f"{title}\nworkspace boundary coloured by {field_label}", field_label,
-                                              box=box, path=path, equal=equal)
+                                              vmin, vmax, box=box, path=path, equal=equal)
         rio.save_figure(fig, target / f"workspace_3d.{fmt}")
         plotting.close(fig)
         files.append(f"workspace_3d.{fmt}")
@@ -214,7 +228,8 @@ def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, targe
         rio.save_figure(fig, target / f"bands_3d.{fmt}")
         plotting.close(fig)
         files.append(f"bands_3d.{fmt}")
-    fig = plotting.sections_figure(panels, edges if field == "lci" else None, title, field_label=field_label)
+    fig = plotting.sections_figure(panels, edges if field == "lci" else None, title, field_label=field_label,
+                                   vmin=vmin, vmax=vmax)
     rio.save_figure(fig, target / f"sections.{fmt}")
     plotting.close(fig)
     files.append(f"sections.{fmt}")

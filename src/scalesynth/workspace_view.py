@@ -16,15 +16,15 @@ import numpy as np
 
 from scalesynth.errors import ConfigError, InvalidParameter
 from scalesynth.evaluate import Grid, make_grid
-from scalesynth.kernels.grid import sample_grid
+from scalesynth.kernels import grid as _grid
 
 CENTROID_RESOLUTION = 24  # coarse grid locating a section's default position (24^3 = 14k points)
 MAX_POINTS = 40_000  # boundary voxels drawn per 3-D panel (deterministic thinning beyond)
 
 
 def available_fields(mech) -> tuple[str, ...]:
-    """Per-voxel fields a mechanism's point kernel provides (the current kernel contract: LCI only)."""
-    return ("lci",)
+    """Per-voxel fields a mechanism's field kernel writes (lci, sigma_min, sigma_max and its own)."""
+    return tuple(mech.field_names)
 
 
 def check_field(mech, name: str) -> str:
@@ -58,8 +58,15 @@ def sample_fields(cfg, design: Mapping[str, float], resolution: int) -> FieldGri
     """Every field of ``design`` on the config's grid box at ``resolution`` cells per task axis."""
     mech = cfg.mech
     g = make_grid(mech, mech.resolve_design(design), cfg.resolved_options(), resolution, cfg.grid.region)
-    lci = sample_grid(mech.point_kernel, _packed(cfg, design), g.lo, g.step, g.shape)
-    return FieldGrid(grid=g, lci=lci, fields={"lci": np.where(lci >= 0, lci, np.nan)})
+    values = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), g.lo, g.step, g.shape)
+    lci = values[..., 0]
+    unreachable = lci < 0
+    fields = {}
+    for f, name in enumerate(mech.field_names):
+        v = values[..., f].copy()
+        v[unreachable] = np.nan
+        fields[name] = v
+    return FieldGrid(grid=g, lci=np.ascontiguousarray(lci), fields=fields)
 
 
 def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, resolution: int):
@@ -70,7 +77,7 @@ def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, re
     lo, step, shape = g.lo.copy(), g.step.copy(), g.shape.copy()
     lo[normal] = value - 0.5 * step[normal]
     shape[normal] = 1
-    plane = sample_grid(mech.point_kernel, _packed(cfg, design), lo, step, shape)
+    plane = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), lo, step, shape)[..., 0]
     others = [a for a in range(3) if a != normal]
     values = np.take(plane, 0, axis=normal)
     ext = []
