@@ -19,7 +19,7 @@ from scalesynth.evaluate import Grid, make_grid
 from scalesynth.kernels import grid as _grid
 
 CENTROID_RESOLUTION = 24  # coarse grid locating a section's default position (24^3 = 14k points)
-MAX_POINTS = 40_000  # boundary voxels drawn per 3-D panel (deterministic thinning beyond)
+MAX_POINTS = 20_000  # boundary voxels drawn per 3-D panel (deterministic thinning beyond; drawing dominates show)
 
 
 def available_fields(mech) -> tuple[str, ...]:
