@@ -222,4 +222,11 @@ def test_designs_equal_up_to_m_minus_n_are_duplicates():
     kept = elim.do(Population.new("X", X))
     assert len(kept) == 2
     M = problem.metrics(X)
-    assert np.array_equal(M[0], M[1])  # identical metrics, as the invariance says
+    # identical kinematic metrics, as the invariance says; design-level ones may see m itself (the base radius)
+    design = [i for i, c in enumerate(problem.metric_columns) if c in ("link_length_sum_m", "footprint_radius_m",
+                                                                        "stroke_d_m")]
+    assert len(design) == 3
+    kinematic = [i for i in range(M.shape[1]) if i not in design]
+    assert np.array_equal(M[0, kinematic], M[1, kinematic])
+    assert M[0, problem.metric_columns.index("footprint_radius_m")] == 0.9  # = m
+    assert M[1, problem.metric_columns.index("footprint_radius_m")] == 1.1

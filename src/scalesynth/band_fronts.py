@@ -62,13 +62,13 @@ def band_pareto(problem, population: pd.DataFrame, band: int) -> tuple[pd.DataFr
 
 def write_band_fronts(run_dir: Path, cfg, problem, population: pd.DataFrame | None, fmt: str = "png",
                       out_dir: Path | None = None) -> dict[str, Any]:
-    """bands/pareto_band<k>.csv and bands/pareto_band<k>.<fmt> for every band; returns their names and sizes."""
+    """bands/pareto_band<k>.csv and bands/pareto_band<k>.<fmt> for every band; returns their paths and sizes."""
     from scalesynth import plotting
 
     if population is None:
-        return {"files": [], "sizes": []}
+        return {"paths": [], "sizes": []}
     bands_dir = rio.ensure_dir(Path(out_dir) if out_dir is not None else Path(run_dir) / "bands")
-    files, sizes = [], []
+    paths, sizes = [], []
     edges = cfg.dexterity.band_edges
     feas = population[population["feasible"].astype(bool)] if "feasible" in population.columns else population
     label = lab.labeller(cfg)
@@ -76,7 +76,7 @@ def write_band_fronts(run_dir: Path, cfg, problem, population: pd.DataFrame | No
         front, cols = band_pareto(problem, population, k)
         name = f"pareto_band{k}"
         rio.write_csv(bands_dir / f"{name}.csv", front.drop(columns=["feasible"], errors="ignore"))
-        files.append(f"{bands_dir.name}/{name}.csv")
+        paths.append(bands_dir / f"{name}.csv")
         sizes.append(len(front))
         ycol = cols[1] if len(cols) > 1 else cols[0]
         fig = plotting.band_pareto_figure(
@@ -85,8 +85,8 @@ def write_band_fronts(run_dir: Path, cfg, problem, population: pd.DataFrame | No
             f"{cfg.name}: Pareto set of LCI band {k} {_band_label(edges, k)} ({', '.join(cols)})")
         rio.save_figure(fig, bands_dir / f"{name}.{fmt}")
         plotting.close(fig)
-        files.append(f"{bands_dir.name}/{name}.{fmt}")
-    return {"files": files, "sizes": sizes}
+        paths.append(bands_dir / f"{name}.{fmt}")
+    return {"paths": paths, "sizes": sizes}
 
 
 def _band_label(edges, k: int) -> str:

@@ -156,16 +156,17 @@ def plan(configs: Sequence[tuple[str, RunConfig]], seeds: int, out: Path) -> lis
 
 def run_task(data: dict[str, Any], seed: int, out_dir: str) -> dict[str, Any]:
     """Run (or skip, or resume) one task; executed on a dask worker. Never raises: failures are returned."""
+    from scalesynth import results
     from scalesynth.config import config_from_dict
-    from scalesynth.optimize import _finished, config_digest, load_result, run
+    from scalesynth.optimize import config_digest, run
 
     t0 = time.perf_counter()
     out = Path(out_dir)
     try:
         cfg = config_from_dict(data)
         seeded = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
-        if _finished(out, config_digest(seeded)):
-            result, status = load_result(out), "skipped"
+        if results.finished(out, config_digest(seeded)):
+            result, status = results.load(out), "skipped"
         else:
             result, status = run(cfg, out, seed=seed, resume=True, progress=None, plots=False), "finished"
         m = result.manifest
@@ -181,7 +182,7 @@ def run_task(data: dict[str, Any], seed: int, out_dir: str) -> dict[str, Any]:
                 "generation": [int(g) for g in history["generation"]],
                 "hypervolume": [float(h) for h in history["hypervolume"]],
             },
-            "pareto_csv": (out / "pareto.csv").read_text(encoding="utf-8"),
+            "pareto_csv": (out / results.PARETO).read_text(encoding="utf-8"),
         }
     except Exception as err:  # a task boundary: report any failure, let the other tasks go on
         return {"status": "failed", "error": one_line(err), "wall_seconds": time.perf_counter() - t0}

@@ -25,11 +25,11 @@ AXIS_PREFERENCE = ("task_coverage", "task_gci", "task_fci", "gci", "fci", "link_
 _ROW = re.compile(r"\(row (\d+) of pareto\.csv\)")
 
 
-def _selected(run_dir: Path, problem, pareto: pd.DataFrame) -> list[tuple[str, int]]:
-    from scalesynth.report import objective_matrix
+def _selected(result) -> list[tuple[str, int]]:
     from scalesynth.selection import choose
 
-    out = [("knee", choose(objective_matrix(problem, pareto), "knee"))] if len(pareto) else []
+    run_dir, pareto = result.out_dir, result.pareto
+    out = [("knee", choose(result.objective_matrix(), "knee"))] if len(pareto) else []
     for path in sorted(run_dir.glob("selected_*.yaml")):
         m = _ROW.search(path.read_text(encoding="utf-8", errors="replace").split("\n", 1)[0])
         if m and int(m.group(1)) < len(pareto):
@@ -40,19 +40,17 @@ def _selected(run_dir: Path, problem, pareto: pd.DataFrame) -> list[tuple[str, i
 
 
 def load_runs(run_dirs: Sequence[Path]) -> list[dict[str, Any]]:
-    from scalesynth.problem import SynthesisProblem
-    from scalesynth.report import load_run
+    from scalesynth.results import load
 
     if len(run_dirs) < 2:
         raise ConfigError("RUN_DIR: compare needs at least two results directories")
     runs = []
     for d in run_dirs:
-        d = Path(d)
-        cfg, pareto, history, _ = load_run(d)
-        problem = SynthesisProblem(cfg)
+        result = load(Path(d))
+        problem, pareto = result.problem, result.pareto
         metrics = [c for c in pareto.columns if c not in problem.var_names and c not in NOT_METRICS]
-        runs.append({"dir": d, "cfg": cfg, "problem": problem, "pareto": pareto, "history": history,
-                     "metrics": metrics, "selected": _selected(d, problem, pareto)})
+        runs.append({"dir": Path(d), "cfg": result.cfg, "problem": problem, "pareto": pareto,
+                     "history": result.history, "metrics": metrics, "selected": _selected(result)})
     return runs
 
 

@@ -13,7 +13,6 @@ import os
 import platform
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
@@ -22,23 +21,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from scalesynth import __version__
+from scalesynth import __version__, results
 from scalesynth import io as rio
-from scalesynth.config import RunConfig, dump_config
+from scalesynth.config import ConstraintConfig, RunConfig
 from scalesynth.errors import ConfigError, RunError
 from scalesynth.problem import SynthesisProblem
+from scalesynth.results import RunResult
 
 ProgressFn = Callable[[dict[str, Any]], None]
 
 DEPENDENCIES = ("numpy", "numba", "llvmlite", "pymoo", "moocore", "pandas", "matplotlib", "pydantic", "pyyaml", "typer")
-
-
-@dataclass
-class RunResult:
-    out_dir: Path
-    pareto: pd.DataFrame
-    history: pd.DataFrame
-    manifest: dict[str, Any]
 
 
 class CanonicalX:
@@ -112,8 +104,46 @@ def _history_row(algorithm, problem: SynthesisProblem, ref: np.ndarray, elapsed:
     for key, sign in zip(problem.objective_keys, problem.signs, strict=True):
         col = problem.objective_keys.index(key)
         row[f"best_{key}"] = float((F[:, col] * sign).max() if sign < 0 else F[:, col].min()) if len(F) else 0.0
+    M = pop.get("M")
+    for i, (con, key) in enumerate(zip(problem.cfg.constraints, problem.constraint_keys, strict=True)):
+        row[constraint_column(i, key)] = best_for_constraint(con, M[:, problem.metric_columns.index(key)])
     row["seconds"] = round(elapsed, 3)
     return row
+
+
+def constraint_column(i: int, key: str) -> str:
+    """history.csv column of constraint i's best value in the generation's population."""
+    return f"constraint{i}_best_{key}"
+
+
+def best_for_constraint(con: ConstraintConfig, values: np.ndarray) -> float:
+    """The value closest to satisfying the constraint: the largest for a lower bound, the smallest for an upper
+    bound, the least violating for both."""
+    if con.max is None:
+        return float(values.max())
+    if con.min is None:
+        return float(values.min())
+    violation = np.maximum(con.min - values, 0.0) + np.maximum(values - con.max, 0.0)
+    return float(values[int(np.argmin(violation))])
+
+
+def _needs(con: ConstraintConfig) -> str:
+    if con.max is None:
+        return f">= {float(con.min)!r}"
+    if con.min is None:
+        return f"<= {float(con.max)!r}"
+    return f"in [{float(con.min)!r}, {float(con.max)!r}]"
+
+
+def infeasibility(problem: SynthesisProblem, history: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per constraint: the best value seen over the whole run (from the history) and what it needs."""
+    out = []
+    for i, (con, key) in enumerate(zip(problem.cfg.constraints, problem.constraint_keys, strict=True)):
+        seen = np.array([row[constraint_column(i, key)] for row in history], dtype=float)
+        best = best_for_constraint(con, seen) if len(seen) else 0.0
+        out.append({"constraint": key, "best": best, "needs": _needs(con)})
+    return out
+
 
 
 def _versions() -> dict[str, str]:
@@ -201,8 +231,8 @@ def run(
         history = state["history"]
         elapsed_before = state["elapsed"]
         started = state["started"]
-    elif resume and _finished(out, digest):
-        return load_result(out)
+    elif resume and results.finished(out, digest):
+        return results.load(out)
     if algorithm is None:
         # a fresh run: an old checkpoint in this directory belongs to another run
         if ckpt_path.exists():
@@ -234,6 +264,7 @@ def run(
     wall = elapsed_before + time.perf_counter() - t0
     pareto, population, dropped = _pareto_frame(problem, algorithm)
     history_df = pd.DataFrame(history)
+    n_feasible = int(_feasible(algorithm.pop).sum())
     manifest = {
         "name": cfg.name,
         "status": "finished",
@@ -253,6 +284,8 @@ def run(
         "hypervolume": history[-1]["hypervolume"] if history else 0.0,
         "pareto_size": int(len(pareto)),
         "objective_duplicates_dropped": int(dropped),
+        "feasible_in_final_population": n_feasible,
+        "no_feasible_design": infeasibility(problem, history) if n_feasible == 0 and cfg.constraints else [],
         "machine": {
             "cores": os.cpu_count(),
             "platform": platform.platform(),
@@ -262,18 +295,17 @@ def run(
         "versions": _versions(),
         "config": cfg.model_dump(mode="json"),
     }
-    rio.write_csv(out / "pareto.csv", pareto)
-    rio.write_csv(out / "population.csv", population)
-    rio.write_csv(out / "history.csv", history_df)
-    rio.write_text(out / "config.yaml", dump_config(cfg))
+    result = RunResult(out_dir=out, cfg=cfg, pareto=pareto, history=history_df, manifest=manifest,
+                       population=population, problem=problem)
+    results.write_tables(result)
     if plots:
         from scalesynth.report import write_plots_and_report
 
-        write_plots_and_report(out)
-    rio.write_json(out / "manifest.json", manifest)  # last: its presence marks a finished run
+        write_plots_and_report(result)  # from the run in memory: the same figures as the manifest
+    results.write_manifest(result)  # last: its presence marks a finished run
     if ckpt_path.exists():
         ckpt_path.unlink()
-    return RunResult(out_dir=out, pareto=pareto, history=history_df, manifest=manifest)
+    return result
 
 
 def _numba_threads() -> int:
@@ -282,40 +314,14 @@ def _numba_threads() -> int:
     return int(numba.get_num_threads())
 
 
-def _finished(out: Path, digest: str) -> bool:
-    path = out / "manifest.json"
-    if not path.exists():
-        return False
-    try:
-        manifest = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError):
-        return False
-    return manifest.get("status") == "finished" and manifest.get("config_digest") == digest
-
-
-def load_result(out: Path) -> RunResult:
-    """Read a finished results directory."""
-    out = Path(out)
-    manifest_path = out / "manifest.json"
-    if not manifest_path.exists():
-        raise ConfigError(f"{out}: not a finished scalesynth run (no manifest.json)")
-    manifest = json.loads(manifest_path.read_text())
-    return RunResult(
-        out_dir=out,
-        pareto=pd.read_csv(out / "pareto.csv"),
-        history=pd.read_csv(out / "history.csv"),
-        manifest=manifest,
-    )
-
-
 def reproduce(run_dir: Path, out_dir: Path) -> dict[str, Any]:
     """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes."""
     from scalesynth.config import config_from_dict
 
-    original = load_result(run_dir)
+    original = results.load(run_dir)
     cfg = config_from_dict(original.manifest["config"])
     result = run(cfg, out_dir, plots=False)
-    same = (Path(run_dir) / "pareto.csv").read_bytes() == (Path(out_dir) / "pareto.csv").read_bytes()
+    same = (Path(run_dir) / results.PARETO).read_bytes() == (Path(out_dir) / results.PARETO).read_bytes()
     return {
         "identical": same,
         "original": str(run_dir),

@@ -131,5 +131,12 @@ class SynthesisProblem(Problem):
                                     self.cfg.dexterity.band_edges, self.cfg.units.length)
 
     def canonical(self, X: np.ndarray) -> np.ndarray:
-        """Design vectors mapped to the mechanism's canonical parameters (identical models -> identical rows)."""
-        return self.cfg.mech.canonical_vectors(self.var_names, np.atleast_2d(X))
+        """Design vectors mapped to the mechanism's canonical parameters (identical models -> identical rows).
+
+        The canonical map describes the kinematics; a design-level objective or constraint (e.g. footprint_radius
+        = m for seed 000) may tell such designs apart, so then the vectors are kept as they are."""
+        X = np.atleast_2d(X)
+        items = [*self.cfg.objectives, *self.cfg.constraints]
+        if any(metric_entry(self.cfg, item).family == "design" for item in items):
+            return np.asarray(X, dtype=float)
+        return self.cfg.mech.canonical_vectors(self.var_names, X)

@@ -1,4 +1,9 @@
-"""Plots and report.md for a finished results directory (reads its CSVs and config; draws via plotting.py)."""
+"""Plots, per-band Pareto sets, report.md and report.html of a run, from its RunResult in memory
+(scalesynth.results); draws via plotting.py (matplotlib) and interactive.py (plotly).
+
+``optimize.run`` passes the result it just built, so report.md, report.html, the plots and manifest.json show the
+same figures; the ``plot-*`` commands pass ``results.load(run_dir)``.
+"""
 
 from __future__ import annotations
 
@@ -6,34 +11,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from scalesynth import io as rio
 from scalesynth import labels as lab
 from scalesynth import plotting
-from scalesynth.config import RunConfig, load_config
+from scalesynth.config import RunConfig
 from scalesynth.errors import ConfigError
 from scalesynth.evaluate import evaluate_config
 from scalesynth.problem import SynthesisProblem
+from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
-
-
-def load_run(run_dir: Path) -> tuple[RunConfig, pd.DataFrame, pd.DataFrame, pd.DataFrame | None]:
-    run_dir = Path(run_dir)
-    for name in ("config.yaml", "pareto.csv", "history.csv"):
-        if not (run_dir / name).is_file():
-            raise ConfigError(f"{run_dir}: not a scalesynth results directory (missing {name})")
-    cfg = load_config(run_dir / "config.yaml")
-    pareto = pd.read_csv(run_dir / "pareto.csv")
-    history = pd.read_csv(run_dir / "history.csv")
-    pop_path = run_dir / "population.csv"
-    population = pd.read_csv(pop_path) if pop_path.is_file() else None
-    return cfg, pareto, history, population
-
-
-def objective_matrix(problem: SynthesisProblem, frame: pd.DataFrame) -> np.ndarray:
-    """Objectives of the rows in minimisation form."""
-    return frame[problem.objective_keys].to_numpy(dtype=float) * problem.signs
+from scalesynth.workspace_view import band_labels, default_section_point, sample_plane, task_geometry
 
 
 def _axes(problem: SynthesisProblem, cfg: RunConfig) -> tuple[str, str]:
@@ -43,13 +31,7 @@ def _axes(problem: SynthesisProblem, cfg: RunConfig) -> tuple[str, str]:
     return cfg.mech.measure_key(cfg.units.length), keys[0]
 
 
-def design_of(problem: SynthesisProblem, row: pd.Series) -> dict[str, float]:
-    d = dict(problem.base_design)
-    d.update({k: float(row[k]) for k in problem.var_names})
-    return d
-
-
-def reference_points(cfg: RunConfig, problem: SynthesisProblem) -> list[dict[str, Any]]:
+def reference_points(cfg: RunConfig) -> list[dict[str, Any]]:
     """The config's reference designs re-evaluated with the run's model and grid."""
     out = []
     for label, ref in cfg.references.items():
@@ -64,30 +46,31 @@ def dominated_by_front(F_front: np.ndarray, f: np.ndarray) -> bool:
     return bool(np.any(np.all(F_front <= f, axis=1) & np.any(F_front < f, axis=1)))
 
 
-def _plots_dir(run_dir: Path, out: Path | None, fmt: str) -> Path:
+def _plots_dir(result: RunResult, out: Path | None, fmt: str) -> Path:
     if fmt not in rio.FIGURE_FORMATS:
         raise ConfigError(f"--format: must be one of {', '.join(rio.FIGURE_FORMATS)}, got {fmt!r}")
-    return rio.ensure_dir(Path(out) if out is not None else run_dir / "plots")
+    return rio.ensure_dir(Path(out) if out is not None else result.out_dir / PLOTS)
 
 
 def _rel(run_dir: Path, path: Path) -> str:
+    """A written file's name relative to the run directory (absolute when --out put it elsewhere)."""
     try:
-        return str(path.resolve().relative_to(run_dir.resolve()))
+        return str(path.resolve().relative_to(Path(run_dir).resolve()))
     except ValueError:
         return str(path)
 
 
-def plot_front(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
     """plots/front.<fmt> (front, final population, reference designs, knee) and plots/hypervolume.<fmt>."""
-    run_dir = Path(run_dir)
-    plots = _plots_dir(run_dir, out, fmt)
-    cfg, pareto, history, population = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
+    plots = _plots_dir(result, out, fmt)
+    cfg, pareto, history, population, problem = (result.cfg, result.pareto, result.history, result.population,
+                                                 result.problem)
+    label = lab.labeller(cfg)
     xk, yk = _axes(problem, cfg)
-    refs = reference_points(cfg, problem)
+    refs = reference_points(cfg)
     highlight = []
     if len(pareto):
-        F = objective_matrix(problem, pareto)
+        F = result.objective_matrix()
         k = choose(F, "knee")
         highlight.append(("knee", float(pareto[xk].iloc[k]), float(pareto[yk].iloc[k])))
         for r in refs:
@@ -99,8 +82,8 @@ def plot_front(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict
     fig = plotting.front_figure(
         pareto[xk].to_numpy(),
         pareto[yk].to_numpy(),
-        lab.labeller(cfg)(xk),
-        lab.labeller(cfg)(yk),
+        label(xk),
+        label(yk),
         f"{cfg.name}: Pareto front ({cfg.mechanism}, seed {cfg.algorithm.seed})",
         references=[(r["label"], r["metrics"][xk], r["metrics"][yk]) for r in refs],
         highlight=highlight,
@@ -113,16 +96,14 @@ def plot_front(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict
     )
     rio.save_figure(fig, plots / f"hypervolume.{fmt}")
     plotting.close(fig)
-    files = [_rel(run_dir, plots / f"front.{fmt}"), _rel(run_dir, plots / f"hypervolume.{fmt}")]
+    files = [_rel(result.out_dir, plots / f"front.{fmt}"), _rel(result.out_dir, plots / f"hypervolume.{fmt}")]
     return {"references": refs, "files": files}
 
 
-from scalesynth.workspace_view import band_labels  # noqa: E402  (re-exported: report.band_labels)
-
-
-def featured_designs(problem: SynthesisProblem, pareto: pd.DataFrame) -> list[tuple[str, int]]:
-    """The knee and the best design of each objective, as (label, row index), without repeats."""
-    F = objective_matrix(problem, pareto)
+def featured_designs(result: RunResult) -> list[tuple[str, int]]:
+    """The knee and the best design of each objective on the front, as (label, row index), without repeats."""
+    problem = result.problem
+    F = result.objective_matrix()
     out = [("knee", choose(F, "knee"))]
     for obj_idx, row in enumerate(extremes(F)):
         label = f"best {problem.objective_keys[obj_idx] if obj_idx < len(problem.objective_keys) else obj_idx}"
@@ -139,13 +120,10 @@ def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, A
     the planes normal to its second and third task axes through the workspace centroid (from a coarse grid; an
     empty plane moves to the nearest one that cuts the workspace), for seed 000 the xz and xy sections; one map
     for planar mechanisms. Axis labels carry units; axes of different units are not drawn to equal scale."""
-    from scalesynth.show import _task_geometry
-    from scalesynth.workspace_view import default_section_point, sample_plane
-
     mech = cfg.mech
     unit = cfg.units.length
     res = max(cfg.grid.resolution, SECTION_RESOLUTION)
-    box, path = _task_geometry(cfg)
+    box, path = task_geometry(cfg)
     if mech.planar:
         values, ext = sample_plane(cfg, design, 2, 0.0, res)
         return [{"values": values, "extent": ext, "xlabel": lab.axis_label(mech, 0, unit),
@@ -169,58 +147,53 @@ def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, A
     return panels
 
 
-def plot_bands(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
     """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
     per-band Pareto sets bands/pareto_band<k>.csv with their plots."""
     from scalesynth.band_fronts import write_band_fronts
 
-    run_dir = Path(run_dir)
-    plots = _plots_dir(run_dir, out, fmt)
-    cfg, pareto, _, population = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
+    plots = _plots_dir(result, out, fmt)
+    cfg, pareto, problem = result.cfg, result.pareto, result.problem
+    label = lab.labeller(cfg)
     edges = cfg.dexterity.band_edges
     labels = band_labels(edges)
     nb = len(edges) - 1
     files = []
     bands_out = None if out is None else plots / "bands"
-    band_info = write_band_fronts(run_dir, cfg, problem, population, fmt, bands_out)
+    band_info = write_band_fronts(result.out_dir, cfg, problem, result.population, fmt, bands_out)
+    band_rel = [_rel(result.out_dir, Path(p)) for p in band_info["paths"]]
     if not len(pareto):
-        return {"files": files, "featured": [], "band_files": band_info["files"], "band_sizes": band_info["sizes"]}
+        return {"files": files, "featured": [], "band_files": band_rel, "band_sizes": band_info["sizes"]}
     xk, yk = _axes(problem, cfg)
     shares = [pareto[f"band{b}_share"].to_numpy() for b in range(nb)]
-    fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels,
-                                     lab.labeller(cfg)(xk), lab.labeller(cfg)(yk))
+    fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels, label(xk),
+                                     label(yk))
     rio.save_figure(fig, plots / f"bands_front.{fmt}")
     plotting.close(fig)
-    files.append(_rel(run_dir, plots / f"bands_front.{fmt}"))
-    featured = featured_designs(problem, pareto)
+    files.append(_rel(result.out_dir, plots / f"bands_front.{fmt}"))
+    featured = featured_designs(result)
     bar = np.array([[pareto[f"band{b}_share"].iloc[i] for b in range(nb)] for _, i in featured])
-    fig = plotting.band_shares_figure([label for label, _ in featured], bar, labels)
+    fig = plotting.band_shares_figure([name for name, _ in featured], bar, labels)
     rio.save_figure(fig, plots / f"band_shares.{fmt}")
     plotting.close(fig)
-    files.append(_rel(run_dir, plots / f"band_shares.{fmt}"))
-    for label, i in featured:
-        design = design_of(problem, pareto.iloc[i])
+    files.append(_rel(result.out_dir, plots / f"band_shares.{fmt}"))
+    for name, i in featured:
+        design = result.design_of(pareto.iloc[i])
         panels = section_panels(cfg, design)
-        title = f"{label}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
+        title = f"{name}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
         fig = plotting.sections_figure(panels, edges, title)
-        name = "sections_" + label.replace(" ", "_") + f".{fmt}"
-        rio.save_figure(fig, plots / name)
+        fname = "sections_" + name.replace(" ", "_") + f".{fmt}"
+        rio.save_figure(fig, plots / fname)
         plotting.close(fig)
-        files.append(_rel(run_dir, plots / name))
-    return {"files": files, "featured": [(label, int(i)) for label, i in featured],
-            "band_files": band_info["files"], "band_sizes": band_info["sizes"]}
+        files.append(_rel(result.out_dir, plots / fname))
+    return {"files": files, "featured": [(name, int(i)) for name, i in featured], "band_files": band_rel,
+            "band_sizes": band_info["sizes"]}
 
 
-def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str, Any]) -> None:
-    """report.md: key numbers of the run and links to its plots."""
-    import json
-
-    run_dir = Path(run_dir)
-    cfg, pareto, history, _ = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
-    manifest_path = run_dir / "manifest.json"
-    manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() else {}
+def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> str:
+    """report.md: key numbers of the run (from the RunResult and its manifest) and links to its plots."""
+    cfg, pareto, history, manifest, problem = (result.cfg, result.pareto, result.history, result.manifest,
+                                               result.problem)
     mkey = cfg.mech.measure_key(cfg.units.length)
     bands = ", ".join(band_labels(cfg.dexterity.band_edges))
     objectives = ", ".join(f"{o.sense} {k}" for o, k in zip(cfg.objectives, problem.objective_keys, strict=True))
@@ -231,6 +204,14 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
         f"{int(history['evaluations'].iloc[-1])} evaluations, seed {cfg.algorithm.seed}",
         f"- grid: {cfg.grid.resolution} cells per axis; dexterity bands {bands}",
         f"- objectives: {objectives}",
+    ]
+    if cfg.constraints:
+        lines.append("- constraints: " + ", ".join(
+            f"{k} {'>= ' + repr(float(c.min)) if c.min is not None else ''}"
+            f"{' and ' if c.min is not None and c.max is not None else ''}"
+            f"{'<= ' + repr(float(c.max)) if c.max is not None else ''}"
+            for c, k in zip(cfg.constraints, problem.constraint_keys, strict=True)))
+    lines += [
         f"- final hypervolume: {history['hypervolume'].iloc[-1]:.6g}",
         f"- Pareto front: {len(pareto)} designs",
     ]
@@ -239,6 +220,12 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
         lines.append(f"- wall time: {manifest['wall_seconds']:.1f} s on {cores} cores")
     if "m_minus_n" in pareto.columns:
         lines.append("- note: the model depends on m and n only through m - n (spec §1.1); see column m_minus_n")
+    diagnostics = infeasibility_lines(manifest)
+    if diagnostics:
+        lines += ["", "## No feasible design", "",
+                  "The final population has no design that meets every constraint. Best value seen of each "
+                  "constraint over the run:", ""]
+        lines += [f"- {line}" for line in diagnostics]
     lines += ["", "## Featured designs", ""]
     cols = [*problem.var_names, *problem.objective_keys, *problem.constraint_keys, mkey, "gci", "fci", "min_lci"]
     cols += [c for c in pareto.columns if c.endswith("_share")]
@@ -267,16 +254,23 @@ def write_report(run_dir: Path, front_info: dict[str, Any], bands_info: dict[str
                          f"[bands/pareto_band{k}.csv](bands/pareto_band{k}.csv)")
     lines += ["", "## Plots", "", "Interactive version: [report.html](report.html) (self-contained, works offline).",
               ""]
-    for f in front_info.get("files", []) + bands_info.get("files", []) + bands_info.get("band_files", [])[1::2]:
+    images = [f for f in bands_info.get("band_files", []) if not f.endswith(".csv")]
+    for f in front_info.get("files", []) + bands_info.get("files", []) + images:
         lines.append(f"![{Path(f).stem}]({f})")
-    rio.write_text(run_dir / "report.md", "\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
 
 
-def write_plots_and_report(run_dir: Path) -> None:
-    """Plots, per-band Pareto sets, report.md and the self-contained interactive report.html."""
+def write_report(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> None:
+    rio.write_text(result.out_dir / REPORT, report_text(result, front_info, bands_info))
+
+
+def write_plots_and_report(result: RunResult) -> None:
+    """Every plot, the per-band Pareto sets, report.md and report.html of a run, from the RunResult (no files
+    re-read, no second problem)."""
     from scalesynth.report_html import write_report_html
 
-    front = plot_front(run_dir)
-    bands = plot_bands(run_dir)
-    write_report(run_dir, front, bands)
-    write_report_html(run_dir, bands.get("featured"), bands.get("band_sizes"))
+    front = plot_front(result)
+    bands = plot_bands(result)
+    write_report(result, front, bands)
+    xk, yk = _axes(result.problem, result.cfg)
+    write_report_html(result, bands.get("featured") or [], (xk, yk), bands.get("band_sizes"))

@@ -5,7 +5,6 @@ the featured designs' workspaces in 3-D coloured by LCI, and the per-band Pareto
 from __future__ import annotations
 
 import html as _html
-import json
 from pathlib import Path
 from typing import Any
 
@@ -17,20 +16,16 @@ from scalesynth import workspace_view as wv
 VIEW_RESOLUTION = 40  # cells per axis of the featured designs' 3-D views (40^3 = 64k cells, ~0.05 s each)
 
 
-def write_report_html(run_dir: Path, featured: list[tuple[str, int]] | None = None,
+def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, str],
                       band_sizes: list[int] | None = None) -> Path:
-    from scalesynth.problem import SynthesisProblem
-    from scalesynth.report import _axes, design_of, featured_designs, load_run
-
-    run_dir = Path(run_dir)
-    cfg, pareto, history, population = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
+    """Write report.html for a results.RunResult; ``featured`` (label, pareto row) and the front's ``axes`` as the
+    report and plots use them."""
+    cfg, pareto, history, population, problem = (result.cfg, result.pareto, result.history, result.population,
+                                                 result.problem)
+    run_dir = result.out_dir
     mech = cfg.mech
-    manifest_path = run_dir / "manifest.json"
-    manifest: dict[str, Any] = json.loads(manifest_path.read_text()) if manifest_path.exists() else {}
-    if featured is None:
-        featured = featured_designs(problem, pareto) if len(pareto) else []
-    xk, yk = _axes(problem, cfg)
+    manifest: dict[str, Any] = result.manifest or {}
+    xk, yk = axes
     derived = [c for c in pareto.columns if c not in problem.var_names and c not in problem.metric_columns
                and c not in ("rank", "feasible")]
     hover = [c for c in [*problem.var_names, *derived, *problem.metric_columns] if c in pareto.columns]
@@ -60,11 +55,9 @@ def write_report_html(run_dir: Path, featured: list[tuple[str, int]] | None = No
         ndim = len(mech.task_axes)
         axis_labels = [lab.axis_label(mech, a, unit) for a in range(ndim)]
         equal = lab.same_units(mech, range(ndim))
-        from scalesynth.show import _task_geometry
-
-        box, path = _task_geometry(cfg)
+        box, path = wv.task_geometry(cfg)
         for name, i in featured:
-            design = design_of(problem, pareto.iloc[i])
+            design = result.design_of(pareto.iloc[i])
             fg = wv.sample_fields(cfg, design, VIEW_RESOLUTION if ndim == 3 else max(cfg.grid.resolution, 96))
             caption = f"{name}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
             if ndim == 3:

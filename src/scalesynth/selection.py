@@ -68,17 +68,16 @@ def select_design(run_dir, method: str = "knee", weights: Sequence[float] | None
     import yaml
 
     from scalesynth import io as rio
-    from scalesynth.problem import SynthesisProblem
-    from scalesynth.report import design_of, load_run, objective_matrix
+    from scalesynth import results
 
     run_dir = Path(run_dir)
-    cfg, pareto, _, _ = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
+    result = results.load(run_dir, require_finished=False)
+    cfg, pareto, problem = result.cfg, result.pareto, result.problem
     if not len(pareto):
         raise InvalidParameter(f"{run_dir}: the front is empty (no feasible design), nothing to select")
-    i = choose(objective_matrix(problem, pareto), method, weights)
+    i = choose(result.objective_matrix(), method, weights)
     row = pareto.iloc[i]
-    design = design_of(problem, row)
+    design = result.design_of(row)
     metrics = {k: float(row[k]) for k in problem.metric_columns if k in row.index}
     data = cfg.model_dump(mode="json")
     data["design"] = design

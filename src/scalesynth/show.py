@@ -25,47 +25,28 @@ CONNECTIVITY = "26-connected: cells sharing a face, an edge or a corner (8 in 2-
 
 
 def load_source(source: Path, sets: Sequence[str] | None = None):
-    """(config, results directory or None) for a config file or a results directory."""
+    """(config, RunResult or None) for a config file or a results directory."""
     from scalesynth.config import load_config
+    from scalesynth.results import load
 
     source = Path(source)
     if source.is_dir():
-        if not (source / "config.yaml").is_file() or not (source / "pareto.csv").is_file():
-            raise ConfigError(f"{source}: not a scalesynth results directory (no config.yaml / pareto.csv)")
-        return load_config(source / "config.yaml", list(sets or [])), source
+        result = load(source, require_finished=False)
+        if sets:
+            return load_config(source / "config.yaml", list(sets)), result
+        return result.cfg, result
     return load_config(source, list(sets or [])), None
 
 
-def resolve_design(cfg, run_dir: Path | None, choice: str | None) -> tuple[dict[str, float], str, int | None]:
+def resolve_design(cfg, result, choice: str | None) -> tuple[dict[str, float], str, int | None]:
     """(design, label, row of pareto.csv or None) for ``--design``."""
-    if run_dir is None:
+    if result is None:
         if choice not in (None, "config"):
             raise ConfigError(f"--design {choice}: a config shows its own design; give a results directory to "
                               "choose knee, best-<metric> or a row")
         return cfg.resolved_design(), "config", None
-    from scalesynth.problem import SynthesisProblem
-    from scalesynth.report import design_of, load_run
-
-    _, pareto, _, _ = load_run(run_dir)
-    problem = SynthesisProblem(cfg)
-    row, label = wv.choose_row(problem, pareto, choice or "knee", cfg.mech.measure_key(cfg.units.length))
-    return design_of(problem, pareto.iloc[row]), label, row
-
-
-def _task_geometry(cfg):
-    """Task box as a (2, 3) array (lo, hi; planar: third axis 0) and the task path (n, 3), each or None."""
-    task = cfg.task
-    if task is None:
-        return None, None
-    n = len(cfg.mech.task_axes)
-    box = np.zeros((2, 3))
-    for a, name in enumerate(cfg.mech.task_axes):
-        box[:, a] = task.box[name]
-    path = None
-    if task.path is not None:
-        p = np.asarray(task.path, dtype=float)
-        path = np.pad(p, ((0, 0), (0, 3 - p.shape[1])))[:, :3]
-    return (box if n else None), path
+    row, label = wv.choose_row(result, choice or "knee")
+    return result.design_of(result.pareto.iloc[row]), label, row
 
 
 def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[list[dict], list[dict]]:
@@ -78,7 +59,7 @@ def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[l
     axes = fg.axes()
     g = fg.grid
     ext = [(float(g.lo[a]), float(g.lo[a] + g.shape[a] * g.step[a])) for a in range(3)]
-    box, path = _task_geometry(cfg)
+    box, path = wv.task_geometry(cfg)
     if mech.planar:
         panel = {"values": values[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": lab.axis_label(mech, 0, unit),
                  "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
@@ -126,14 +107,15 @@ def show_design(
     t0 = time.perf_counter()
     if fmt not in FORMATS:
         raise ConfigError(f"--format: must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    cfg, run_dir = load_source(source, sets)
+    cfg, result = load_source(source, sets)
+    run_dir = None if result is None else result.out_dir
     mech = cfg.mech
     wv.check_field(mech, field)
     at_axes = wv.parse_at(at, mech)
     res = resolution or cfg.grid.resolution
     if not 4 <= res <= 512:
         raise ConfigError(f"--resolution: must be between 4 and 512 cells per axis, got {res}")
-    chosen, label, row = resolve_design(cfg, run_dir, design)
+    chosen, label, row = resolve_design(cfg, result, design)
     target = Path(out) if out is not None else (run_dir or cfg.output_dir()) / "show" / label
     rio.ensure_dir(target)
     t1 = time.perf_counter()
@@ -197,7 +179,7 @@ def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, targe
     edges = cfg.dexterity.band_edges
     field_label = lab.field_label(mech, field, cfg.units.length)
     vmin, vmax = colour_range(fg, field)
-    box, path = _task_geometry(cfg)
+    box, path = wv.task_geometry(cfg)
     files = []
     if fmt == "html":
         from scalesynth import interactive

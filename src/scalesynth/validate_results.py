@@ -1,43 +1,43 @@
 """Schema and invariant checks of a finished results directory (CI: `python -m scalesynth.validate_results DIR`).
 
-Checks: every file present and parseable; pareto.csv has the design variables, derived and metric columns;
-no NaN/inf; design variables within bounds; LCI-type metrics in [0, 1]; band shares sum to 1; every row
-non-dominated and no two rows equal in objective space; history generations 1..n_gen, hypervolume finite and
-higher at the end than at the start; manifest status finished with matching evaluations.
+Checks: every file present and parseable (scalesynth.results); pareto.csv has the design variables, derived and
+every catalogue metric column; no NaN/inf; design variables within bounds; every metric within its catalogue
+range; band shares sum to 1; every row non-dominated and no two rows equal in objective space; history
+generations 1..n_gen, hypervolume finite and higher at the end than at the start; manifest status finished with
+matching evaluations.
 """
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
-from scalesynth.config import load_config
-from scalesynth.problem import SynthesisProblem
+from scalesynth import metrics as _metrics
+from scalesynth import results
+from scalesynth.errors import ConfigError
 
 
 def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
     """Problems found (empty list: the directory is valid). ``require_report``: report.md must exist too."""
     run_dir = Path(run_dir)
     problems: list[str] = []
-    names = ["pareto.csv", "population.csv", "history.csv", "manifest.json", "config.yaml"]
-    for name in names + (["report.md"] if require_report else []):
+    names = [results.PARETO, results.POPULATION, results.HISTORY, results.MANIFEST, results.CONFIG]
+    for name in names + ([results.REPORT] if require_report else []):
         if not (run_dir / name).is_file():
             problems.append(f"{name}: missing")
     if problems:
         return problems
-    leftovers = [p.name for p in run_dir.iterdir() if p.name.endswith(".tmp") or p.name == "checkpoint.pkl"]
+    leftovers = [p.name for p in run_dir.iterdir() if p.name.endswith(".tmp") or p.name == results.CHECKPOINT]
     if leftovers:
         problems.append(f"leftover files: {', '.join(sorted(leftovers))}")
-    cfg = load_config(run_dir / "config.yaml")
-    problem = SynthesisProblem(cfg)
-    manifest = json.loads((run_dir / "manifest.json").read_text())
-    pareto = pd.read_csv(run_dir / "pareto.csv")
-    history = pd.read_csv(run_dir / "history.csv")
-    expected = [*problem.var_names, *cfg.mech.derived_columns(problem.base_design), *problem.metric_columns, "rank"]
+    try:
+        result = results.load(run_dir)
+    except ConfigError as err:
+        return [str(err)]
+    cfg, problem, manifest, pareto, history = result.cfg, result.problem, result.manifest, result.pareto, result.history
+    expected = results.expected_pareto_columns(problem)
     missing = [c for c in expected if c not in pareto.columns]
     if missing:
         problems.append(f"pareto.csv: missing columns {missing}")
@@ -49,9 +49,11 @@ def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
         lo, hi = cfg.bounds[k]
         if not pareto[k].between(lo, hi).all():
             problems.append(f"pareto.csv: {k} outside bounds [{lo}, {hi}]")
-    for col in ("gci", "fci", "min_lci", "max_lci") + tuple(c for c in pareto.columns if c.endswith("_share")):
-        if col in pareto.columns and not pareto[col].between(0.0, 1.0).all():
-            problems.append(f"pareto.csv: {col} outside [0, 1]")
+    for m in _metrics.catalogue(cfg.mech, cfg.units.length).values():
+        lo, hi = m.range
+        for col in m.columns(len(cfg.dexterity.band_edges) - 1):
+            if col in pareto.columns and not pareto[col].between(lo, hi).all():
+                problems.append(f"pareto.csv: {col} outside [{lo:g}, {hi:g}]")
     shares = [c for c in pareto.columns if c.startswith("band") and c.endswith("_share")]
     nonempty = pareto["voxels"] > 0
     if shares and not np.allclose(pareto.loc[nonempty, shares].sum(axis=1), 1.0, atol=1e-9):

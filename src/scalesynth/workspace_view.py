@@ -191,17 +191,34 @@ def boundary_points(mask: np.ndarray, axes: Sequence[np.ndarray], max_points: in
     return pts, flat
 
 
+def task_geometry(cfg):
+    """The task box as a (2, 3) array (lo, hi; planar: third axis 0) and the task path (n, 3), each or None."""
+    task = cfg.task
+    if task is None:
+        return None, None
+    box = np.zeros((2, 3))
+    for a, name in enumerate(cfg.mech.task_axes):
+        box[:, a] = task.box[name]
+    path = None
+    if task.path is not None:
+        p = np.asarray(task.path, dtype=float)
+        path = np.pad(p, ((0, 0), (0, 3 - p.shape[1])))[:, :3]
+    return box, path
+
+
 # ----- choosing a design of a run ----------------------------------------------------------------------------------
-def choose_row(problem, pareto, choice: str, measure_key: str) -> tuple[int, str]:
-    """Row of pareto.csv for ``choice``: 'knee', 'best-<metric>' (a column of pareto.csv, or 'volume'/'area' for the
-    workspace measure; best = the objective's sense, otherwise the largest) or a row number. Returns (row, label)."""
-    from scalesynth.report import objective_matrix
+def choose_row(result, choice: str) -> tuple[int, str]:
+    """Row of a run's pareto.csv for ``choice``: 'knee', 'best-<metric>' (a column of pareto.csv, or 'volume'/'area'
+    for the workspace measure; best = the objective's sense, otherwise the largest) or a row number. ``result``:
+    a results.RunResult. Returns (row, label)."""
     from scalesynth.selection import choose
 
+    problem, pareto = result.problem, result.pareto
+    measure_key = result.cfg.mech.measure_key(result.cfg.units.length)
     if not len(pareto):
         raise InvalidParameter("--design: the front is empty (no feasible design), nothing to show")
     if choice == "knee":
-        return choose(objective_matrix(problem, pareto), "knee"), "knee"
+        return choose(result.objective_matrix(), "knee"), "knee"
     if choice.startswith("best-"):
         metric = choice[5:]
         col = measure_key if metric in ("volume", "area", "measure") else metric

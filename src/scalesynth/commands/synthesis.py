@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import SetOpt, app, handles_errors
+from scalesynth.cliapp import SetOpt, app, handles_errors
 
 
 @app.command("optimize")
@@ -25,6 +25,7 @@ def optimize_cmd(
     from scalesynth.config import load_config
     from scalesynth.optimize import run
     from scalesynth.progress import make_progress
+    from scalesynth.results import infeasibility_lines
 
     cfg = load_config(config, sets)
     progress = make_progress(cfg.algorithm.n_gen, quiet)
@@ -34,6 +35,8 @@ def optimize_cmd(
         if progress is not None:
             progress.close()
     m = result.manifest
+    for line in infeasibility_lines(m):
+        typer.echo(line, err=True)
     typer.echo(
         f"{m['name']}: {m['pareto_size']} Pareto designs, HV {m['hypervolume']:.6g}, "
         f"{m['evaluations']} evaluations in {m['wall_seconds']:.1f} s -> {result.out_dir}",
@@ -57,8 +60,9 @@ def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directo
                    out: PlotOut = None, fmt: PlotFormat = "png") -> None:
     """Pareto front with the config's reference designs re-evaluated, and hypervolume per generation."""
     from scalesynth.report import plot_front
+    from scalesynth.results import load
 
-    _echo_files(run_dir, plot_front(run_dir, out, fmt)["files"])
+    _echo_files(run_dir, plot_front(load(run_dir, require_finished=False), out, fmt)["files"])
 
 
 @app.command("plot-bands")
@@ -68,8 +72,9 @@ def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directo
     """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs;
     per-band Pareto sets (bands/pareto_band<k>.csv and their plots)."""
     from scalesynth.report import plot_bands
+    from scalesynth.results import load
 
-    info = plot_bands(run_dir, out, fmt)
+    info = plot_bands(load(run_dir, require_finished=False), out, fmt)
     _echo_files(run_dir, info["files"] + info["band_files"])
 
 
@@ -96,7 +101,7 @@ def select_cmd(
             raise InvalidParameter(f"--weights: expected comma-separated numbers, got {weights!r}") from None
     chosen = select_design(run_dir, method, w, out)
     if as_json:
-        from scalesynth.cli import _print_json
+        from scalesynth.cliapp import _print_json
 
         _print_json(chosen)
         return

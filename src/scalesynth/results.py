@@ -1,0 +1,128 @@
+"""The results directory (``results/<name>/``): its files, writing them, loading them, the manifest, "finished".
+
+The one module that knows the layout. ``optimize.run`` builds a :class:`RunResult` in memory and writes it here
+(tables first, then the caller's plots/report from the same object, the manifest last: its presence marks a
+finished run); ``select``, the ``plot-*`` commands, ``reproduce``, ``batch`` and the validator load it here.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from scalesynth import io as rio
+from scalesynth.config import RunConfig, dump_config, load_config
+from scalesynth.errors import ConfigError
+from scalesynth.problem import SynthesisProblem
+
+PARETO, POPULATION, HISTORY, MANIFEST, CONFIG, REPORT = (
+    "pareto.csv", "population.csv", "history.csv", "manifest.json", "config.yaml", "report.md",
+)
+TABLES = (PARETO, POPULATION, HISTORY, CONFIG)
+FILES = (PARETO, POPULATION, HISTORY, MANIFEST, CONFIG, REPORT)
+CHECKPOINT = rio.CHECKPOINT
+PLOTS = "plots"
+
+
+@dataclass
+class RunResult:
+    """A run's results in memory. ``problem`` is the run's SynthesisProblem (columns, objective keys and signs),
+    built once: by the run itself, or from the config when loaded."""
+
+    out_dir: Path
+    cfg: RunConfig
+    pareto: pd.DataFrame
+    history: pd.DataFrame
+    manifest: dict[str, Any]
+    population: pd.DataFrame | None = None
+    problem: SynthesisProblem | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        self.out_dir = Path(self.out_dir)
+        if self.problem is None:
+            self.problem = SynthesisProblem(self.cfg)
+
+    def objective_matrix(self, frame: pd.DataFrame | None = None) -> np.ndarray:
+        """Objectives of the rows (default: the front) in minimisation form."""
+        frame = self.pareto if frame is None else frame
+        return frame[self.problem.objective_keys].to_numpy(dtype=float) * self.problem.signs
+
+    def design_of(self, row: pd.Series) -> dict[str, float]:
+        """The full design of a results row (design variables over the config's fixed parameters)."""
+        d = dict(self.problem.base_design)
+        d.update({k: float(row[k]) for k in self.problem.var_names})
+        return d
+
+
+def expected_pareto_columns(problem: SynthesisProblem) -> list[str]:
+    """pareto.csv's columns: design variables, derived columns, every catalogue metric column, rank."""
+    cfg = problem.cfg
+    return [*problem.var_names, *cfg.mech.derived_columns(problem.base_design), *problem.metric_columns, "rank"]
+
+
+def write_tables(result: RunResult) -> None:
+    """pareto.csv, population.csv, history.csv and config.yaml (each atomically)."""
+    out = rio.ensure_dir(result.out_dir)
+    rio.write_csv(out / PARETO, result.pareto)
+    if result.population is not None:
+        rio.write_csv(out / POPULATION, result.population)
+    rio.write_csv(out / HISTORY, result.history)
+    rio.write_text(out / CONFIG, dump_config(result.cfg))
+
+
+def write_manifest(result: RunResult) -> None:
+    """manifest.json, written last: its presence (status 'finished') marks a finished run."""
+    rio.write_json(result.out_dir / MANIFEST, result.manifest)
+
+
+def read_manifest(out_dir: Path) -> dict[str, Any] | None:
+    """The manifest of a results directory, or None if it has none (or an unreadable one)."""
+    path = Path(out_dir) / MANIFEST
+    if not path.is_file():
+        return None
+    try:
+        return json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError, UnicodeDecodeError):
+        return None
+
+
+def finished(out_dir: Path, digest: str | None = None) -> bool:
+    """True if ``out_dir`` holds a finished run (of the config with this digest, when given)."""
+    manifest = read_manifest(out_dir)
+    if manifest is None or manifest.get("status") != "finished":
+        return False
+    return digest is None or manifest.get("config_digest") == digest
+
+
+def load(out_dir: Path, *, require_finished: bool = True) -> RunResult:
+    """Read a results directory into a RunResult; ConfigError (exit 2) naming the missing or broken file.
+
+    ``require_finished``: the manifest must exist (a finished run); otherwise the tables and config suffice
+    (plots of a directory whose manifest was lost)."""
+    out = Path(out_dir)
+    manifest = read_manifest(out)
+    if require_finished and manifest is None:
+        raise ConfigError(f"{out}: not a finished scalesynth run (no readable {MANIFEST})")
+    for name in (CONFIG, PARETO, HISTORY):
+        if not (out / name).is_file():
+            raise ConfigError(f"{out}: not a scalesynth results directory (missing {name})")
+    cfg = load_config(out / CONFIG)
+    try:
+        pareto = pd.read_csv(out / PARETO)
+        history = pd.read_csv(out / HISTORY)
+        population = pd.read_csv(out / POPULATION) if (out / POPULATION).is_file() else None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{out}: unreadable results table ({err.__class__.__name__})") from None
+    return RunResult(out_dir=out, cfg=cfg, pareto=pareto, history=history, manifest=manifest or {},
+                     population=population)
+
+
+def infeasibility_lines(manifest: dict[str, Any]) -> list[str]:
+    """'no feasible design: task_coverage best 0.0002, needs >= 1.0', one per constraint (none when feasible)."""
+    return [f"no feasible design: {d['constraint']} best {d['best']:.4g}, needs {d['needs']}"
+            for d in manifest.get("no_feasible_design", [])]
