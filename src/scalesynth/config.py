@@ -14,6 +14,7 @@ from typing import Any, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from scalesynth.cycle import config as cycle_config
 from scalesynth.errors import ConfigError, ScalesynthError
 
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
@@ -145,6 +146,7 @@ class RunConfig(_Strict):
     grid: GridConfig = Field(default_factory=GridConfig)
     dexterity: DexterityConfig = Field(default_factory=DexterityConfig)
     task: TaskConfig | None = None
+    cycle: cycle_config.CycleConfig | None = Field(None, description="pick-and-place cycle (scalesynth.cycle)")
     references: dict[str, dict[str, float]] = Field(
         default_factory=dict, description="labelled designs re-evaluated and drawn beside the front (e.g. a paper's)"
     )
@@ -205,6 +207,8 @@ class RunConfig(_Strict):
                     raise ValueError(f"task.box.{axis}: missing (the box needs every task axis: {axes})")
             if self.task.path is not None and len(self.task.path[0]) != len(mech.task_axes):
                 raise ValueError(f"task.path: points need {len(mech.task_axes)} coordinates for {mech.name}")
+        if self.cycle is not None:
+            cycle_config.check(self.cycle, mech)
         if len(self.objectives) < 1:
             raise ValueError("objectives: need at least one")
         return self
@@ -220,7 +224,8 @@ class RunConfig(_Strict):
         for where, items in (("objectives", self.objectives), ("constraints", self.constraints)):
             for i, item in enumerate(items):
                 try:
-                    m = resolve(mech, self.units.length, item.metric, item.band, n_bands, has_task, has_path, options)
+                    m = resolve(mech, self.units.length, item.metric, item.band, n_bands, has_task, has_path, options,
+                                self.cycle)
                 except ValueError as err:
                     raise ValueError(f"{where}[{i}].{err}") from None
                 if where == "objectives" and item.sense == "min" and m.worst is None:

@@ -133,11 +133,12 @@ def _metrics_of(
     band_edges: Sequence[float],
     unit: str,
     task: Any,
+    cycle: Any = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of the designs: workspace statistics given, task statistics and the computed
     families (design, path) evaluated here."""
     has_path = task is not None and task.path is not None
-    entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options)
+    entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
     n_bands = len(band_edges) - 1
     out = stats_to_metrics(mech, workspace_stats, cell, 0.0, [m for m in entries if m.family == "workspace"],
                            n_bands)
@@ -148,7 +149,7 @@ def _metrics_of(
         tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
         out.update(stats_to_metrics(mech, tstats, np.full(n, tg.cell_measure), float(tg.n_cells),
                                     [m for m in entries if m.family == "task" and m.compute is None], n_bands))
-    ctx = _metrics.EvalContext(mech, resolved, options, packed, task, resolution, band_edges, unit)
+    ctx = _metrics.EvalContext(mech, resolved, options, packed, task, resolution, band_edges, unit, cycle)
     for m in entries:
         if m.compute is not None:
             out[m.column] = np.asarray(m.compute(ctx), dtype=float)
@@ -217,9 +218,11 @@ def evaluate(
     length_unit: str | None = None,
     keep_grid: bool = False,
     task: Any = None,
+    cycle: Any = None,
 ) -> WorkspaceReport:
     """Evaluate one design on a ``resolution``-per-axis grid. ``seconds`` (the workspace grid alone) excludes JIT
-    compilation. ``keep_grid``: keep every per-voxel field (WorkspaceReport.field_grid)."""
+    compilation. ``keep_grid``: keep every per-voxel field (WorkspaceReport.field_grid). ``cycle`` (a config
+    CycleConfig): also the cycle metrics."""
     design = mech.resolve_design(design)
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
@@ -231,7 +234,7 @@ def evaluate(
     stats = mech.grid_stats(packed, g.lo[None, :], g.step[None, :], g.shape, edges)
     seconds = time.perf_counter() - t0
     values = _metrics_of(mech, [design], options, packed, stats, np.array([g.cell_measure]), resolution, band_edges,
-                         unit, task)
+                         unit, task, cycle)
     metrics = {k: v[0].item() for k, v in values.items()}
     fields = None
     if keep_grid:
@@ -275,17 +278,18 @@ def evaluate_population(
     band_edges: Sequence[float] = DEFAULT_BAND_EDGES,
     length_unit: str | None = None,
     task: Any = None,
+    cycle: Any = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of many designs, column name -> (n,) array; the workspace grids in one parallel
     kernel call (no Python work per voxel); with ``task`` (a config TaskConfig) also the task-box and path
-    metrics."""
+    metrics, with ``cycle`` (a config CycleConfig) the cycle metrics."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
     n = len(resolved)
     if n == 0:
         has_path = task is not None and task.path is not None
-        cols = _metrics.result_columns(mech, unit, len(band_edges) - 1, task is not None, has_path, options)
+        cols = _metrics.result_columns(mech, unit, len(band_edges) - 1, task is not None, has_path, options, cycle)
         return {k: np.zeros(0) for k in cols}
     packed = np.stack([mech.pack(d, options) for d in resolved])
     grids = [make_grid(mech, d, options, resolution, region) for d in resolved]
@@ -294,7 +298,7 @@ def evaluate_population(
     edges = np.asarray(band_edges, dtype=float)
     stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
     cell = np.array([g.cell_measure for g in grids])
-    return _metrics_of(mech, resolved, options, packed, stats, cell, resolution, band_edges, unit, task)
+    return _metrics_of(mech, resolved, options, packed, stats, cell, resolution, band_edges, unit, task, cycle)
 
 
 def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid: bool = False) -> WorkspaceReport:
@@ -309,11 +313,15 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
         length_unit=cfg.units.length,
         keep_grid=keep_grid,
         task=cfg.task,
+        cycle=cfg.cycle,
     )
 
 
 def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> dict[str, np.ndarray]:
-    """All metrics of many designs under one config, in one parallel kernel call per grid."""
+    """All metrics of many designs under one config, in one parallel kernel call per grid. The cycle metrics
+    (seconds per design) only when an objective or constraint uses one (``cycle.config.searched``)."""
+    from scalesynth.cycle.config import searched
+
     return evaluate_population(
         cfg.mech,
         designs,
@@ -323,4 +331,5 @@ def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> d
         band_edges=cfg.dexterity.band_edges,
         length_unit=cfg.units.length,
         task=cfg.task,
+        cycle=searched(cfg),
     )

@@ -12,7 +12,7 @@ Families:
 * ``path``: along the config's task path;
 * ``design``: from the design parameters alone (``Mechanism.design_metrics``: link_length_sum, footprint_radius,
   strokes);
-* ``cycle``: reserved for metrics of a motion cycle (none yet).
+* ``cycle``: along the config's pick-and-place cycle (``scalesynth.cycle``; needs a ``cycle`` section).
 
 Per-voxel field statistics are generated from each mechanism's ``fields``: adding a field to a mechanism (its
 field kernel and its ``fields`` entry) adds ``mean_<f>``, ``std_<f>``, ``min_<f>``, ``max_<f>`` and their
@@ -55,6 +55,7 @@ class EvalContext:
     resolution: int
     band_edges: Sequence[float]
     length_unit: str
+    cycle: Any = None  # config CycleConfig or None
     cache: dict[str, Any] = field(default_factory=dict)  # shared between compute functions (e.g. path samples)
 
 
@@ -199,6 +200,54 @@ def _path_mean_lci(ctx: EvalContext) -> np.ndarray:
     return np.where(lci >= 0, lci, 0.0).mean(axis=1)
 
 
+def _cycle_values(ctx: EvalContext) -> dict[str, np.ndarray]:
+    """Every cycle metric of every design (scalesynth.cycle.analysis.metrics), computed once per context."""
+    if "cycle" not in ctx.cache:
+        from scalesynth.cycle import analysis
+
+        rows = [analysis.metrics(ctx.mech, d, ctx.options, ctx.cycle, ctx.length_unit) for d in ctx.designs]
+        ctx.cache["cycle"] = {k: np.array([r.get(k, 0.0) for r in rows], dtype=float) for k in analysis.METRICS}
+    return ctx.cache["cycle"]
+
+
+def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
+    from scalesynth.cycle.analysis import CYCLE_PENALTY
+
+    def entry(name, unit, rng, better, worst, needs, description):
+        def compute(ctx: EvalContext, name=name) -> np.ndarray:
+            return _cycle_values(ctx)[name]
+
+        return Metric(name, _with_unit(name, unit), "cycle", None, None, unit, rng, better, worst, needs,
+                      description, compute=compute)
+
+    lu = length_unit
+    kinds = set(mech.joint_units)
+    # one unit when every actuator is of one kind; mixed actuators (pprs-rprs) give a plain column name
+    speed, accel, force = {frozenset({"angle"}): ("rad/s", "rad/s^2", "N m"),
+                           frozenset({"length"}): (f"{lu}/s", f"{lu}/s^2", "N")}.get(frozenset(kinds), ("", "", ""))
+    failed = f"; {CYCLE_PENALTY:g} if the cycle cannot be followed"
+    return [
+        entry("cycle_feasible", "1", (0.0, 1.0), "max", 1.0, ("cycle",),
+              "1 if the cycle stays in the workspace without branch jump or singularity, with clearance >= 0 and "
+              "within the cycle's speed and force limits, else 0"),
+        entry("cycle_max_actuator_speed", speed, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
+              f"largest |qd_i| over the cycle and the actuators ({lu}/s or rad/s, per actuator type){failed}"),
+        entry("cycle_max_actuator_accel", accel, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
+              f"largest |qdd_i| over the cycle and the actuators ({lu}/s^2 or rad/s^2){failed}"),
+        entry("cycle_max_actuator_force", force, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
+              f"largest actuator force or torque for the payload, quasi-static plus payload inertia (N or N m)"
+              f"{failed}"),
+        entry("cycle_min_lci", "1", (0.0, 1.0), "max", 1.0, ("cycle",),
+              "smallest LCI along the cycle (0 if it cannot be followed)"),
+        entry("cycle_min_clearance", lu, (-CYCLE_PENALTY, math.inf), "max", None,
+              ("cycle",), f"smallest distance between non-adjacent link capsules along the cycle ({lu}; < 0: "
+              f"interference; -{CYCLE_PENALTY:g} if the cycle cannot be followed)"),
+        entry("max_cycles_per_minute", "", (0.0, math.inf), "max", None, ("cycle", "cycle.limits"),
+              "highest cycle rate within the actuator speed and force limits of the cycle section (cycles per "
+              "minute; 0 if gravity alone exceeds a force limit or the cycle cannot be followed)"),
+    ]
+
+
 _CACHE: dict[tuple[str, str], dict[str, Metric]] = {}
 
 
@@ -242,6 +291,7 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
                compute=_path_mean_lci),
     ]
     entries += [_design_entry(mech, dm, unit) for dm in mech.design_metrics]
+    entries += _cycle_entries(mech, unit)
     out = {}
     for m in entries:
         if m.name in out:
@@ -251,9 +301,15 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
     return out
 
 
-def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None) -> str | None:
-    """Why ``m`` cannot be evaluated under a config (a phrase), or None if it can."""
+def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None,
+               cycle: Any = None) -> str | None:
+    """Why ``m`` cannot be evaluated under a config (a phrase), or None if it can. ``cycle``: the config's
+    CycleConfig or None."""
     for need in m.needs:
+        if need == "cycle" and cycle is None:
+            return "needs a cycle section"
+        if need == "cycle.limits" and cycle is not None and cycle.speed_limits is None and cycle.force_limits is None:
+            return "needs cycle.speed_limits or cycle.force_limits"
         if need == "task" and not has_task:
             return "needs a task section"
         if need == "path" and not has_path:
@@ -264,15 +320,17 @@ def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, 
 
 
 def result_metrics(mech: Mechanism, length_unit: str, has_task: bool, has_path: bool,
-                   options: Mapping[str, Any] | None = None) -> list[Metric]:
+                   options: Mapping[str, Any] | None = None, cycle: Any = None) -> list[Metric]:
     """The metrics evaluated for a config (catalogue order)."""
-    return [m for m in catalogue(mech, length_unit).values() if applicable(m, has_task, has_path, options) is None]
+    return [m for m in catalogue(mech, length_unit).values()
+            if applicable(m, has_task, has_path, options, cycle) is None]
 
 
 def result_columns(mech: Mechanism, length_unit: str, n_bands: int, has_task: bool, has_path: bool,
-                   options: Mapping[str, Any] | None = None) -> list[str]:
+                   options: Mapping[str, Any] | None = None, cycle: Any = None) -> list[str]:
     """Every metric column of a config's results, in a fixed order."""
-    return [c for m in result_metrics(mech, length_unit, has_task, has_path, options) for c in m.columns(n_bands)]
+    return [c for m in result_metrics(mech, length_unit, has_task, has_path, options, cycle)
+            for c in m.columns(n_bands)]
 
 
 def all_field_names() -> set[str]:
@@ -282,7 +340,7 @@ def all_field_names() -> set[str]:
 
 
 def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_bands: int, has_task: bool,
-            has_path: bool, options: Mapping[str, Any] | None = None) -> Metric:
+            has_path: bool, options: Mapping[str, Any] | None = None, cycle: Any = None) -> Metric:
     """The catalogue entry of a config's objective/constraint. Raises ValueError with a message that starts with
     the sub-field it is about ('metric: ...' or 'band: ...') and lists the valid choices."""
     cat = catalogue(mech, length_unit)
@@ -294,10 +352,10 @@ def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_ba
                 if name.startswith(head) and fname in all_field_names():
                     raise ValueError(f"metric: {name}: field {fname!r} is not provided by {mech.name} "
                                      f"(fields: {', '.join(mech.field_names)})")
-        usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options) is None]
+        usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options, cycle) is None]
         raise ValueError(f"metric: unknown metric {name!r} for {mech.name} (valid: {', '.join(usable)})")
     m = cat[name]
-    why = applicable(m, has_task, has_path, options)
+    why = applicable(m, has_task, has_path, options, cycle)
     if why is not None:
         raise ValueError(f"metric: {name} {why}")
     if "band" in m.needs:
@@ -347,7 +405,8 @@ def markdown() -> str:
         "(`constraints: [{metric: NAME, min: .., max: ..}]`), and appears in `pareto.csv` / `population.csv` under",
         "its column name (units in the name; `{band}` is the band index k, chosen with `band: k`). Families:",
         "`workspace` (statistic of a per-voxel field over the reachable workspace), `task` (over the reachable part",
-        "of `task.box`; needs a task), `path` (along `task.path`), `design` (from the design parameters). A",
+        "of `task.box`; needs a task), `path` (along `task.path`), `design` (from the design parameters), `cycle`",
+        "(along the config's `cycle`, see the README's Cycles section). A",
         "minimised objective needs a finite worst value for the hypervolume reference: `bounding_box` is the",
         "bounding-box measure of the largest design in the bounds, `bounds_corners` the largest value over the",
         "corners of the bounds; metrics without one can be maximised or constrained.",

@@ -334,5 +334,71 @@ def task_figure(lci: np.ndarray, extent, path: np.ndarray | None, band_edges, xl
     return fig
 
 
+def _mark_segments(ax, vertex_times: np.ndarray) -> None:
+    """Vertical lines at the cycle's vertex times, numbered (vertex k reached at vertex_times[k])."""
+    for k, t in enumerate(vertex_times):
+        ax.axvline(t, color="0.75", lw=0.8, zorder=0)
+        ax.annotate(str(k % (len(vertex_times) - 1) + 1), (t, 1.0), xycoords=("data", "axes fraction"),
+                    ha="center", va="bottom", fontsize=7, color="0.4")
+
+
+def cycle_actuator_figure(t, series: Sequence[tuple[str, Sequence[tuple[str, np.ndarray]]]], vertex_times, title):
+    """One row per quantity (e.g. 'q1 (rad)' ...), one column per actuator: ``series`` is a list of
+    (actuator label, [(axis label with unit, values (n,)), ...]); vertex times marked and numbered."""
+    n_act = len(series)
+    n_rows = len(series[0][1])
+    fig, axes = plt.subplots(n_rows, n_act, figsize=(3.2 * n_act + 1, 2.0 * n_rows + 1), sharex=True, squeeze=False)
+    for j, (name, rows) in enumerate(series):
+        for i, (label, values) in enumerate(rows):
+            ax = axes[i, j]
+            ax.plot(t, values, lw=1.2, c=f"C{i}")
+            ax.set_ylabel(label, fontsize=8)
+            ax.tick_params(labelsize=7)
+            ax.grid(alpha=0.3)
+            _mark_segments(ax, vertex_times)
+        axes[0, j].set_title(name, fontsize=9, pad=12)
+        axes[-1, j].set_xlabel("t (s)")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def cycle_path_figure(lci, extent, path: np.ndarray, vertices: np.ndarray, band_edges, xlabel, ylabel, title):
+    """The cycle's path drawn on an LCI section of the workspace (unreachable cells blank), vertices numbered."""
+    fig, ax = plt.subplots(figsize=(7.0, 5.5))
+    data = np.ma.masked_less(np.asarray(lci).T, 0.0)
+    norm = BoundaryNorm(np.linspace(0, 1, 21), 256)
+    im = ax.imshow(data, origin="lower", extent=extent, cmap="viridis", norm=norm, aspect="equal")
+    ax.plot(path[:, 0], path[:, 1], "-", c="k", lw=1.5, label="cycle path")
+    for k, (x, y) in enumerate(vertices[:-1]):
+        ax.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8, color="k")
+    ax.plot(vertices[:, 0], vertices[:, 1], "o", c="w", mec="k", ms=4)
+    cb = fig.colorbar(im, ax=ax, ticks=band_edges)
+    cb.set_label("LCI")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    return fig
+
+
+def cycle_quality_figure(t, lci, clearance, vertex_times, clearance_label, title):
+    """LCI and link clearance over the cycle (clearance 0 = capsules touching, drawn red)."""
+    fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+    axes[0].plot(t, lci, c="C0")
+    axes[0].set_ylabel("LCI")
+    axes[1].plot(t, clearance, c="C2")
+    axes[1].axhline(0.0, c="C3", lw=1)
+    axes[1].set_ylabel(clearance_label)
+    axes[1].set_xlabel("t (s)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        _mark_segments(ax, vertex_times)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
 def close(fig) -> None:
     plt.close(fig)

@@ -29,9 +29,11 @@ def metric_key(cfg: RunConfig, item: ObjectiveConfig | ConstraintConfig) -> str:
 
 def result_columns(cfg: RunConfig) -> list[str]:
     """Every metric column of the config's results (catalogue order)."""
+    from scalesynth.cycle.config import searched
+
     has_task = cfg.task is not None
     return _metrics.result_columns(cfg.mech, cfg.units.length, len(cfg.dexterity.band_edges) - 1, has_task,
-                                   has_task and cfg.task.path is not None, cfg.resolved_options())
+                                   has_task and cfg.task.path is not None, cfg.resolved_options(), searched(cfg))
 
 
 def objective_label(cfg: RunConfig, obj: ObjectiveConfig) -> str:

@@ -222,6 +222,19 @@ class Mechanism(ABC):
     def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
         """'none', 'inverse', 'forward' or 'both'."""
 
+    # ----- cycle analysis and interference (scalesynth.cycle); optional: a mechanism without them says so --
+    def link_geometry(self, design, options, pose, q):
+        """Bodies at a pose with joint values q as named capsules, and which bodies share a joint
+        (:class:`scalesynth.mechanisms.links.LinkGeometry`, mechanism frame, length unit, planar z = 0)."""
+        raise InvalidParameter(f"mechanism: {self.name} has no link geometry yet (cycle and clearance need it)")
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """Square matrix A (n_joints x n_joints) with q_dot = A [x_dot; 0]: its first len(task_axes) columns
+        map task-axis rates (length or rad per unit time) to actuator rates, any further columns the rates of
+        the degrees of freedom the task holds constant (pprs-rprs: the angular velocity). The inverse of the
+        forward Jacobian; actuator forces of a task-space force F follow from A^T tau = [F; 0]."""
+        raise InvalidParameter(f"mechanism: {self.name} has no velocity map yet (cycle analysis needs it)")
+
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
         """Statistics rows of every field for many designs (layout in kernels.grid). A mechanism may override this
         with a faster kernel that feeds the same accumulator (kernels.grid.accumulate_column)."""

@@ -19,6 +19,7 @@ from scalesynth.errors import InvalidParameter
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import SIGMA_CAP, inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Mechanism,
@@ -33,6 +34,8 @@ from scalesynth.mechanisms.base import (
 )
 
 MODES = ("++", "+-", "-+", "--")
+# default capsule radii (m), illustrative (the paper gives no cross-sections)
+LINK_RADII = {"base": 0.05, "arm1": 0.03, "arm2": 0.03, "link1": 0.02, "link2": 0.02, "platform": 0.05}
 
 # packed-parameter layout (see PauuPpap.pack)
 _DELTA, _L1, _L2, _E, _S1, _S2 = 0, 1, 2, 3, 4, 5
@@ -382,6 +385,7 @@ class PauuPpap(Mechanism):
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                     raise InvalidParameter(f"options.{name}: expected a finite number or null, got {value!r}")
                 options[name] = float(value)
+        links.check_radius_option(options, LINK_RADII)
 
     def offset_e(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         e = options.get("e")
@@ -555,6 +559,36 @@ class PauuPpap(Mechanism):
             return 0.0
         return svd_lci(jac["J"])
 
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules (design length unit) at P = (x, y, z) with inputs q = (theta1, theta2, d), frame of spec §1.1
+        as in ``joint_screws``: base A2 -> A1 with A_i = (+-m, 0, e); arm_i (the parallelogram's long link l1)
+        A_i -> C_i = (+-(m + l1 cos theta_i), 0, e - l1 sin theta_i); link_i (l2, between the U joints)
+        C_i -> D_i = (x +- n, y, z); platform D2 -> D1. Each parallelogram is drawn as its one long link and the
+        PPaP chain is not modelled (the paper gives none of its dimensions). Adjacent: base-arm_i, arm_i-link_i,
+        link_i-platform. Radii: option ``link_radius``, defaults LINK_RADII (m)."""
+        x, y, z = self.check_vector("pose", pose, 3)
+        t1, t2, _ = self.check_vector("inputs", q, 3)
+        m, n, l1 = design["m"], design["n"], design["l1"]
+        e = self.offset_e(design, options)
+        rad = links.radii(options, LINK_RADII)
+        a = {1: links.point(m, 0.0, e), -1: links.point(-m, 0.0, e)}
+        c = {s: links.point(s * (m + l1 * math.cos(t)), 0.0, e - l1 * math.sin(t)) for s, t in ((1, t1), (-1, t2))}
+        d = {s: links.point(x + s * n, y, z) for s in (1, -1)}
+        ends = {"base": (a[-1], a[1]), "arm1": (a[1], c[1]), "arm2": (a[-1], c[-1]), "link1": (c[1], d[1]),
+                "link2": (c[-1], d[-1]), "platform": (d[-1], d[1])}
+        segments = tuple(links.Segment(k, k, u, v, rad[k]) for k, (u, v) in ends.items())
+        return links.LinkGeometry(segments, links.adjacency([
+            ("base", "arm1"), ("base", "arm2"), ("arm1", "link1"), ("arm2", "link2"), ("link1", "platform"),
+            ("link2", "platform"),
+        ]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """A = Jq^-1 Jx: q_dot = A P_dot (rad and length per unit time), the inverse of J = Jx^-1 Jq; rows with an
+        inverse singularity (Jq_ii = 0) are infinite."""
+        jac = self.jacobians(design, options, pose, q)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return jac["Jx"] / np.diag(jac["Jq"])[:, None]
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of paper §1 for the G-K counts, each parallelogram Pa counted as one 1-DOF joint:
@@ -634,6 +668,8 @@ MECHANISM = PauuPpap(
         Option("theta2_limits", None, "[lo, hi] rad for theta2 (convention T), null = none"),
         Option("stroke_limits", None, "[lo, hi] for the stroke d = y, null = none"),
         Option("z_min", None, "keep only z >= z_min, null = none"),
+        Option("link_radius", None, "capsule radius of every body, or {body: radius}; null = defaults base 0.05, "
+               "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative)"),
     ),
     default_length_unit="m",
     fields=base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is dimensionless; "

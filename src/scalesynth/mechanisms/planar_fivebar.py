@@ -31,8 +31,10 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import planar_capsule_gap
 from scalesynth.kernels.conditioning import SIGMA_CAP, sv_2x2
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Mechanism,
@@ -47,13 +49,18 @@ from scalesynth.mechanisms.base import (
 )
 
 MODES = ("++", "+-", "-+", "--")
+# default capsule radii (mm) of the bodies, illustrative like the lengths: the platform ball carries the gripper
+LINK_RADII = {"base": 25.0, "arm1": 20.0, "arm2": 20.0, "forearm1": 15.0, "forearm2": 15.0, "platform": 40.0}
 TWO_PI = 2.0 * math.pi
 
 # packed-parameter layout (see PlanarFivebar.pack); arm limit i occupies 6 slots from _LIM[i]:
 # has, cos lo, sin lo, cos hi, sin hi, wide (1 if hi - lo > pi)
 _R, _L1, _L2, _S1, _S2 = 0, 1, 2, 3, 4
 _LIM1, _LIM2 = 5, 11
-N_PACKED = 17
+# capsule radii of base, arm1, arm2, forearm1, forearm2, platform (order of LINK_RADII); 1 = interference-free only
+_RAD = 17
+_FREE_ONLY = 23
+N_PACKED = 24
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -99,7 +106,8 @@ def _arc_ok(p, k, c, s):
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """Fields at P = (x, y) in the packed working mode (kernels.grid contract): LCI (sigma_min/sigma_max of J),
-    sigma_min and sigma_max of J = dx/dq (mm/rad); LCI -1 if unreachable; z unused."""
+    sigma_min and sigma_max of J = dx/dq (mm/rad), clearance (mm) of the link capsules; LCI -1 if unreachable (or,
+    with interference_free, where the capsules overlap); z unused."""
     r = p[_R]
     l1 = p[_L1]
     l2 = p[_L2]
@@ -116,6 +124,25 @@ def point_fields(p, x, y, z, out):
     if not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
         _grid.write_unreachable(out)
         return
+    # clearance (field 3): capsules base B2-B1, arm_i B_i-Q_i, forearm_i Q_i-P, platform ball at P; the pairs that
+    # share no joint (as in link_geometry)
+    q1x = r + l1 * c1
+    q1y = l1 * s1
+    q2x = -r + l1 * c2
+    q2y = l1 * s2
+    rb, ra1, ra2, rf1, rf2, rp = p[_RAD], p[_RAD + 1], p[_RAD + 2], p[_RAD + 3], p[_RAD + 4], p[_RAD + 5]
+    gap = planar_capsule_gap(-r, 0.0, r, 0.0, rb, q1x, q1y, x, y, rf1)
+    gap = min(gap, planar_capsule_gap(-r, 0.0, r, 0.0, rb, q2x, q2y, x, y, rf2))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, r, 0.0, rb, x, y, x, y, rp))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, -r, 0.0, q2x, q2y, ra2))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, q2x, q2y, x, y, rf2))
+    gap = min(gap, planar_capsule_gap(r, 0.0, q1x, q1y, ra1, x, y, x, y, rp))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, q2x, q2y, ra2, q1x, q1y, x, y, rf1))
+    gap = min(gap, planar_capsule_gap(-r, 0.0, q2x, q2y, ra2, x, y, x, y, rp))
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
+    out[3] = gap
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1
@@ -159,6 +186,8 @@ class PlanarFivebar(Mechanism):
             raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
         for name in ("alpha1_limits", "alpha2_limits"):
             options[name] = parse_range(name, options[name])
+        links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(N_PACKED)
@@ -173,6 +202,8 @@ class PlanarFivebar(Mechanism):
             if lim is not None and lim[1] - lim[0] < TWO_PI:  # a full turn or more restricts nothing
                 lo, hi = lim
                 p[k : k + 6] = (1.0, math.cos(lo), math.sin(lo), math.cos(hi), math.sin(hi), hi - lo > math.pi)
+        p[_RAD : _RAD + 6] = list(links.radii(options, LINK_RADII).values())
+        p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
         return p
 
     @property
@@ -299,6 +330,31 @@ class PlanarFivebar(Mechanism):
             return 0.0
         return svd_lci(jac["J"])
 
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules in the plane z = 0 (mm): base B2 -> B1, arm_i B_i -> Q_i, forearm_i Q_i -> P, and the
+        platform as a ball at P. Adjacent (a joint between them): base-arm_i, arm_i-forearm_i, the two forearms
+        (they meet at P), forearm_i-platform. Radii: option ``link_radius``, defaults LINK_RADII."""
+        x, y = self.check_vector("pose", pose, 2)
+        q1, q2 = self.elbows(design, q)
+        rad = links.radii(options, LINK_RADII)
+        r = design["r"]
+        b1, b2, p = links.point(r, 0.0), links.point(-r, 0.0), links.point(x, y)
+        e1, e2 = links.point(*q1), links.point(*q2)
+        ends = {"base": (b2, b1), "arm1": (b1, e1), "arm2": (b2, e2), "forearm1": (e1, p), "forearm2": (e2, p),
+                "platform": (p, p)}
+        segments = tuple(links.Segment(name, name, a, b, rad[name]) for name, (a, b) in ends.items())
+        return links.LinkGeometry(segments, links.adjacency([
+            ("base", "arm1"), ("base", "arm2"), ("arm1", "forearm1"), ("arm2", "forearm2"),
+            ("forearm1", "forearm2"), ("forearm1", "platform"), ("forearm2", "platform"),
+        ]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """A = Jq^-1 Jx (rad/mm): alpha_dot = A P_dot, the inverse of J (spec §2.4); rows with an inverse
+        singularity (Jq_ii = 0) are infinite."""
+        jac = self.jacobians(design, options, pose, q)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return jac["Jx"] / np.diag(jac["Jq"])[:, None]
+
     def resolution_index(self, design, options, pose, dalpha=(1.0, 1.0)) -> float:
         """Kinematic resolution |J dalpha| (mm per the arm increments dalpha in rad; spec §2.4, paper eq. 18) in
         the working mode options['mode']. Infinite at an exact forward singularity (J unbounded); raises
@@ -368,8 +424,11 @@ MECHANISM = PlanarFivebar(
         Option("mode", "+-", "working mode sigma1 sigma2: '+-' = elbows out (operating mode), '++', '-+', '--'"),
         Option("alpha1_limits", None, "[lo, hi] rad for alpha1 modulo 2 pi, null = none (spec: [-4pi/9, 7pi/36])"),
         Option("alpha2_limits", None, "[lo, hi] rad for alpha2 modulo 2 pi, null = none (spec: [29pi/36, 13pi/9])"),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults "
+               "base 25, arm1/arm2 20, forearm1/forearm2 15, platform 40 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
-    fields=base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"),
+    fields=(*base_fields("{length}/rad", "J = dx/dq (mm per rad of arm rotation)"), links.CLEARANCE_FIELD),
     design_metrics=DESIGN_METRICS,
 )

@@ -35,6 +35,7 @@ from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Mechanism,
@@ -54,6 +55,9 @@ BRANCHES = tuple(a + b + c for a in "+-" for b in "+-" for c in "+-")
 CONVENTIONS = ("O", "R")
 JOINTS = ("w1", "w2", "beta", "s1", "s2", "s3")
 CHAIN_OF_JOINT = (0, 1, 2, 0, 1, 2)
+# default capsule radii (mm), illustrative (the paper gives no cross-sections)
+LINK_RADII = {"base": 5.0, "slider1": 8.0, "slider2": 8.0, "leg3": 8.0, "link1": 5.0, "link2": 5.0, "link3": 5.0,
+              "platform": 5.0}
 
 # packed-parameter layout (see PprsRprs.pack)
 _R1, _R2, _R3 = 0, 3, 6  # rotated sphere-centre offsets r_k = R c_k' (3 each)
@@ -520,6 +524,7 @@ class PprsRprs(Mechanism):
                 if value <= 0.0:
                     raise InvalidParameter(f"options.{name}: must be > 0 (a length in mm) or null, got {value:g}")
                 options[name] = value
+        links.check_radius_option(options, LINK_RADII)
 
     # ----- kernel side -------------------------------------------------------------------------------
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
@@ -672,6 +677,42 @@ class PprsRprs(Mechanism):
             return 0.0
         sv = np.linalg.svd(scaled(geo, twist_jacobian(geo, st)), compute_uv=False)
         return float(sv[-1] / sv[0])
+
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules (mm) at a pose (x, y, z[, phi, theta, psi]) with inputs q: base = the rails O -> R u_1,
+        O -> R u_2 and the strut O -> B3; slider_i the vertical slider B_i -> D_i = B_i + s_i z on its carriage
+        (chains 1, 2); leg3 the tilting prismatic B3 -> D3 = B3 + s3 d3; link_i D_i -> C_i; platform the triangle
+        C1 C2 C3. Adjacent: base-slider1, base-slider2, base-leg3, slider_i-link_i, leg3-link3,
+        link_i-platform. Radii: option ``link_radius``, defaults LINK_RADII."""
+        X = self.full_pose(options, pose)
+        w1, w2, beta, s1, s2, s3 = self.check_vector("inputs", q, 6)
+        geo = Geometry.of(design, options)
+        c = X[:3] + geo.body @ rotation(*X[3:]).T  # rows C_1, C_2, C_3
+        rad = links.radii(options, LINK_RADII)
+        z = np.array([0.0, 0.0, 1.0])
+        o = np.zeros(3)
+        b = [(geo.rail - w if geo.conv_r else w) * geo.u[k] for k, w in enumerate((w1, w2))]
+        d = [b[0] + s1 * z, b[1] + s2 * z]
+        b3 = geo.rail * geo.u[2]
+        d3 = b3 + s3 * (-math.cos(beta) * geo.u[2] + math.sin(beta) * z)
+        parts = [
+            ("rail1", "base", o, geo.rail * geo.u[0]), ("rail2", "base", o, geo.rail * geo.u[1]),
+            ("strut3", "base", o, b3),
+            ("slider1", "slider1", b[0], d[0]), ("slider2", "slider2", b[1], d[1]), ("leg3", "leg3", b3, d3),
+            ("link1", "link1", d[0], c[0]), ("link2", "link2", d[1], c[1]), ("link3", "link3", d3, c[2]),
+            ("platform12", "platform", c[0], c[1]), ("platform23", "platform", c[1], c[2]),
+            ("platform31", "platform", c[2], c[0]),
+        ]
+        segments = tuple(links.Segment(n, body, np.array(a), np.array(e), rad[body]) for n, body, a, e in parts)
+        return links.LinkGeometry(segments, links.adjacency([
+            ("base", "slider1"), ("base", "slider2"), ("base", "leg3"), ("slider1", "link1"), ("slider2", "link2"),
+            ("leg3", "link3"), ("link1", "platform"), ("link2", "platform"), ("link3", "platform"),
+        ]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """The twist Jacobian J_t (6 x 6): q_dot = J_t [v; omega]; the task axes are v (mm/s), the held
+        orientation's angular velocity omega (rad/s) is 0 along a constant-orientation cycle (spec §1.5)."""
+        return self.jacobians(design, options, pose, q)["Jt"]
 
     def joint_limits(self, options: Mapping[str, Any]) -> np.ndarray:
         """Limits (6, 2) of (w1, w2, beta, s1, s2, s3), mm and rad."""
@@ -843,6 +884,8 @@ MECHANISM = PprsRprs(
         Option("w_convention", "O", "'O': B_i = w_i u_i (spec); 'R': B_i = (R - w_i) u_i (eq.10-12, E5)"),
         Option("beta_length", None, "mm multiplying the beta row of J_t for the LCI; null = R"),
         Option("angle_length", None, "mm dividing the angular-velocity columns of J_t for the LCI; null = r"),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 5, "
+               "slider1/slider2/leg3 8, link1/link2/link3 5, platform 5 (illustrative)"),
     ),
     default_length_unit="mm",
     fields=base_fields("1", "J = dx/dq, the twist of O1 with its angular part times angle_length and the beta input "

@@ -40,6 +40,7 @@ from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Mechanism,
@@ -542,6 +543,11 @@ _C_START_THETA = (-1.0, 0.0, 1.0, math.pi - 1.0, math.pi, 1.0 - math.pi)
 _C_START_PSI = (-0.8, 0.0, 0.8)
 
 
+# default capsule radii (mm), illustrative (the paper gives no cross-sections); the tool only on rps-upu-tool
+LINK_RADII = {"base": 6.0, "leg1": 5.0, "leg2": 5.0, "leg3": 5.0, "platform": 6.0}
+TOOL_RADII = {**LINK_RADII, "tool": 4.0}
+
+
 class RpsUpu(Mechanism):
     """Seed-002 mechanism; see module docstring."""
 
@@ -559,6 +565,7 @@ class RpsUpu(Mechanism):
             if length <= 0:
                 raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
             options["characteristic_length"] = float(length)
+        links.check_radius_option(options, LINK_RADII)
 
     @staticmethod
     def _check_limits(options: dict[str, Any]) -> None:
@@ -715,6 +722,43 @@ class RpsUpu(Mechanism):
             forward = bool(sv[-1] <= tol * sv[0])
         return singularity_label(inverse, forward)
 
+    # ----- link geometry, velocity map (scalesynth.cycle) ----------------------------------------------------
+    def _joint_points(self, design, options, pose) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Base joints A_i (3, 3), platform joints B_i = p + R b_i' (3, 3), platform origin p and R at a pose."""
+        x = self.check_vector("pose", pose, 3)
+        g, h, c, e = self._geom(design)
+        valid, p, R, _, _ = _platform(self._geom(design), options["model"], options["c3_variant"], x[None])
+        if not valid[0]:
+            raise InvalidPose(f"pose: the C-model yaw or y0 is undefined at {list(map(float, x))}")
+        a = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        b = np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]])
+        return a, p[0] + b @ R[0].T, p[0], R[0]
+
+    def _capsules(self, design, options, pose, radii):
+        a, b, _, _ = self._joint_points(design, options, pose)
+        sides = ((1, 2), (2, 3), (3, 1))
+        segs = [links.Segment(f"base{i}{j}", "base", a[i - 1], a[j - 1], radii["base"]) for i, j in sides]
+        segs += [links.Segment(f"leg{i}", f"leg{i}", a[i - 1], b[i - 1], radii[f"leg{i}"]) for i in (1, 2, 3)]
+        segs += [links.Segment(f"platform{i}{j}", "platform", b[i - 1], b[j - 1], radii["platform"])
+                 for i, j in sides]
+        adjacent = [("base", f"leg{i}") for i in (1, 2, 3)] + [(f"leg{i}", "platform") for i in (1, 2, 3)]
+        return segs, adjacent
+
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules (mm) at a pose (z, theta, psi): the base triangle A1 A2 A3, each leg A_i -> B_i (cylinder and
+        piston as one capsule) and the platform triangle B1 B2 B3 (spec §2.2, the configured model). Adjacent:
+        base-leg_i, leg_i-platform. q is not needed (the legs are the segments A_i B_i). Radii: option
+        ``link_radius``, defaults LINK_RADII."""
+        segs, adjacent = self._capsules(design, options, pose, links.radii(options, LINK_RADII))
+        return links.LinkGeometry(tuple(segs), links.adjacency(adjacent))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """dq/d(z, theta, psi) (mm/mm, mm/rad), the spec's dq_dx (§2.5); infinite rows where a leg length is 0."""
+        jac = self.jacobians(design, options, pose, q)
+        if jac["dq_dx"] is None:
+            return np.full((3, 3), np.inf)
+        return jac["dq_dx"]
+
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
@@ -803,6 +847,8 @@ MECHANISM = RpsUpu(
         Option("theta_range", [-0.314, 0.314], "workspace box in theta (rad), the paper's"),
         Option("psi_range", [-0.314, 0.314], "workspace box in psi (rad), the paper's"),
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
+               "leg1/leg2/leg3 5, platform 6 (illustrative)"),
     ),
     default_length_unit="mm",
     fields=FIELDS,
@@ -908,6 +954,7 @@ class RpsUpuTool(RpsUpu):
         if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) or d <= 0:
             raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
         options["tool_offset"] = float(d)
+        links.check_radius_option(options, TOOL_RADII)
 
     @staticmethod
     def _p(options: Mapping[str, Any]) -> dict[str, Any]:
@@ -1018,6 +1065,21 @@ class RpsUpuTool(RpsUpu):
                 out["J"] = None
         return out
 
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """As RpsUpu.link_geometry for the pose placing the tool at T = pose (legs closest to q), plus the tool
+        O' -> T (body 'tool', adjacent to the platform only, so it is checked against the base and the legs)."""
+        x = self._pose_for(design, options, pose, q)
+        radii = links.radii(options, TOOL_RADII)
+        segs, adjacent = self._capsules(design, self._p(options), x, radii)
+        _, _, origin, _ = self._joint_points(design, self._p(options), x)
+        segs.append(links.Segment("tool", "tool", origin, self.tool_point(design, options, x), radii["tool"]))
+        return links.LinkGeometry(tuple(segs), links.adjacency([*adjacent, ("tool", "platform")]))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """dq/dT (mm/mm) of the tool point; infinite where cos theta cos psi = 0 or a leg length is 0."""
+        jac = self.jacobians(design, options, pose, q)
+        return np.full((3, 3), np.inf) if jac["dq_dT"] is None else jac["dq_dT"]
+
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of dq/dT with NumPy's SVD (0 at any singularity)."""
         jac = self.jacobians(design, options, pose, q)
@@ -1064,6 +1126,8 @@ TOOL_MECHANISM = RpsUpuTool(
     options=(
         Option("tool_offset", 50.0, "d (mm): T = O' + R (0, 0, -d); illustrative default, the paper has no tool"),
         *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
+               "leg1/leg2/leg3 5, platform 6, tool 4 (illustrative)"),
     ),
     default_length_unit="mm",
     fields=base_fields("1", "J = dT/dq of the tool point (mm/mm)"),

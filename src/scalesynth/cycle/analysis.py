@@ -1,0 +1,333 @@
+"""Cycle analysis of one design: actuator positions, rates and forces, LCI and link clearance along a cycle.
+
+Along the sampled trajectory (``cycle.trajectory``), in the configured working mode (``kernel_branch``):
+
+* every sample must be in the workspace (the point kernel: reachable within every limit); the IK branch is
+  followed with continuity (angles unwrapped; each step in q must match, to first order, the step the velocity
+  map predicts for the step in x, so a branch jump is caught) and the determinant of the velocity map may not
+  change sign between samples (a singularity crossed). A failure raises :class:`CycleError` naming the sample,
+  its time and its position;
+* q from the closed-form IK; q_dot = A x_dot with the mechanism's velocity map A (inverse Jacobian);
+  q_ddot = A x_ddot + A_dot x_dot, where A_dot x_dot is the derivative of A along the motion, taken by a
+  central difference of A over a displacement of 1e-6 of the mechanism's size (IK re-solved in the branch);
+* actuator forces for the payload, quasi-static plus payload inertia: the payload is a point mass m at the
+  task point, the links are massless and joint friction is ignored, so A_SI^T tau = [F; 0] with
+  F = m (a - g) (N), tau in N for prismatic and N m for revolute actuators (SI units, whatever the config's
+  length unit). This is what the actuators must exert on the payload, gravity included: sum tau_i q_dot_i
+  equals F . x_dot at every sample (power balance);
+* the LCI from the point kernel and the clearance of the link capsules (``cycle.clearance``).
+
+Deflection along the cycle (stiffness, issue 12) goes into ``CycleResult.deflection`` when a mechanism provides
+a compliance model; it is None until then.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from scalesynth.cycle import config as ccfg
+from scalesynth.cycle import trajectory
+from scalesynth.cycle.clearance import clearance
+from scalesynth.errors import InvalidPose, ScalesynthError
+from scalesynth.mechanisms.base import Mechanism, wrap_angle
+
+# relative displacement (of the mechanism's size) for the directional derivative of the velocity map
+_DERIV_STEP = 1e-6
+
+
+class CycleError(InvalidPose):
+    """The cycle cannot be followed (outside the workspace, a branch jump, a singularity); exit code 2."""
+
+
+@dataclass(frozen=True)
+class CycleResult:
+    """One design's cycle. Arrays per sample (n rows): q, qd, qdd (n, n_joints) in the length unit or rad
+    (per s, per s^2); force (n, n_joints) in N or N m; task_force (n, k) the force F on the payload (N);
+    lci (n,); clearance (n,) in the length unit (< 0: interference) and clearance_pair the two segments at it.
+    ``deflection``: hook for the stiffness model, None until a mechanism provides one."""
+
+    traj: trajectory.Trajectory
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    force: np.ndarray
+    task_force: np.ndarray
+    lci: np.ndarray
+    clearance: np.ndarray
+    clearance_pair: tuple[tuple[str, str] | None, ...]
+    task_axes: tuple[str, ...]
+    task_units: tuple[str, ...]
+    joints: tuple[str, ...]
+    joint_units: tuple[str, ...]
+    length_unit: str
+    payload: float
+    gravity: np.ndarray
+    force_map: np.ndarray  # (n, n_joints, k): force = force_map @ F
+    deflection: np.ndarray | None = None
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """cycle.csv's columns in order: t; p_a, pd_a, pdd_a per task axis; q, qd, qdd, force per actuator
+        (1-based); lci, clearance."""
+        out = {"t": self.traj.t}
+        for a, name in enumerate(self.task_axes):
+            out[f"p_{name}"] = self.traj.p[:, a]
+            out[f"pd_{name}"] = self.traj.pd[:, a]
+            out[f"pdd_{name}"] = self.traj.pdd[:, a]
+        for i in range(len(self.joints)):
+            out[f"q{i + 1}"] = self.q[:, i]
+            out[f"qd{i + 1}"] = self.qd[:, i]
+            out[f"qdd{i + 1}"] = self.qdd[:, i]
+            out[f"force{i + 1}"] = self.force[:, i]
+        out["lci"] = self.lci
+        out["clearance"] = self.clearance
+        return out
+
+    def units(self) -> dict[str, str]:
+        """Unit of each column of ``columns``."""
+        lu = self.length_unit
+        out = {"t": "s"}
+        for name, u in zip(self.task_axes, self.task_units, strict=True):
+            base = lu if u == "length" else "rad"
+            out.update({f"p_{name}": base, f"pd_{name}": f"{base}/s", f"pdd_{name}": f"{base}/s^2"})
+        for i, u in enumerate(self.joint_units, start=1):
+            base = lu if u == "length" else "rad"
+            out.update({f"q{i}": base, f"qd{i}": f"{base}/s", f"qdd{i}": f"{base}/s^2",
+                        f"force{i}": "N" if u == "length" else "N m"})
+        out.update({"lci": "1", "clearance": lu})
+        return out
+
+
+def _size(mech: Mechanism, design, options) -> float:
+    lo, hi = mech.bounding_box(design, options)
+    return float(max(np.max(np.asarray(hi) - np.asarray(lo)), 1e-12))
+
+
+def _where(mech: Mechanism, traj, k: int) -> str:
+    pos = ", ".join(f"{v:.6g}" for v in traj.p[k])
+    axes = ", ".join(mech.task_axes)
+    return f"sample {k} (t = {traj.t[k]:.4g} s, segment {traj.segment[k] + 1}) at ({axes}) = ({pos})"
+
+
+def _branches(mech: Mechanism, design, options, pose) -> dict[str, np.ndarray]:
+    return {s.label: s.values for s in mech.inverse_kinematics(design, options, pose)}
+
+
+def _unwrap(q: np.ndarray, ref: np.ndarray, angular: np.ndarray) -> np.ndarray:
+    """q with its angles moved by whole turns to lie within pi of ref."""
+    out = np.array(q, dtype=float)
+    out[angular] = ref[angular] + wrap_angle(out[angular] - ref[angular])
+    return out
+
+
+def check_vertices(mech: Mechanism, design, options, verts: np.ndarray, what: str) -> None:
+    """Raise CycleError naming the first vertex outside the workspace (within every limit)."""
+    from scalesynth.kernels.grid import points_lci
+
+    lci = points_lci(mech.point_kernel, mech.pack(design, options), np.pad(verts, ((0, 0), (0, 3 - verts.shape[1]))))
+    bad = np.nonzero(lci < 0)[0]
+    if bad.size:
+        k = int(bad[0])
+        pos = ", ".join(f"{v:.6g}" for v in verts[k])
+        raise CycleError(
+            f"{what}[{k}]: ({pos}) is outside the workspace of the design (working mode "
+            f"{mech.kernel_branch(options)}, within the limits)"
+        )
+
+
+def analyse(
+    mech: Mechanism,
+    design: Mapping[str, float],
+    options: Mapping[str, Any],
+    cyc: ccfg.CycleConfig,
+    length_unit: str,
+    *,
+    rate_scale: float = 1.0,
+) -> CycleResult:
+    """The cycle of one design (module docstring). ``rate_scale`` multiplies the cycle rate (2 = twice as many
+    cycles per minute). Raises CycleError where the cycle cannot be followed."""
+    from scalesynth.kernels.grid import points_lci
+
+    design = mech.resolve_design(design)
+    options = mech.resolve_options(options)
+    verts = ccfg.vertices(cyc, mech, length_unit)
+    check_vertices(mech, design, options, verts, "cycle.path" if cyc.path is not None else f"cycle.{cyc.preset}")
+    traj = trajectory.build(verts, cyc.law, cyc.cycle_time / rate_scale, cyc.samples)
+    n, k = traj.p.shape
+    nj = len(mech.joints)
+    lci = points_lci(mech.point_kernel, mech.pack(design, options), np.pad(traj.p, ((0, 0), (0, 3 - k))))
+    outside = np.nonzero(lci < 0)[0]
+    if outside.size:
+        raise CycleError(f"cycle: {_where(mech, traj, int(outside[0]))} is outside the workspace")
+    label = mech.kernel_branch(options)
+    angular = np.array([u == "angle" for u in mech.joint_units])
+    size = _size(mech, design, options)
+    joint_scale = np.where(angular, size, 1.0)
+    q = np.empty((n, nj))
+    A = np.empty((n, nj, nj))
+    for s in range(n):
+        sols = _branches(mech, design, options, traj.p[s])
+        if label not in sols:
+            raise CycleError(f"cycle: {_where(mech, traj, s)} is out of reach in working mode {label}")
+        q[s] = sols[label] if s == 0 else _unwrap(sols[label], q[s - 1], angular)
+        A[s] = mech.velocity_map(design, options, traj.p[s], q[s])
+        if s > 0 and np.all(np.isfinite(A[s - 1 : s + 1])):
+            # branch continuity: the step in q must be the one the velocity map predicts for the step in x (to
+            # first order; the trapezoidal rule's error is second order), else the branch jumped
+            dx = np.zeros(nj)
+            dx[:k] = traj.p[s] - traj.p[s - 1]
+            predicted = 0.5 * (A[s] + A[s - 1]) @ dx
+            if np.linalg.norm((q[s] - q[s - 1] - predicted) * joint_scale) > 0.5 * np.linalg.norm(
+                predicted * joint_scale
+            ) + 1e-9 * size:
+                raise CycleError(
+                    f"cycle: branch {label} jumps between sample {s - 1} and {_where(mech, traj, s)} (a singularity "
+                    "or a branch point on the path; more cycle.samples may resolve it)"
+                )
+    det = np.linalg.det(A)
+    sign = np.sign(det)
+    bad = np.nonzero(~np.isfinite(det) | (sign == 0) | (lci <= 0))[0]
+    if bad.size:
+        raise CycleError(f"cycle: {_where(mech, traj, int(bad[0]))} is singular (LCI {lci[bad[0]]:.3g})")
+    flip = np.nonzero(sign[1:] != sign[:-1])[0]
+    if flip.size:
+        raise CycleError(f"cycle: a singularity lies between {_where(mech, traj, int(flip[0]))} and the next sample")
+    pd_full = np.zeros((n, nj))
+    pd_full[:, :k] = traj.pd
+    pdd_full = np.zeros((n, nj))
+    pdd_full[:, :k] = traj.pdd
+    qd = np.einsum("nij,nj->ni", A, pd_full)
+    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(mech, design, options, traj, q, label, angular, size)
+    g = ccfg.gravity_vector(cyc, mech)
+    force, task_force, force_map = _forces(mech, A, traj, cyc.payload, g, length_unit)
+    gaps, pairs = [], []
+    for s in range(n):
+        c = clearance(mech.link_geometry(design, options, traj.p[s], q[s]))
+        gaps.append(c.value)
+        pairs.append(c.pair)
+    return CycleResult(
+        traj=traj, q=q, qd=qd, qdd=qdd, force=force, task_force=task_force, lci=lci, clearance=np.array(gaps),
+        clearance_pair=tuple(pairs), task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
+        joint_units=mech.joint_units, length_unit=length_unit, payload=cyc.payload, gravity=g,
+        force_map=force_map,
+    )
+
+
+def _a_dot_xdot(mech, design, options, traj, q, label, angular, size) -> np.ndarray:
+    """(dA/dt) x_dot per sample by a central difference of A along x_dot (IK re-solved in the branch)."""
+    n, k = traj.p.shape
+    nj = q.shape[1]
+    out = np.zeros((n, nj))
+    for s in range(n):
+        v = traj.pd[s]
+        speed = float(np.linalg.norm(v))
+        if speed == 0.0:
+            continue
+        eps = _DERIV_STEP * size / speed  # a time step: the pose moves by _DERIV_STEP * size
+        mats = []
+        for sign in (1.0, -1.0):
+            pose = traj.p[s] + sign * eps * v
+            sols = _branches(mech, design, options, pose)
+            if label not in sols:
+                raise CycleError(f"cycle: {_where(mech, traj, s)} lies on the boundary of the workspace")
+            mats.append(mech.velocity_map(design, options, pose, _unwrap(sols[label], q[s], angular)))
+        vfull = np.zeros(nj)
+        vfull[:k] = v
+        out[s] = (mats[0] - mats[1]) @ vfull / (2.0 * eps)
+    return out
+
+
+def si_velocity_map(mech: Mechanism, A: np.ndarray, length_unit: str) -> np.ndarray:
+    """A in SI units (m/s or rad/s both sides): rows of prismatic actuators and columns of Cartesian task axes
+    scaled by metres per length unit. Columns past the task axes (held rotations) are rad/s already."""
+    m = ccfg.METRES_PER_UNIT[length_unit]
+    nj = A.shape[-1]
+    row = np.array([m if u == "length" else 1.0 for u in mech.joint_units])
+    col = np.ones(nj)
+    col[: len(mech.task_units)] = [1.0 / m if u == "length" else 1.0 for u in mech.task_units]
+    return A * row[:, None] * col[None, :]
+
+
+def _forces(mech, A, traj, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Actuator forces (n, n_joints), the payload force F = m (a - g) (n, k) and the map between them
+    (n, n_joints, k), SI."""
+    if any(u != "length" for u in mech.task_units):
+        axes = ", ".join(mech.task_axes)
+        raise CycleError(f"cycle: payload forces need Cartesian task axes; {mech.name} has {axes}")
+    n, k = traj.p.shape
+    m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
+    F = mass * (traj.pdd * m_per_unit - g[None, :])
+    A_si = si_velocity_map(mech, A, length_unit)
+    force_map = np.linalg.inv(np.transpose(A_si, (0, 2, 1)))[:, :, :k]
+    return np.einsum("nik,nk->ni", force_map, F), F, force_map
+
+
+# ----- design-level metrics (catalogue: cycle_*) ------------------------------------------------------------
+CYCLE_PENALTY = 1e12  # a speed/acceleration/force no actuator reaches: the value of an infeasible cycle
+METRICS = ccfg.CYCLE_METRICS
+
+
+def max_rate_scale(res: CycleResult, speed_limits, force_limits) -> float:
+    """Largest factor k on the cycle rate that keeps |k qd_i| <= speed limit and |tau_g + k^2 tau_a| <= force
+    limit at every sample, where tau_a is the inertial and tau_g the gravity part of the forces (tau is linear
+    in F = m a - m g and a scales with k^2). inf without limits; 0 if gravity alone exceeds a force limit."""
+    k2 = np.inf
+    if speed_limits is not None:
+        peak = np.max(np.abs(res.qd), axis=0)
+        with np.errstate(divide="ignore"):
+            k2 = min(k2, float(np.min((speed_limits / peak) ** 2)))
+    if force_limits is not None:
+        tau_g = np.einsum("nik,k->ni", res.force_map, -res.payload * res.gravity)
+        tau_a = res.force - tau_g
+        if np.any(np.abs(tau_g) > force_limits):
+            return 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.where(tau_a > 0, (force_limits - tau_g) / tau_a,
+                             np.where(tau_a < 0, (force_limits + tau_g) / -tau_a, np.inf))
+        k2 = min(k2, float(np.min(bound)))
+    return float(np.sqrt(k2))
+
+
+def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit: str) -> dict[str, float]:
+    """The cycle catalogue metrics of one design; never raises for a cycle that cannot be followed.
+
+    cycle_feasible: 1 when every sample is reachable without a branch jump or singularity, the clearance is
+    >= 0 and (with limits) the actuator speeds and forces stay within them, else 0.
+    cycle_max_actuator_speed / _accel / _force: the largest |qd_i|, |qdd_i|, |force_i| over the cycle and the
+    actuators (their units: length unit or rad per s, per s^2; N or N m; mixed for mixed actuators).
+    cycle_min_lci, cycle_min_clearance (length unit; < 0 interference). max_cycles_per_minute: the configured
+    rate times max_rate_scale (only with speed or force limits). A cycle that cannot be followed gives feasible 0,
+    speed, acceleration and force CYCLE_PENALTY, LCI 0, clearance -CYCLE_PENALTY and 0 cycles per minute."""
+    try:
+        res = analyse(mech, design, options, cyc, length_unit)
+    except ScalesynthError:  # CycleError, or a degenerate design's kinematics refusing a pose
+        bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
+                "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
+                "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
+        if cyc.speed_limits is not None or cyc.force_limits is not None:
+            bad["max_cycles_per_minute"] = 0.0
+        return bad
+    return result_metrics(res, cyc)
+
+
+def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:
+    """The catalogue metrics (see ``metrics``) of an analysed, followable cycle."""
+    n = len(res.joints)
+    speed = ccfg.limit_vector(cyc.speed_limits, n)
+    force = ccfg.limit_vector(cyc.force_limits, n)
+    scale = max_rate_scale(res, speed, force)
+    ok = bool(np.min(res.clearance) >= 0.0 and scale >= 1.0)
+    out = {
+        "cycle_feasible": float(ok),
+        "cycle_max_actuator_speed": float(np.max(np.abs(res.qd))),
+        "cycle_max_actuator_accel": float(np.max(np.abs(res.qdd))),
+        "cycle_max_actuator_force": float(np.max(np.abs(res.force))),
+        "cycle_min_lci": float(np.min(res.lci)),
+        "cycle_min_clearance": float(min(np.min(res.clearance), CYCLE_PENALTY)),
+    }
+    if speed is not None or force is not None:
+        out["max_cycles_per_minute"] = 60.0 / cyc.cycle_time * scale
+    return out

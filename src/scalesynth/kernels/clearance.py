@@ -1,0 +1,64 @@
+"""Numba segment-segment distance for the per-voxel ``clearance`` field of the field kernels.
+
+Scalar twin of :func:`scalesynth.cycle.clearance.segment_distance` (the NumPy version the cycle analysis uses; the
+tests compare the two): closest points of two segments with clamped parameters (C. Ericson, *Real-Time
+Collision Detection*, §5.1.9). Zero-length segments are points.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from scalesynth.kernels.flags import FASTMATH
+
+_EPS = 1e-300
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _clamp01(v):
+    return 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def segment_distance(px, py, pz, qx, qy, qz, ux, uy, uz, vx, vy, vz):
+    """Distance between segments P-Q and U-V (3-D points given by coordinates)."""
+    d1x, d1y, d1z = qx - px, qy - py, qz - pz
+    d2x, d2y, d2z = vx - ux, vy - uy, vz - uz
+    rx, ry, rz = px - ux, py - uy, pz - uz
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    if a <= _EPS and e <= _EPS:
+        s = 0.0
+        t = 0.0
+    elif a <= _EPS:
+        s = 0.0
+        t = _clamp01(f / e)
+    else:
+        c = d1x * rx + d1y * ry + d1z * rz
+        if e <= _EPS:
+            t = 0.0
+            s = _clamp01(-c / a)
+        else:
+            b = d1x * d2x + d1y * d2y + d1z * d2z
+            denom = a * e - b * b
+            s = _clamp01((b * f - c * e) / denom) if denom > 1e-14 * a * e else 0.0
+            t = (b * s + f) / e
+            if t < 0.0:
+                t = 0.0
+                s = _clamp01(-c / a)
+            elif t > 1.0:
+                t = 1.0
+                s = _clamp01((b - c) / a)
+    dx = px + s * d1x - (ux + t * d2x)
+    dy = py + s * d1y - (uy + t * d2y)
+    dz = pz + s * d1z - (uz + t * d2z)
+    return math.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def planar_capsule_gap(ax, ay, bx, by, ra, cx, cy, dx, dy, rc):
+    """Distance between the planar capsules A-B (radius ra) and C-D (radius rc): segment distance minus radii."""
+    return segment_distance(ax, ay, 0.0, bx, by, 0.0, cx, cy, 0.0, dx, dy, 0.0) - ra - rc

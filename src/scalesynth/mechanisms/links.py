@@ -1,0 +1,121 @@
+"""Link geometry of a mechanism at one pose: named capsules (segment + radius) and which bodies share a joint.
+
+Every mechanism's :meth:`~scalesynth.mechanisms.base.Mechanism.link_geometry` returns a :class:`LinkGeometry`
+in the mechanism frame (3-D points in the design's length unit; planar mechanisms have z = 0). A body (base,
+each moving link, platform) is one or more :class:`Segment` s with the same ``body`` name; two bodies are
+*adjacent* when a joint connects them. Clearance (``scalesynth.cycle.clearance``) is measured between the
+capsules of non-adjacent bodies only: adjacent capsules always overlap at their common joint. The same
+geometry is what a drawing of the robot uses.
+
+Radii come from the mechanism option ``link_radius``: a number (every body) or a mapping body -> radius,
+bodies it does not name keeping the mechanism's default (each mechanism states its defaults).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from scalesynth.errors import InvalidParameter
+from scalesynth.mechanisms.base import Field
+
+# the per-voxel field of the mechanisms whose field kernels compute their capsules' clearance
+CLEARANCE_FIELD = Field(
+    "clearance", "{length}", "smallest distance between the capsules of links that share no joint, minus their "
+    "radii (< 0: the links interfere); radii from options.link_radius", "max", (-math.inf, math.inf),
+)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One capsule: the segment a -> b (3 floats each, length unit) swept by a ball of ``radius``.
+
+    ``name`` identifies the segment (e.g. 'arm1'), ``body`` the rigid body it belongs to (several segments of
+    one body, e.g. the sides of a platform triangle, share a body name). A zero-length segment is a ball.
+    """
+
+    name: str
+    body: str
+    a: np.ndarray
+    b: np.ndarray
+    radius: float
+
+
+@dataclass(frozen=True)
+class LinkGeometry:
+    """The capsules of a mechanism at one pose and the pairs of adjacent bodies (sharing a joint)."""
+
+    segments: tuple[Segment, ...]
+    adjacent: frozenset[frozenset[str]]
+
+    @property
+    def bodies(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(s.body for s in self.segments))
+
+    def checked_pairs(self) -> list[tuple[int, int]]:
+        """Index pairs (i < j) of segments whose clearance counts: different, non-adjacent bodies."""
+        out = []
+        segs = self.segments
+        for i in range(len(segs)):
+            for j in range(i + 1, len(segs)):
+                bi, bj = segs[i].body, segs[j].body
+                if bi != bj and frozenset((bi, bj)) not in self.adjacent:
+                    out.append((i, j))
+        return out
+
+    def as_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(a, b, radius) stacked: shapes (n, 3), (n, 3), (n,)."""
+        return (
+            np.array([s.a for s in self.segments], dtype=float).reshape(-1, 3),
+            np.array([s.b for s in self.segments], dtype=float).reshape(-1, 3),
+            np.array([s.radius for s in self.segments], dtype=float),
+        )
+
+
+def adjacency(pairs: Iterable[tuple[str, str]]) -> frozenset[frozenset[str]]:
+    """The adjacency set of body-name pairs."""
+    return frozenset(frozenset(p) for p in pairs)
+
+
+def point(*coords: float) -> np.ndarray:
+    """A 3-D point from 2 or 3 coordinates (planar points get z = 0)."""
+    c = [float(v) for v in coords]
+    return np.array(c + [0.0] * (3 - len(c)))
+
+
+def check_radius_option(options: dict[str, Any], bodies: Iterable[str]) -> None:
+    """Validate ``options['link_radius']`` in place: null, a number >= 0, or a mapping of known bodies to numbers
+    >= 0; raise InvalidParameter naming the entry."""
+    value = options.get("link_radius")
+    if value is None:
+        return
+    known = tuple(bodies)
+    items = value.items() if isinstance(value, Mapping) else [(None, value)]
+    for body, r in items:
+        where = "options.link_radius" + ("" if body is None else f".{body}")
+        if body is not None and body not in known:
+            raise InvalidParameter(f"{where}: unknown body (known: {', '.join(known)})")
+        if isinstance(r, bool) or not isinstance(r, (int, float)) or not math.isfinite(r) or r < 0:
+            raise InvalidParameter(f"{where}: expected a length >= 0, got {r!r}")
+
+
+def radii(options: Mapping[str, Any], defaults: Mapping[str, float]) -> dict[str, float]:
+    """Radius per body: ``defaults`` overlaid by the ``link_radius`` option (a number or a mapping)."""
+    value = options.get("link_radius")
+    out = dict(defaults)
+    if value is None:
+        return out
+    if isinstance(value, Mapping):
+        out.update({k: float(v) for k, v in value.items()})
+        return out
+    return {k: float(value) for k in out}
+
+
+def check_flag_option(options: dict[str, Any], name: str) -> None:
+    """A boolean option (true/false); raise InvalidParameter naming it otherwise."""
+    if not isinstance(options.get(name), bool):
+        raise InvalidParameter(f"options.{name}: expected true or false, got {options.get(name)!r}")

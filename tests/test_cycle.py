@@ -1,0 +1,390 @@
+"""Pick-and-place cycles (scalesynth.cycle): motion laws against their closed forms, actuator rates against finite
+differences of the IK positions, power balance, rate scaling, capsule clearance against brute force and an
+optimiser, seed 001's drive curves against the recorded output of the old `drives` command, the `cycle` command
+and its bad input."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+from scipy.optimize import minimize
+from typer.testing import CliRunner
+
+from scalesynth.cli import app
+from scalesynth.config import load_config
+from scalesynth.cycle import analysis, trajectory
+from scalesynth.cycle.clearance import clearance, segment_distance
+from scalesynth.cycle.config import METRES_PER_UNIT
+from scalesynth.mechanisms.base import wrap_angle
+
+from conftest import ROOT
+
+FIVEBAR = load_config(ROOT / "configs" / "fivebar_packing.yaml")
+PPRS = load_config(ROOT / "configs" / "pprs_rprs.yaml")
+CASES = {"planar-fivebar": FIVEBAR, "pprs-rprs": PPRS}
+
+
+def run(cfg, **changes):
+    """The config's cycle with changes (100 time intervals unless given: enough for every check, fast)."""
+    cyc = cfg.cycle.model_copy(update={"samples": 100, **changes})
+    return analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cyc, cfg.units.length)
+
+
+# ----- motion laws ----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("law, peak_v, peak_a", [
+    ("poly345", 1.875, 10 / math.sqrt(3)),  # s' = 30 t^2 (1-t)^2 at t = 1/2; s'' at t = 1/2 -+ sqrt(3)/6
+    ("modified_trapezoid", 2.0, 4.888124),  # the classic modified trapezoid: C_v = 2, C_a = 4.8881
+])
+def test_motion_law_boundary_values_peaks_and_derivatives(law, peak_v, peak_a):
+    tau = np.linspace(0.0, 1.0, 200_001)
+    s, sd, sdd = trajectory.law_profile(law, tau)
+    assert (s[0], s[-1], sd[0], sd[-1]) == pytest.approx((0.0, 1.0, 0.0, 0.0), abs=1e-12)
+    assert sdd[0] == pytest.approx(0.0, abs=1e-12) and sdd[-1] == pytest.approx(0.0, abs=1e-9)
+    assert sd.max() == pytest.approx(peak_v, rel=1e-6)
+    assert np.abs(sdd).max() == pytest.approx(peak_a, rel=1e-5)
+    h = tau[1] - tau[0]
+    np.testing.assert_allclose(np.gradient(s, h)[1:-1], sd[1:-1], atol=1e-8)
+    np.testing.assert_allclose(np.gradient(sd, h)[1:-1], sdd[1:-1], atol=2e-6)
+    np.testing.assert_allclose(s + s[::-1], 1.0, atol=1e-12)  # rest-to-rest laws are point-symmetric
+
+
+def test_trajectory_vertices_times_and_closure():
+    traj = trajectory.build([[0, 0], [4, 0], [4, 1]], "poly345", 3.0, 300)
+    # closed back to the start; durations proportional to sqrt(length): 2 : 1 : sqrt(17)
+    np.testing.assert_allclose(traj.vertices, [[0, 0], [4, 0], [4, 1], [0, 0]])
+    w = np.sqrt([4.0, 1.0, math.sqrt(17.0)])
+    np.testing.assert_allclose(traj.vertex_times, np.concatenate([[0], np.cumsum(3.0 * w / w.sum())]))
+    for k, tv in enumerate(traj.vertex_times):
+        i = int(np.argmin(np.abs(traj.t - tv)))
+        assert traj.t[i] == pytest.approx(tv)
+        np.testing.assert_allclose(traj.p[i], traj.vertices[k], atol=1e-12)
+        np.testing.assert_allclose(traj.pd[i], 0.0, atol=1e-12)  # rest at every vertex
+    assert traj.t[-1] == 3.0 and np.all(np.diff(traj.t) > 0)
+
+
+# ----- actuator rates against finite differences of the IK positions ---------------------------------------
+def _ik(cfg, pose, ref):
+    """The configured branch's IK at a pose, angles unwrapped towards ref (independent of the velocity map)."""
+    mech = cfg.mech
+    sols = {s.label: s.values for s in mech.inverse_kinematics(cfg.resolved_design(), cfg.resolved_options(), pose)}
+    q = np.array(sols[mech.kernel_branch(cfg.resolved_options())])
+    ang = np.array([u == "angle" for u in mech.joint_units])
+    q[ang] = ref[ang] + wrap_angle(q[ang] - ref[ang])
+    return q
+
+
+@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize("law", ["poly345", "modified_trapezoid"])
+def test_rates_match_finite_differences_of_ik_positions(name, law):
+    cfg = CASES[name]
+    res = run(cfg, law=law, samples=120)
+    traj = res.traj
+    seg = np.diff(traj.vertices, axis=0)
+    durations = np.diff(traj.vertex_times)
+    checked = 0
+    for s in range(0, len(traj.t) - 1, 7):
+        k = traj.segment[s]
+        tau = (traj.t[s] - traj.vertex_times[k]) / durations[k]
+        if not 0.02 < tau < 0.98:
+            continue
+        h = 1e-4
+        poses = [traj.vertices[k] + trajectory.law_profile(law, tau + j * h)[0] * seg[k] for j in (-1, 0, 1)]
+        q_m, q_0, q_p = (_ik(cfg, p, res.q[s]) for p in poses)
+        dt = h * durations[k]
+        np.testing.assert_allclose(q_0, res.q[s], rtol=0, atol=1e-9)
+        scale_v = np.abs(res.qd).max(axis=0)
+        scale_a = np.abs(res.qdd).max(axis=0)
+        # central differences: truncation O(h^2), rounding of the second difference ~ 1e-16 / h^2 relative
+        err_v = np.abs((q_p - q_m) / (2 * dt) - res.qd[s])
+        err_a = np.abs((q_p - 2 * q_0 + q_m) / dt**2 - res.qdd[s])
+        assert np.all(err_v <= 1e-6 * scale_v), (s, err_v / scale_v)
+        assert np.all(err_a <= 2e-4 * scale_a), (s, err_a / scale_a)
+        checked += 1
+    assert checked >= 10
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_power_balance_at_every_sample(name):
+    cfg = CASES[name]
+    res = run(cfg, payload=2.5, gravity=[1.0, -3.0, -9.0][-len(cfg.mech.task_axes):])
+    m = METRES_PER_UNIT[cfg.units.length]
+    joint_si = np.array([m if u == "length" else 1.0 for u in cfg.mech.joint_units])
+    actuator_power = np.sum(res.force * res.qd * joint_si, axis=1)
+    task_power = np.sum(res.task_force * res.traj.pd * m, axis=1)
+    assert np.abs(task_power).max() > 0.1  # W: the check is not 0 = 0
+    np.testing.assert_allclose(actuator_power, task_power, rtol=0, atol=1e-9 * np.abs(task_power).max())
+    # F = m (a - g) exactly
+    np.testing.assert_allclose(res.task_force, 2.5 * (res.traj.pdd * m - res.gravity), rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_doubling_the_rate_doubles_speeds_and_quadruples_accelerations(name):
+    cfg = CASES[name]
+    slow = run(cfg)
+    fast = run(cfg, cycles_per_minute=2 * cfg.cycle.cycles_per_minute)
+    np.testing.assert_allclose(fast.traj.t, slow.traj.t / 2, rtol=1e-12)
+    np.testing.assert_allclose(fast.q, slow.q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fast.qd, 2 * slow.qd, rtol=1e-9, atol=1e-9 * np.abs(slow.qd).max())
+    np.testing.assert_allclose(fast.qdd, 4 * slow.qdd, rtol=1e-6, atol=1e-6 * np.abs(slow.qdd).max())
+    # inertial forces quadruple, gravity's part stays: tau(2x) - tau_g = 4 (tau(1x) - tau_g)
+    tau_g = np.einsum("nik,k->ni", slow.force_map, -slow.payload * slow.gravity)
+    np.testing.assert_allclose(fast.force - tau_g, 4 * (slow.force - tau_g), rtol=1e-6,
+                               atol=1e-6 * np.abs(slow.force).max())
+
+
+def test_max_cycles_per_minute_from_speed_and_force_limits():
+    cfg = FIVEBAR
+    design, options = cfg.resolved_design(), cfg.resolved_options()
+    base = cfg.cycle.model_copy(update={"speed_limits": 6.0, "samples": 100})
+    m = analysis.metrics(cfg.mech, design, options, base, "mm")
+    peak = run(cfg).qd
+    # speeds scale with the rate: 60 cycles/min * 6 rad/s / peak |qd|
+    assert m["max_cycles_per_minute"] == pytest.approx(60 * 6.0 / np.abs(peak).max(), rel=1e-12)
+    # at that rate the limit is reached exactly
+    k = m["max_cycles_per_minute"] / 60
+    assert np.abs(run(cfg, cycles_per_minute=60 * k).qd).max() == pytest.approx(6.0, rel=1e-9)
+    # force limits: the rate found leaves the worst actuator force at the limit
+    forced = cfg.cycle.model_copy(update={"force_limits": 20.0, "samples": 100})
+    m = analysis.metrics(cfg.mech, design, options, forced, "mm")
+    at = run(cfg, cycles_per_minute=m["max_cycles_per_minute"])
+    assert np.abs(at.force).max() == pytest.approx(20.0, rel=1e-6)
+    # gravity alone above the limit: no rate works
+    tiny = cfg.cycle.model_copy(update={"force_limits": 1.0, "samples": 100})
+    assert analysis.metrics(cfg.mech, design, options, tiny, "mm")["max_cycles_per_minute"] == 0.0
+
+
+# ----- seed 001: the old drives curves --------------------------------------------------------------------
+def test_seed001_drive_curves_unchanged_from_the_recorded_drives_output():
+    ref = np.loadtxt(ROOT / "tests" / "data" / "cycle" / "drives_seed001_square.csv", delimiter=",", skiprows=1)
+    res = run(PPRS, law="constant", period=1.0, cycles_per_minute=None, samples=len(ref) - 1)
+    np.testing.assert_allclose(res.traj.t, ref[:, 0], atol=1e-11)
+    np.testing.assert_allclose(res.traj.p, ref[:, 1:4], rtol=1e-11, atol=1e-9)
+    np.testing.assert_allclose(res.q, ref[:, 4:], rtol=1e-11, atol=1e-9)  # 12 significant digits in the file
+
+
+# ----- clearance ------------------------------------------------------------------------------------------
+def _segment_points(a, b, n):
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    return a + t * (b - a)
+
+
+def test_segment_distance_against_brute_force_and_an_optimiser():
+    rng = np.random.default_rng(7)
+    cases = [rng.normal(size=(4, 3)) for _ in range(30)]
+    # degenerate cases: parallel, collinear overlapping, a point, crossing, both points
+    cases += [np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]]),
+              np.array([[0, 0, 0], [2, 0, 0], [1, 0, 0], [3, 0, 0.0]]),
+              np.array([[0, 0, 0], [0, 0, 0], [1, -1, 0], [1, 1, 0.0]]),
+              np.array([[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0.0]]),
+              np.array([[0, 0, 0], [0, 0, 0], [3, 4, 0], [3, 4, 0.0]])]
+    for p1, q1, p2, q2 in cases:
+        d = float(segment_distance(p1, q1, p2, q2))
+        pa, pb = _segment_points(p1, q1, 801), _segment_points(p2, q2, 801)
+        brute = np.min(np.linalg.norm(pa[:, None, :] - pb[None, :, :], axis=2))
+        # the grids are 1/800 of each segment apart: brute force overestimates by at most half of that each
+        assert d <= brute + 1e-12
+        assert brute - d <= (np.linalg.norm(q1 - p1) + np.linalg.norm(q2 - p2)) / 1600 + 1e-12
+        def gap(st, p1=p1, q1=q1, p2=p2, q2=q2):
+            return np.linalg.norm(p1 + st[0] * (q1 - p1) - p2 - st[1] * (q2 - p2))
+
+        opt = minimize(gap, x0=[0.5, 0.5], bounds=[(0, 1), (0, 1)], method="L-BFGS-B")
+        assert d <= opt.fun + 1e-12 and opt.fun - d <= 1e-6
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_mechanism_clearance_against_points_sampled_on_the_capsules(name):
+    """Brute force: 400 points along each capsule's axis; a capsule's surface lies at its radius from the axis, so
+    the smallest point-set distance of each non-adjacent pair minus the two radii can only exceed the exact
+    clearance, by at most half the point spacing of the two segments."""
+    cfg = CASES[name]
+    res = run(cfg, samples=40)
+    design, options = cfg.resolved_design(), cfg.resolved_options()
+    for s in (0, 7, 23):
+        geo = cfg.mech.link_geometry(design, options, res.traj.p[s], res.q[s])
+        clouds = [_segment_points(seg.a, seg.b, 400) for seg in geo.segments]
+        gaps = []
+        for i, j in geo.checked_pairs():
+            d = np.min(np.linalg.norm(clouds[i][:, None, :] - clouds[j][None, :, :], axis=2))
+            gaps.append(d - geo.segments[i].radius - geo.segments[j].radius)
+        brute = min(gaps)
+        exact = clearance(geo).value
+        assert exact == pytest.approx(res.clearance[s], abs=1e-12)
+        longest = max(np.linalg.norm(seg.b - seg.a) for seg in geo.segments)
+        assert exact <= brute + 1e-9
+        assert brute - exact <= longest / 399 + 1e-9
+
+
+def test_fivebar_link_geometry_and_adjacency():
+    cfg = FIVEBAR
+    design, options = cfg.resolved_design(), cfg.resolved_options()
+    pose = (0.0, -725.0)
+    q = next(s.values for s in cfg.mech.inverse_kinematics(design, options, pose) if s.label == "+-")
+    geo = cfg.mech.link_geometry(design, options, pose, q)
+    seg = {s.name: s for s in geo.segments}
+    # spec §2.7 point o: alpha1 = -0.305041, alpha2 = -2.836552; elbows at B_i + l1 (cos, sin)
+    elbow = [200 + 475 * math.cos(-0.305041), 475 * math.sin(-0.305041), 0]
+    np.testing.assert_allclose(seg["arm1"].b, elbow, atol=1e-3)
+    np.testing.assert_allclose(seg["forearm2"].b, [0, -725, 0])
+    assert np.linalg.norm(seg["forearm1"].b - seg["forearm1"].a) == pytest.approx(875.0)
+    names = {(geo.segments[i].body, geo.segments[j].body) for i, j in geo.checked_pairs()}
+    assert ("arm1", "arm2") in names and ("base", "forearm1") in names
+    assert ("arm1", "forearm1") not in names and ("forearm1", "forearm2") not in names
+    with_radius = cfg.mech.link_geometry(design, {**options, "link_radius": {"arm1": 7.0}}, pose, q)
+    assert {s.name: s.radius for s in with_radius.segments}["arm1"] == 7.0
+
+
+def test_interference_is_negative_clearance():
+    """Fat links collide: radius 250 mm on every body makes the two arms (400 mm apart at the base) overlap."""
+    fat = {**FIVEBAR.resolved_options(), "link_radius": 250.0}
+    res = analysis.analyse(FIVEBAR.mech, FIVEBAR.resolved_design(), fat, FIVEBAR.cycle, "mm")
+    assert res.clearance.min() == pytest.approx(400.0 - 500.0)  # the pivots B1, B2 are 2 r = 400 mm apart
+    m = analysis.result_metrics(res, FIVEBAR.cycle)
+    assert m["cycle_feasible"] == 0.0 and m["cycle_min_clearance"] == pytest.approx(-100.0)
+
+
+# ----- command and bad input ------------------------------------------------------------------------------
+def test_cycle_command_writes_csv_json_and_plots(tmp_path):
+    res = CliRunner().invoke(app, ["cycle", str(ROOT / "configs" / "fivebar_packing.yaml"), "--out", str(tmp_path),
+                                   "--json"])
+    assert res.exit_code == 0, res.output
+    info = json.loads(res.stdout)
+    header = (tmp_path / "cycle.csv").read_text().splitlines()[0].split(",")
+    assert header == ["t", "p_x", "pd_x", "pdd_x", "p_y", "pd_y", "pdd_y", "q1", "qd1", "qdd1", "force1",
+                      "q2", "qd2", "qdd2", "force2", "lci", "clearance"]
+    units = json.loads((tmp_path / "cycle.json").read_text())["units"]
+    assert units["pdd_x"] == "mm/s^2" and units["qd1"] == "rad/s" and units["force2"] == "N m"
+    assert info["metrics"]["cycle_feasible"] == 1.0
+    # adept preset: 25 mm up, 305 mm across, 25 mm down and back, from the start point
+    np.testing.assert_allclose(info["vertices"], [[-152.5, -800], [-152.5, -775], [152.5, -775], [152.5, -800],
+                                                  [152.5, -775], [-152.5, -775], [-152.5, -800]])
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["actuators.png", "cycle.csv", "cycle.json", "path.png", "quality.png"]
+
+
+def _write(tmp_path, cfg, **cycle):
+    data = yaml.safe_load((ROOT / "configs" / cfg).read_text())
+    data["cycle"] = {**data.get("cycle", {}), **cycle}
+    data["cycle"] = {k: v for k, v in data["cycle"].items() if v is not None}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+@pytest.mark.parametrize("cfg, change, message", [
+    ("fivebar_packing.yaml", {"preset": None, "start": None, "direction": None, "path": [[0, -700], [0, -2000]]},
+     "error: cycle.path[1]: (0, -2000) is outside the workspace"),
+    ("fivebar_packing.yaml", {"preset": None, "start": None, "direction": None, "path": [[0, -700]]},
+     "error: cycle.path: need at least 2 points, got 1"),
+    ("fivebar_packing.yaml", {"cycles_per_minute": None, "period": -1.0},
+     "error: cycle.period: must be a finite number > 0"),
+    ("fivebar_packing.yaml", {"cycles_per_minute": 0}, "error: cycle.cycles_per_minute: must be a finite number > 0"),
+    ("fivebar_packing.yaml", {"payload": 0}, "error: cycle.payload: must be a finite number > 0"),
+    ("fivebar_packing.yaml", {"preset": "scara"}, "error: cycle.preset: unknown preset 'scara' (known: adept)"),
+    ("fivebar_packing.yaml", {"start": [0, -300]}, "error: cycle.adept[0]: (0, -300) is outside the workspace"),
+    ("fivebar_packing.yaml", {"law": "cubic"}, "error: cycle.law: unknown motion law 'cubic'"),
+    ("rps_upu.yaml", {"preset": "adept", "start": [40, 0, 0], "cycles_per_minute": 30},
+     "error: cycle.preset: adept needs two Cartesian task axes; rps-upu has z, theta, psi"),
+])
+def test_bad_cycle_input_one_line_exit_2_nothing_written(tmp_path, cfg, change, message):
+    path = _write(tmp_path, cfg, **change)
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["cycle", str(path), "--out", str(out)])
+    assert res.exit_code == 2, res.output
+    assert res.stderr.startswith(message), res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+# ----- per-voxel clearance field ---------------------------------------------------------------------------
+def test_numba_segment_distance_matches_the_numpy_version():
+    from scalesynth.kernels.clearance import segment_distance as jit_distance
+
+    rng = np.random.default_rng(11)
+    pts = rng.normal(size=(400, 4, 3))
+    pts[::7, 1] = pts[::7, 0]  # some zero-length segments
+    pts[::5, 3] = pts[::5, 2] + 2.0 * (pts[::5, 1] - pts[::5, 0])  # some parallel pairs
+    for p1, q1, p2, q2 in pts:
+        assert jit_distance(*p1, *q1, *p2, *q2) == pytest.approx(float(segment_distance(p1, q1, p2, q2)), abs=1e-12)
+
+
+@pytest.mark.parametrize("radius", [None, 150.0])
+def test_fivebar_clearance_field_matches_numpy_link_geometry(radius):
+    """The field kernel's clearance at every reachable node of a grid against cycle.clearance of the mechanism's
+    link_geometry (NumPy, the cycle's code path), and interference_free = reachable and clearance >= 0."""
+    from scalesynth.evaluate import make_grid
+    from scalesynth.kernels import grid as kgrid
+
+    mech = FIVEBAR.mech
+    design = FIVEBAR.resolved_design()
+    options = mech.resolve_options({**FIVEBAR.options, "link_radius": radius})
+    g = make_grid(mech, design, options, 31)
+    slot = mech.field_names.index("clearance")
+    fields = kgrid.sample_fields(mech.field_kernel, mech.n_fields, mech.pack(design, options), g.lo, g.step, g.shape)
+    reach = fields[..., 0] >= 0
+    checked = 0
+    for i, j in zip(*np.nonzero(reach[:, :, 0]), strict=True):
+        pose = (g.axis(0)[i], g.axis(1)[j])
+        q = next(s.values for s in mech.inverse_kinematics(design, options, pose) if s.label == options["mode"])
+        expected = clearance(mech.link_geometry(design, options, pose, q)).value
+        assert fields[i, j, 0, slot] == pytest.approx(expected, abs=1e-9 * 1000)
+        checked += 1
+    assert checked > 100
+    free = mech.resolve_options({**options, "interference_free": True})
+    only = kgrid.sample_fields(mech.field_kernel, mech.n_fields, mech.pack(design, free), g.lo, g.step, g.shape)
+    assert np.array_equal(only[..., 0] >= 0, reach & (fields[..., slot] >= 0))
+    if radius is not None:
+        assert (reach & (fields[..., slot] < 0)).any()  # fat links: some reachable poses do interfere
+
+
+def test_five_bar_synthesis_minimising_cycle_speed_with_clearance_constraint(tmp_path):
+    """Done-when of issue 13: cycle_max_actuator_speed (min) as an objective, cycle_min_clearance >= 0 as a
+    constraint; every front row's cycle metrics equal a fresh analysis of that design."""
+    data = yaml.safe_load((ROOT / "configs" / "fivebar_packing.yaml").read_text())
+    data.update(name="fivebar_cycle", grid={"resolution": 16}, task=None,
+                objectives=[{"metric": "cycle_max_actuator_speed", "sense": "min"}, {"metric": "gci", "sense": "max"}],
+                constraints=[{"metric": "cycle_min_clearance", "min": 0.0}],
+                algorithm={"pop_size": 6, "n_gen": 2, "seed": 3}, output={"checkpoint_every": 1})
+    data["cycle"]["samples"] = 24
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(data))
+    res = CliRunner().invoke(app, ["optimize", str(path), "--out", str(tmp_path / "run"), "--no-plots"])
+    assert res.exit_code == 0, res.output
+    import pandas as pd
+
+    front = pd.read_csv(tmp_path / "run" / "pareto.csv")
+    assert len(front) >= 1
+    cfg = load_config(path)
+    for _, row in front.iterrows():
+        design = {k: row[k] for k in ("r", "l1", "l2")}
+        m = analysis.metrics(cfg.mech, design, cfg.resolved_options(), cfg.cycle, "mm")
+        assert row["cycle_max_actuator_speed_rad_per_s"] == pytest.approx(m["cycle_max_actuator_speed"], rel=1e-9)
+        assert row["cycle_min_clearance_mm"] >= 0
+    res = CliRunner().invoke(app, ["cycle", str(tmp_path / "run"), "--design", "best-cycle_max_actuator_speed",
+                                   "--out", str(tmp_path / "cyc"), "--json"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["metrics"]["cycle_max_actuator_speed"] == pytest.approx(
+        front["cycle_max_actuator_speed_rad_per_s"].min(), rel=1e-9)
+
+
+def test_cycle_on_a_mechanism_with_angular_task_axes_is_refused(tmp_path):
+    """rps-upu's task axes are (z, theta, psi): m (a - g) has no meaning there; one line, exit 2."""
+    path = _write(tmp_path, "rps_upu.yaml", path=[[40, 0, 0], [50, 0, 0]], cycles_per_minute=30)
+    res = CliRunner().invoke(app, ["cycle", str(path), "--out", str(tmp_path / "out")])
+    assert res.exit_code == 2
+    assert res.stderr.startswith("error: cycle: ") and len(res.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("config", ["paper_2pauu_ppap.yaml", "rps_upu_tool.yaml", "pprs_rprs.yaml"])
+def test_cycle_runs_on_the_configs_with_a_cycle(tmp_path, config):
+    """`scalesynth cycle` on each shipped config with a cycle (fewer samples for speed): feasible, clearance >= 0,
+    and the power balance of its CSV columns."""
+    cfg = load_config(ROOT / "configs" / config, ["cycle.samples=60"])
+    res = run(cfg, samples=60)
+    m = analysis.result_metrics(res, cfg.cycle)
+    assert m["cycle_feasible"] == 1.0 and m["cycle_min_clearance"] >= 0, m
+    lu = METRES_PER_UNIT[cfg.units.length]
+    joint_si = np.array([lu if u == "length" else 1.0 for u in cfg.mech.joint_units])
+    np.testing.assert_allclose(np.sum(res.force * res.qd * joint_si, axis=1),
+                               np.sum(res.task_force * res.traj.pd * lu, axis=1), atol=1e-9)
