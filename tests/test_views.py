@@ -242,6 +242,31 @@ def test_show_colours_by_any_field_of_the_kernel(tmp_path):
     assert json.loads((tmp_path / "show.json").read_text())["field"] == "sigma_min"
 
 
+def test_show_draws_the_robot_from_its_link_geometry(tmp_path):
+    """Five-bar at a chosen pose: the drawn arms and forearms have the design's lengths and meet at the pose; the
+    pose must be reachable; ups-sspr (no link geometry yet) says so and still shows its workspace."""
+    cfg = load_config(ROOT / "configs" / "fivebar_packing.yaml")
+    d = cfg.resolved_design()
+    res = runner.invoke(app, ["show", str(ROOT / "configs" / "fivebar_packing.yaml"), "--resolution", "16",
+                              "--pose=0,-700", "--out", str(tmp_path), "--json"])
+    assert res.exit_code == 0, res.output
+    robot = json.loads(res.stdout)["robot"]
+    seg = {s["name"]: (np.array(s["a"]), np.array(s["b"])) for s in robot["segments"]}
+    for arm, fore in (("arm1", "forearm1"), ("arm2", "forearm2")):
+        assert np.linalg.norm(seg[arm][1] - seg[arm][0]) == pytest.approx(d["l1"], rel=1e-12)
+        assert np.linalg.norm(seg[fore][1] - seg[fore][0]) == pytest.approx(d["l2"], rel=1e-12)
+        np.testing.assert_allclose(seg[fore][1], [0.0, -700.0, 0.0], atol=1e-9)
+    assert robot["branch"] == cfg.resolved_options()["mode"] and (tmp_path / "robot.png").is_file()
+    res = runner.invoke(app, ["show", str(ROOT / "configs" / "fivebar_packing.yaml"), "--resolution", "8",
+                              "--pose=0,-5000", "--out", str(tmp_path / "far"), "--json"])
+    assert res.exit_code == 0 and json.loads(res.stdout)["robot"]["missing"] == "the pose is out of reach"
+    res = runner.invoke(app, ["show", str(ROOT / "configs" / "fivebar_packing.yaml"), "--pose=1,2,3"])
+    assert res.exit_code == 2 and "--pose: expected 2 finite numbers (x, y)" in res.stderr
+    res = runner.invoke(app, ["show", str(ROOT / "configs" / "ups_sspr.yaml"), "--resolution", "8",
+                              "--out", str(tmp_path / "u")])
+    assert res.exit_code == 0 and "robot not drawn: mechanism: ups-sspr has no link geometry" in res.stdout
+
+
 def test_plane_sampling_equals_the_full_grid_slice():
     cfg = load_config(ROOT / "configs" / "paper_2pauu_ppap.yaml")
     design = TABLE4[1]

@@ -176,8 +176,28 @@ def table(frame: pd.DataFrame, columns: Sequence[str], index_name: str, index: S
     return f"<table><tr><th>{_html.escape(index_name)}</th>{head}</tr>{''.join(rows)}</table>"
 
 
+def robot_figure(segments: Sequence[dict], unit: str, title: str):
+    """The robot's capsules as thick 3-D lines, one colour per body, equal scale (mechanism frame)."""
+    import plotly.graph_objects as go
+
+    fig = go.Figure()
+    bodies = list(dict.fromkeys(s["body"] for s in segments))
+    for k, body in enumerate(bodies):
+        xs, ys, zs = [], [], []
+        for s in segments:
+            if s["body"] == body:
+                xs += [s["a"][0], s["b"][0], None]
+                ys += [s["a"][1], s["b"][1], None]
+                zs += [s["a"][2], s["b"][2], None]
+        fig.add_trace(go.Scatter3d(x=xs, y=ys, z=zs, mode="lines+markers", name=body,
+                                   line={"color": PALETTE[k % len(PALETTE)], "width": 8}, marker={"size": 3}))
+    fig.update_layout(title=title, scene={"xaxis_title": f"x [{unit}]", "yaxis_title": f"y [{unit}]",
+                                          "zaxis_title": f"z [{unit}]", "aspectmode": "data"})
+    return fig
+
+
 def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path, field_label: str,
-              vmin: float = 0.0, vmax: float = 1.0) -> str:
+              vmin: float = 0.0, vmax: float = 1.0, robot: dict | None = None) -> str:
     """The HTML of `scalesynth show --format html`: 3-D view, one 3-D view per band (regions coloured), sections."""
     import plotly.graph_objects as go
 
@@ -206,4 +226,10 @@ def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, pat
             blocks.append(figs.html(fig, 560))
     for panel in panels:
         blocks.append(figs.html(heatmap_figure(panel, field_label, vmin=vmin, vmax=vmax), 480))
+    if robot and "segments" in robot:
+        pose = ", ".join(f"{v:.4g}" for v in robot["pose"])
+        blocks.append(figs.html(robot_figure(robot["segments"], cfg.units.length,
+                                             f"robot at pose ({pose}), branch {robot['branch']}"), 560))
+    elif robot:
+        blocks.append(f"<p class=\"note\">Robot not drawn: {_html.escape(robot['missing'])}</p>")
     return page(title, blocks)

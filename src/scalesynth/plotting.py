@@ -250,6 +250,46 @@ def band_regions_figure(regions: Sequence[dict], labels: Sequence[str], title: s
     return fig
 
 
+def robot_figure(segments: Sequence[dict], unit: str, title: str, planar: bool, path: np.ndarray | None = None,
+                 path_label: str = "path"):
+    """The robot: each capsule's segment a -> b as a thick line, one colour per body, joints as dots; drawn to
+    equal scale in the mechanism frame (x, y, z in the length unit)."""
+    bodies = list(dict.fromkeys(s["body"] for s in segments))
+    colour = {b: OKABE_ITO[k % len(OKABE_ITO)] for k, b in enumerate(bodies)}
+    fig = plt.figure(figsize=(7.0, 6.0))
+    ax = fig.add_subplot() if planar else fig.add_subplot(projection="3d")
+    seen = set()
+    pts = []
+    for s in segments:
+        a, b = np.asarray(s["a"]), np.asarray(s["b"])
+        pts += [a, b]
+        lbl = s["body"] if s["body"] not in seen else None
+        seen.add(s["body"])
+        xyz = np.stack([a, b])
+        lw = 4 if s["radius"] > 0 else 2
+        if planar:
+            ax.plot(xyz[:, 0], xyz[:, 1], "-o", c=colour[s["body"]], lw=lw, ms=4, label=lbl)
+        else:
+            ax.plot(xyz[:, 0], xyz[:, 1], xyz[:, 2], "-o", c=colour[s["body"]], lw=lw, ms=3, label=lbl)
+    if path is not None:
+        p = np.asarray(path, dtype=float)
+        if planar:
+            ax.plot(p[:, 0], p[:, 1], "--", c="k", lw=1, label=path_label)
+        else:
+            ax.plot(p[:, 0], p[:, 1], p[:, 2], "--", c="k", lw=1, label=path_label)
+    ax.set_xlabel(f"x [{unit}]")
+    ax.set_ylabel(f"y [{unit}]")
+    if planar:
+        ax.set_aspect("equal")
+    else:
+        ax.set_zlabel(f"z [{unit}]")
+        span = np.ptp(np.array(pts), axis=0) if pts else np.ones(3)
+        ax.set_box_aspect(np.where(span > 0, span, max(span.max(), 1.0) * 0.05))
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title(title, fontsize=9)
+    return fig
+
+
 def _draw_box_path(ax, box, path) -> None:
     if box is not None:
         lo, hi = np.asarray(box, dtype=float)

@@ -60,6 +60,8 @@ def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[l
     g = fg.grid
     ext = [(float(g.lo[a]), float(g.lo[a] + g.shape[a] * g.step[a])) for a in range(3)]
     box, path = wv.task_geometry(cfg)
+    if path is None:
+        path = wv.cycle_path(cfg)
     if mech.planar:
         panel = {"values": values[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": lab.axis_label(mech, 0, unit),
                  "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
@@ -101,6 +103,7 @@ def show_design(
     fmt: str = "png",
     resolution: int | None = None,
     sets: Sequence[str] | None = None,
+    pose: str | None = None,
 ) -> dict[str, Any]:
     """Write the views of one design into ``out`` (default <run or results/<name>>/show/<design label>/) and
     return what show.json holds."""
@@ -150,11 +153,13 @@ def show_design(
         "sections": section_info,
         "task": None if cfg.task is None else {"box": {k: list(v) for k, v in cfg.task.box.items()},
                                                "path_points": None if cfg.task.path is None else len(cfg.task.path)},
-        "robot": "not drawn: link geometry of the mechanisms is not available yet (issue 13)",
+        "cycle_path_points": None if wv.cycle_path(cfg) is None else int(len(wv.cycle_path(cfg)) - 1),
         "files": [],
     }
+    pose_values = wv.default_pose(fg, ndim) if pose is None else _parse_pose(pose, mech)
+    summary["robot"] = wv.robot(cfg, chosen, pose_values)
     title = f"{mech.name} {label}: " + ", ".join(f"{k}={v:.4g}" for k, v in chosen.items())
-    files = _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target, fmt)
+    files = _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target, fmt, summary["robot"])
     summary["files"] = files
     summary["seconds"] = {"sample": round(t_sample, 3), "total": round(time.perf_counter() - t0, 3)}
     rio.write_json(target / "show.json", summary)
@@ -174,18 +179,54 @@ def colour_range(fg: wv.FieldGrid, field: str) -> tuple[float, float]:
     return (lo, hi) if hi > lo else (lo, lo + 1.0)
 
 
-def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target: Path, fmt: str) -> list[str]:
+def _parse_pose(text: str, mech) -> np.ndarray:
+    from scalesynth.errors import InvalidPose
+
+    try:
+        values = np.array([float(t) for t in text.split(",")])
+    except ValueError:
+        raise InvalidPose(f"--pose: expected {len(mech.task_axes)} comma-separated numbers, got {text!r}") from None
+    if values.shape != (len(mech.task_axes),) or not np.all(np.isfinite(values)):
+        raise InvalidPose(f"--pose: expected {len(mech.task_axes)} finite numbers "
+                          f"({', '.join(mech.task_axes)}), got {text!r}")
+    return values
+
+
+def _robot_view(cfg, robot: dict, target: Path, fmt: str, title: str) -> list[str]:
+    """robot.<fmt>: the links at the chosen pose, with the task or cycle path when the task axes are x, y(, z)."""
+    from scalesynth import plotting
+
+    if "segments" not in robot:
+        return []
+    mech = cfg.mech
+    cartesian = tuple(mech.task_axes) in (("x", "y"), ("x", "y", "z"))
+    box, path = wv.task_geometry(cfg)
+    label = "task path"
+    if path is None:
+        path, label = wv.cycle_path(cfg), "cycle path"
+    pose = ", ".join(f"{lab.axis_name(a)}={v:.4g}" for a, v in zip(mech.task_axes, robot["pose"], strict=True))
+    fig = plotting.robot_figure(robot["segments"], cfg.units.length, f"{title}\nrobot at {pose} "
+                                f"(branch {robot['branch']})", mech.planar, path if cartesian else None, label)
+    rio.save_figure(fig, target / f"robot.{fmt}")
+    plotting.close(fig)
+    return [f"robot.{fmt}"]
+
+
+def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target: Path, fmt: str,
+                 robot: dict | None = None) -> list[str]:
     mech = cfg.mech
     edges = cfg.dexterity.band_edges
     field_label = lab.field_label(mech, field, cfg.units.length)
     vmin, vmax = colour_range(fg, field)
     box, path = wv.task_geometry(cfg)
+    if path is None:
+        path = wv.cycle_path(cfg)
     files = []
     if fmt == "html":
         from scalesynth import interactive
 
         html = interactive.show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, path,
-                                     field_label, vmin, vmax)
+                                     field_label, vmin, vmax, robot)
         rio.write_text(target / "show.html", html)
         return ["show.html"]
     from scalesynth import plotting
@@ -215,4 +256,5 @@ def _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, targe
     rio.save_figure(fig, target / f"sections.{fmt}")
     plotting.close(fig)
     files.append(f"sections.{fmt}")
+    files += _robot_view(cfg, robot or {}, target, fmt, title)
     return files

@@ -256,3 +256,52 @@ def parse_at(items: Sequence[str] | None, mech) -> dict[int, float]:
             raise InvalidParameter(f"--at {item}: must be finite")
         out[mech.task_axes.index(name.strip())] = value
     return out
+
+
+# ----- the robot and the cycle path ------------------------------------------------------------------------------
+def cycle_path(cfg) -> np.ndarray | None:
+    """The config's pick-and-place cycle as a closed polyline (n, 3) in task units, or None without a cycle."""
+    if getattr(cfg, "cycle", None) is None:
+        return None
+    from scalesynth.cycle.config import vertices
+
+    v = np.asarray(vertices(cfg.cycle, cfg.mech, cfg.units.length), dtype=float)
+    v = np.vstack([v, v[:1]])
+    return np.pad(v, ((0, 0), (0, 3 - v.shape[1])))[:, :3]
+
+
+def default_pose(fg: FieldGrid, ndim: int) -> np.ndarray:
+    """The reachable grid node nearest to the workspace centroid (task coordinates, ``ndim`` entries)."""
+    c = centroid(fg)
+    idx = np.argwhere(fg.reachable)
+    if not len(idx):
+        return c[:ndim]
+    axes = fg.axes()
+    pts = np.column_stack([axes[a][idx[:, a]] for a in range(3)])
+    span = np.where(fg.grid.step > 0, fg.grid.step, 1.0)  # distance in cells: axes of different units
+    k = int(np.argmin((((pts - c) / span) ** 2).sum(axis=1)))
+    return pts[k, :ndim]
+
+
+def robot(cfg, design, pose) -> dict[str, Any]:
+    """Link geometry at ``pose`` in the kernel's working mode: {"pose", "branch", "segments": [{"name", "body",
+    "a", "b", "radius"}]} or {"pose", "missing": reason} when the mechanism has no link geometry or the pose is out
+    of reach."""
+    from scalesynth.errors import ScalesynthError
+
+    mech = cfg.mech
+    options = cfg.resolved_options()
+    design = mech.resolve_design(design)
+    pose = [float(v) for v in pose]
+    sols = mech.inverse_kinematics(design, options, pose)
+    if not sols:
+        return {"pose": pose, "missing": "the pose is out of reach"}
+    branch = mech.kernel_branch(options)
+    sol = next((s for s in sols if s.label == branch), sols[0])
+    try:
+        geo = mech.link_geometry(design, options, pose, sol.values)
+    except ScalesynthError as err:
+        return {"pose": pose, "missing": str(err)}
+    segs = [{"name": s.name, "body": s.body, "a": [float(v) for v in s.a], "b": [float(v) for v in s.b],
+             "radius": float(s.radius)} for s in geo.segments]
+    return {"pose": pose, "branch": sol.label, "segments": segs}

@@ -24,6 +24,8 @@ def show_cmd(
         "--out", help="directory to write (default RUN_DIR/show/<design> or results/<name>/show/config)")] = None,
     fmt: Annotated[str, typer.Option("--format", help="png | svg | pdf | html")] = "png",
     resolution: Annotated[int | None, typer.Option(help="cells per axis (default grid.resolution)")] = None,
+    pose: Annotated[str | None, typer.Option(
+        "--pose", help="task coordinates of the robot drawing, comma-separated (default: near the centroid)")] = None,
     sets: SetOpt = None,
     as_json: Annotated[bool, typer.Option("--json", help="print show.json's content on stdout")] = False,
 ) -> None:
@@ -31,7 +33,7 @@ def show_cmd(
     sections with the task box and path; writes the figures and show.json."""
     from scalesynth.show import show_design
 
-    info = show_design(source, design, field, at, out, fmt, resolution, sets)
+    info = show_design(source, design, field, at, out, fmt, resolution, sets, pose)
     if as_json:
         _print_json(info)
         return
@@ -43,5 +45,8 @@ def show_cmd(
     for s in info["sections"]:
         if s.get("normal") is not None:
             typer.echo(f"  section {s['normal']} = {s['value']:.6g} ({s['source']}): {s['cells']} reachable cells")
+    robot = info["robot"]
+    if "missing" in robot:
+        typer.echo(f"  robot not drawn: {robot['missing']}")
     for f in info["files"] + ["show.json"]:
         typer.echo(str(Path(info["out"]) / f))
