@@ -58,6 +58,26 @@ def test_report_html_is_self_contained_with_every_column_on_hover(small_run):
     assert "report.html" in (small_run / "report.md").read_text()
 
 
+def test_validator_checks_report_html_and_band_sets(small_run, tmp_path):
+    import shutil
+
+    from scalesynth.validate_results import check_results
+
+    assert check_results(small_run) == []
+    bad = tmp_path / "bad"
+    shutil.copytree(small_run, bad)
+    band = pd.read_csv(bad / "bands" / "pareto_band2.csv")
+    worse = band.iloc[[0]].copy()
+    worse["band2_volume_m3"] *= 0.5
+    worse["gci"] *= 0.5
+    pd.concat([band, worse]).to_csv(bad / "bands" / "pareto_band2.csv", index=False)
+    html = (bad / "report.html").read_text(encoding="utf-8")
+    (bad / "report.html").write_text(html.replace("<head>", '<head><script src="https://cdn.plot.ly/x.js"></script>'),
+                                     encoding="utf-8")
+    assert check_results(bad) == ["report.html: loads a script from the network",
+                                  "bands/pareto_band2.csv: a row is dominated"]
+
+
 def test_remote_script_check_can_fail():
     assert has_remote_scripts('<script src="https://cdn.plot.ly/plotly-2.35.2.min.js"></script>')
     assert has_remote_scripts("<script type='text/javascript' src='//cdn.example/x.js'></script>")
