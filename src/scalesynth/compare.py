@@ -20,8 +20,8 @@ from scalesynth import labels as lab
 from scalesynth.errors import ConfigError
 
 NOT_METRICS = {"rank", "feasible", "voxels"}
-# preferred axes of the figure when the runs share no two objectives
-AXIS_PREFERENCE = ("task_coverage", "task_gci", "task_fci", "gci", "fci", "link_length_sum", "min_lci", "path_min_lci")
+# preferred axes of the figure when the runs share no two objectives: by catalogue family, task metrics first
+FAMILY_PREFERENCE = ("task", "workspace", "design", "cycle", "path")
 _ROW = re.compile(r"\(row (\d+) of pareto\.csv\)")
 
 
@@ -66,7 +66,16 @@ def shared_metrics(runs: Sequence[dict]) -> list[str]:
 def figure_axes(runs: Sequence[dict], shared: Sequence[str]) -> tuple[str, str]:
     objectives = [k for k in runs[0]["problem"].objective_keys
                   if all(k in r["problem"].objective_keys for r in runs) and k in shared]
-    ordered = list(dict.fromkeys([*objectives, *[k for k in AXIS_PREFERENCE if k in shared], *shared]))
+    from scalesynth.metrics import catalogue
+
+    cfg = runs[0]["cfg"]
+    family = {}
+    for m in catalogue(cfg.mech, cfg.units.length).values():
+        for col in m.columns(len(cfg.dexterity.band_edges) - 1):
+            family[col] = m.family
+    rank = {f: i for i, f in enumerate(FAMILY_PREFERENCE)}
+    by_family = sorted(shared, key=lambda c: rank.get(family.get(c, ""), len(rank)))  # stable: keeps column order
+    ordered = list(dict.fromkeys([*objectives, *by_family]))
     if len(ordered) < 2:
         raise ConfigError("RUN_DIR: the runs share fewer than two metrics, nothing to compare "
                           f"(shared: {', '.join(shared) or 'none'})")

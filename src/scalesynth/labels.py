@@ -12,23 +12,17 @@ import re
 _GREEK = {"alpha": "α", "beta": "β", "gamma": "γ", "theta": "θ", "psi": "ψ", "phi": "φ", "sigma": "σ"}
 _SUPER = str.maketrans("0123456789", "⁰¹²³⁴⁵⁶⁷⁸⁹")
 
+# the literature's short names of the LCI statistics; other names come from the catalogue, made readable
 _NAMES = {
     "gci": "GCI",
     "fci": "FCI",
     "min_lci": "min LCI",
     "max_lci": "max LCI",
     "lci": "LCI",
-    "voxels": "voxels",
-    "task_coverage": "task coverage",
-    "task_gci": "task GCI",
-    "task_fci": "task FCI",
-    "task_min_lci": "task min LCI",
-    "path_min_lci": "path min LCI",
-    "path_mean_lci": "path mean LCI",
-    "path_reachable": "path reachable share",
     "m_minus_n": "m − n",
     "link_length_sum": "Σ link lengths",
 }
+_PREFIXES = ("task_", "path_", "cycle_")  # families whose names are a prefix and a workspace-style name
 _MEASURE = re.compile(r"^(?:(band\d+)_)?(volume|area)_([a-z0-9_]+)$")
 
 
@@ -64,7 +58,7 @@ def labeller(cfg):
             return metric_label(column)
         if column in units:
             name, unit = units[column]
-            base = _NAMES.get(name, _pretty_name(name))
+            base = _name(name)
             return base if unit in ("1", "") else f"{base} [{unit_text(unit)}]"
         return metric_label(column)
 
@@ -76,9 +70,9 @@ def field_label(mech, name: str, length_unit: str) -> str:
     for f in getattr(mech, "fields", ()):
         if f.name == name:
             unit = f.unit.replace("{length}", length_unit)
-            base = _NAMES.get(name, _pretty_name(name))
+            base = _name(name)
             return base if unit in ("1", "") else f"{base} [{unit_text(unit)}]"
-    return _NAMES.get(name, name)
+    return _name(name)
 
 
 def metric_label(column: str) -> str:
@@ -93,7 +87,17 @@ def metric_label(column: str) -> str:
     m = re.fullmatch(r"band(\d+)_share", column)
     if m:
         return f"share of band {m.group(1)}"
-    return _NAMES.get(column, column)
+    return _name(column)
+
+
+def _name(name: str) -> str:
+    """'task_gci' -> 'task GCI', 'path_min_lci' -> 'path min LCI', 'mean_sigma_min' -> 'mean σ_min'."""
+    if name in _NAMES:
+        return _NAMES[name]
+    for prefix in _PREFIXES:
+        if name.startswith(prefix) and len(name) > len(prefix):
+            return f"{prefix[:-1]} {_name(name[len(prefix):])}"
+    return _pretty_name(name)
 
 
 def axis_name(name: str) -> str:
