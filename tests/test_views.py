@@ -119,6 +119,17 @@ def test_report_html_renders_in_headless_chromium(small_run, tmp_path):
     _not_blank(r["pixels"])
 
 
+def test_show_html_renders_in_headless_chromium(small_run, tmp_path):
+    _need_chromium()
+    res = runner.invoke(app, ["show", str(small_run), "--format", "html", "--resolution", "16",
+                              "--out", str(tmp_path / "h")])
+    assert res.exit_code == 0, res.output
+    r = open_page(tmp_path / "h" / "show.html", tmp_path / "show.png")
+    assert r["loaded"] and r["errors"] == []
+    assert r["dom"].count('class="main-svg"') >= 5  # 3-D workspace, three bands, sections, robot
+    _not_blank(r["pixels"])
+
+
 # ----- per-band Pareto sets -----------------------------------------------------------------------------------------
 def test_band_pareto_csvs_are_the_brute_force_nondominated_sets(small_run):
     pop = pd.read_csv(small_run / "population.csv")
