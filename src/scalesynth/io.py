@@ -151,8 +151,13 @@ def write_csv(path: Path, frame) -> None:
     write_text(path, frame.to_csv(index=False, float_format="%.12g", lineterminator="\n"))
 
 
+FIGURE_FORMATS = ("png", "svg", "pdf")
+
+
 def save_figure(fig, path: Path, dpi: int = 130) -> None:
-    write_atomic(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi, bbox_inches="tight"), mode="wb")
+    """Write a matplotlib figure atomically in the format of the file's suffix (png, svg or pdf)."""
+    fmt = Path(path).suffix.lstrip(".").lower() or "png"
+    write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight"), mode="wb")
 
 
 # ----- reading a results directory that may have been damaged: one-line ConfigError, never a traceback ----------

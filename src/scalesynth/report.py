@@ -1,7 +1,8 @@
-"""Plots and report.md of a run, from its RunResult in memory (scalesynth.results); draws via plotting.py.
+"""Plots, per-band Pareto sets, report.md and report.html of a run, from its RunResult in memory
+(scalesynth.results); draws via plotting.py (matplotlib) and interactive.py (plotly).
 
-``optimize.run`` passes the result it just built, so report.md, the plots and manifest.json show the same
-figures; the ``plot-*`` commands pass ``results.load(run_dir)``.
+``optimize.run`` passes the result it just built, so report.md, report.html, the plots and manifest.json show the
+same figures; the ``plot-*`` commands pass ``results.load(run_dir)``.
 """
 
 from __future__ import annotations
@@ -12,13 +13,15 @@ from typing import Any
 import numpy as np
 
 from scalesynth import io as rio
+from scalesynth import labels as lab
 from scalesynth import plotting
 from scalesynth.config import RunConfig
-from scalesynth.evaluate import evaluate_config, make_grid
-from scalesynth.kernels.grid import sample_grid
+from scalesynth.errors import ConfigError
+from scalesynth.evaluate import evaluate_config
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
+from scalesynth.workspace_view import band_labels, default_section_point, sample_plane, task_geometry
 
 
 def _axes(problem: SynthesisProblem, cfg: RunConfig) -> tuple[str, str]:
@@ -43,11 +46,26 @@ def dominated_by_front(F_front: np.ndarray, f: np.ndarray) -> bool:
     return bool(np.any(np.all(F_front <= f, axis=1) & np.any(F_front < f, axis=1)))
 
 
-def plot_front(result: RunResult) -> dict[str, Any]:
-    """plots/front.png (front, final population, reference designs, knee) and plots/hypervolume.png."""
+def _plots_dir(result: RunResult, out: Path | None, fmt: str) -> Path:
+    if fmt not in rio.FIGURE_FORMATS:
+        raise ConfigError(f"--format: must be one of {', '.join(rio.FIGURE_FORMATS)}, got {fmt!r}")
+    return rio.ensure_dir(Path(out) if out is not None else result.out_dir / PLOTS)
+
+
+def _rel(run_dir: Path, path: Path) -> str:
+    """A written file's name relative to the run directory (absolute when --out put it elsewhere)."""
+    try:
+        return str(path.resolve().relative_to(Path(run_dir).resolve()))
+    except ValueError:
+        return str(path)
+
+
+def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+    """plots/front.<fmt> (front, final population, reference designs, knee) and plots/hypervolume.<fmt>."""
+    plots = _plots_dir(result, out, fmt)
     cfg, pareto, history, population, problem = (result.cfg, result.pareto, result.history, result.population,
                                                  result.problem)
-    plots = rio.ensure_dir(result.out_dir / PLOTS)
+    label = lab.labeller(cfg)
     xk, yk = _axes(problem, cfg)
     refs = reference_points(cfg)
     highlight = []
@@ -64,25 +82,22 @@ def plot_front(result: RunResult) -> dict[str, Any]:
     fig = plotting.front_figure(
         pareto[xk].to_numpy(),
         pareto[yk].to_numpy(),
-        xk,
-        yk,
+        label(xk),
+        label(yk),
         f"{cfg.name}: Pareto front ({cfg.mechanism}, seed {cfg.algorithm.seed})",
         references=[(r["label"], r["metrics"][xk], r["metrics"][yk]) for r in refs],
         highlight=highlight,
         population=pop_xy,
     )
-    rio.save_figure(fig, plots / "front.png")
+    rio.save_figure(fig, plots / f"front.{fmt}")
     plotting.close(fig)
     fig = plotting.hypervolume_figure(
         history["generation"].to_numpy(), history["hypervolume"].to_numpy(), f"{cfg.name}: hypervolume per generation"
     )
-    rio.save_figure(fig, plots / "hypervolume.png")
+    rio.save_figure(fig, plots / f"hypervolume.{fmt}")
     plotting.close(fig)
-    return {"references": refs, "files": ["plots/front.png", "plots/hypervolume.png"]}
-
-
-def band_labels(edges) -> list[str]:
-    return [f"{'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]" for b in range(len(edges) - 1)]
+    files = [_rel(result.out_dir, plots / f"front.{fmt}"), _rel(result.out_dir, plots / f"hypervolume.{fmt}")]
+    return {"references": refs, "files": files}
 
 
 def featured_designs(result: RunResult) -> list[tuple[str, int]]:
@@ -97,75 +112,82 @@ def featured_designs(result: RunResult) -> list[tuple[str, int]]:
     return out
 
 
-SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; one design costs ~0.1 s
+SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; a plane costs 128^2 points
 
 
 def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, Any]]:
-    """Mid-plane sections of the LCI grid: (axis0, axis2) at the middle of axis1 and (axis0, axis1) at the middle
-    of axis2 (for seed 000: xz at y = 0 and xy at the centre height); one map for planar mechanisms."""
+    """Workspace sections coloured by LCI, each sampled on its plane only (never a full grid): for a 3-D mechanism
+    the planes normal to its second and third task axes through the workspace centroid (from a coarse grid; an
+    empty plane moves to the nearest one that cuts the workspace), for seed 000 the xz and xy sections; one map
+    for planar mechanisms. Axis labels carry units; axes of different units are not drawn to equal scale."""
+    mech = cfg.mech
+    unit = cfg.units.length
     res = max(cfg.grid.resolution, SECTION_RESOLUTION)
-    res = res + res % 2 + 1
-    mech, options = cfg.mech, cfg.resolved_options()
-    design = mech.resolve_design(design)
-    g = make_grid(mech, design, options, res, cfg.grid.region)
-    packed = mech.pack(design, options)
-
-    def plane(axis: int, index: int) -> np.ndarray:
-        """LCI on the grid's plane ``index`` of ``axis`` only (never the whole res^3 grid: issue 11)."""
-        lo, shape = g.lo.copy(), g.shape.copy()
-        lo[axis] += index * g.step[axis]
-        shape[axis] = 1
-        return sample_grid(mech.point_kernel, packed, lo, g.step, shape)
-
-    names = mech.task_axes
-    ext = [(g.lo[a], g.lo[a] + g.shape[a] * g.step[a]) for a in range(3)]
-    if len(names) == 2:
-        return [{"lci": plane(2, 0)[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": names[0],
-                 "ylabel": names[1], "title": f"{names[0]}{names[1]} workspace"}]
-    j = int(g.shape[1]) // 2
-    k = int(g.shape[2]) // 2
-    yj = g.lo[1] + (j + 0.5) * g.step[1]
-    zk = g.lo[2] + (k + 0.5) * g.step[2]
-    return [
-        {"lci": plane(1, j)[:, 0, :], "extent": (*ext[0], *ext[2]), "xlabel": names[0], "ylabel": names[2],
-         "title": f"{names[0]}{names[2]} section at {names[1]} = {yj:.4g}"},
-        {"lci": plane(2, k)[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": names[0], "ylabel": names[1],
-         "title": f"{names[0]}{names[1]} section at {names[2]} = {zk:.4g}"},
-    ]
+    box, path = task_geometry(cfg)
+    if mech.planar:
+        values, ext = sample_plane(cfg, design, 2, 0.0, res)
+        return [{"values": values, "extent": ext, "xlabel": lab.axis_label(mech, 0, unit),
+                 "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
+                 "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
+                 "path": None if path is None else path[:, :2]}]
+    point = default_section_point(cfg, design)
+    panels = []
+    for normal in (1, 2):
+        a, b = [x for x in range(3) if x != normal]
+        point[normal] = round(float(point[normal]), 10) + 0.0  # no '-7e-17' in titles for a symmetric workspace
+        values, ext = sample_plane(cfg, design, normal, float(point[normal]), res)
+        name = lab.axis_name(mech.task_axes[normal])
+        panel = {"values": values, "extent": ext, "xlabel": lab.axis_label(mech, a, unit),
+                 "ylabel": lab.axis_label(mech, b, unit), "equal": lab.same_units(mech, (a, b)),
+                 "title": f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at "
+                          f"{name} = {point[normal]:.4g} (centroid)"}
+        if box is not None and box[0, normal] <= point[normal] <= box[1, normal]:
+            panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
+        panels.append(panel)
+    return panels
 
 
-def plot_bands(result: RunResult) -> dict[str, Any]:
-    """plots/bands_front.png, plots/band_shares.png and plots/sections_<design>.png (paper Figs. 7-10, Table 5)."""
+def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+    """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
+    per-band Pareto sets bands/pareto_band<k>.csv with their plots."""
+    from scalesynth.band_fronts import write_band_fronts
+
+    plots = _plots_dir(result, out, fmt)
     cfg, pareto, problem = result.cfg, result.pareto, result.problem
-    plots = rio.ensure_dir(result.out_dir / PLOTS)
+    label = lab.labeller(cfg)
     edges = cfg.dexterity.band_edges
     labels = band_labels(edges)
     nb = len(edges) - 1
     files = []
+    bands_out = None if out is None else plots / "bands"
+    band_info = write_band_fronts(result.out_dir, cfg, problem, result.population, fmt, bands_out)
+    band_rel = [_rel(result.out_dir, Path(p)) for p in band_info["paths"]]
     if not len(pareto):
-        return {"files": files, "featured": []}
+        return {"files": files, "featured": [], "band_files": band_rel, "band_sizes": band_info["sizes"]}
     xk, yk = _axes(problem, cfg)
     shares = [pareto[f"band{b}_share"].to_numpy() for b in range(nb)]
-    fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels, xk, yk)
-    rio.save_figure(fig, plots / "bands_front.png")
+    fig = plotting.band_front_figure(pareto[xk].to_numpy(), pareto[yk].to_numpy(), shares, labels, label(xk),
+                                     label(yk))
+    rio.save_figure(fig, plots / f"bands_front.{fmt}")
     plotting.close(fig)
-    files.append("plots/bands_front.png")
+    files.append(_rel(result.out_dir, plots / f"bands_front.{fmt}"))
     featured = featured_designs(result)
     bar = np.array([[pareto[f"band{b}_share"].iloc[i] for b in range(nb)] for _, i in featured])
-    fig = plotting.band_shares_figure([label for label, _ in featured], bar, labels)
-    rio.save_figure(fig, plots / "band_shares.png")
+    fig = plotting.band_shares_figure([name for name, _ in featured], bar, labels)
+    rio.save_figure(fig, plots / f"band_shares.{fmt}")
     plotting.close(fig)
-    files.append("plots/band_shares.png")
-    for label, i in featured:
+    files.append(_rel(result.out_dir, plots / f"band_shares.{fmt}"))
+    for name, i in featured:
         design = result.design_of(pareto.iloc[i])
         panels = section_panels(cfg, design)
-        title = f"{label}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
+        title = f"{name}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
         fig = plotting.sections_figure(panels, edges, title)
-        name = "sections_" + label.replace(" ", "_") + ".png"
-        rio.save_figure(fig, plots / name)
+        fname = "sections_" + name.replace(" ", "_") + f".{fmt}"
+        rio.save_figure(fig, plots / fname)
         plotting.close(fig)
-        files.append(f"plots/{name}")
-    return {"files": files, "featured": [(label, int(i)) for label, i in featured]}
+        files.append(_rel(result.out_dir, plots / fname))
+    return {"files": files, "featured": [(name, int(i)) for name, i in featured], "band_files": band_rel,
+            "band_sizes": band_info["sizes"]}
 
 
 def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> str:
@@ -222,8 +244,18 @@ def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[
             dom = r.get("dominated_by_front")
             lines.append(f"| {r['label']} | {r['metrics'][mkey]:.4g} | {r['metrics']['gci']:.4g} | "
                          f"{'yes' if dom else 'no' if dom is not None else '-'} |")
-    lines += ["", "## Plots", ""]
-    for f in front_info.get("files", []) + bands_info.get("files", []):
+    sizes = bands_info.get("band_sizes") or []
+    if sizes:
+        lines += ["", "## Per-band Pareto sets", "",
+                  "Designs of the final population non-dominated in band k's measure and the run's other objectives.",
+                  ""]
+        for k, n in enumerate(sizes):
+            lines.append(f"- LCI {band_labels(cfg.dexterity.band_edges)[k]}: {n} designs, "
+                         f"[bands/pareto_band{k}.csv](bands/pareto_band{k}.csv)")
+    lines += ["", "## Plots", "", "Interactive version: [report.html](report.html) (self-contained, works offline).",
+              ""]
+    images = [f for f in bands_info.get("band_files", []) if not f.endswith(".csv")]
+    for f in front_info.get("files", []) + bands_info.get("files", []) + images:
         lines.append(f"![{Path(f).stem}]({f})")
     return "\n".join(lines) + "\n"
 
@@ -233,7 +265,12 @@ def write_report(result: RunResult, front_info: dict[str, Any], bands_info: dict
 
 
 def write_plots_and_report(result: RunResult) -> None:
-    """Every plot and report.md of a run, from the RunResult (no files re-read, no second problem)."""
+    """Every plot, the per-band Pareto sets, report.md and report.html of a run, from the RunResult (no files
+    re-read, no second problem)."""
+    from scalesynth.report_html import write_report_html
+
     front = plot_front(result)
     bands = plot_bands(result)
     write_report(result, front, bands)
+    xk, yk = _axes(result.problem, result.cfg)
+    write_report_html(result, bands.get("featured") or [], (xk, yk), bands.get("band_sizes"))

@@ -4,7 +4,8 @@ Checks: every file present and parseable (scalesynth.results); pareto.csv has th
 every catalogue metric column; no NaN/inf; design variables within bounds; every metric within its catalogue
 range; band shares sum to 1; every row non-dominated and no two rows equal in objective space; history
 generations 1..n_gen, hypervolume finite and higher at the end than at the start; manifest status finished with
-matching evaluations.
+matching evaluations. With the report: report.html loads no script from the network, and every
+bands/pareto_band<k>.csv exists and is non-dominated in its band objectives.
 """
 
 from __future__ import annotations
@@ -79,6 +80,35 @@ def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
         problems.append("manifest.json: status is not finished")
     if manifest.get("evaluations") != int(history["evaluations"].iloc[-1]):
         problems.append("manifest.json: evaluations differ from history.csv")
+    if require_report:
+        problems += _check_views(run_dir, result)
+    return problems
+
+
+def _check_views(run_dir: Path, result) -> list[str]:
+    """report.html self-contained; per-band Pareto sets present and non-dominated."""
+    import pandas as pd
+
+    from scalesynth.band_fronts import band_objectives
+    from scalesynth.report_html import has_remote_scripts
+
+    problems = []
+    html = run_dir / "report.html"
+    if not html.is_file():
+        problems.append("report.html: missing")
+    elif has_remote_scripts(html.read_text(encoding="utf-8", errors="replace")):
+        problems.append("report.html: loads a script from the network")
+    if result.population is None or not result.population["feasible"].any():
+        return problems
+    for k in range(len(result.cfg.dexterity.band_edges) - 1):
+        path = run_dir / "bands" / f"pareto_band{k}.csv"
+        if not path.is_file():
+            problems.append(f"bands/pareto_band{k}.csv: missing")
+            continue
+        cols, signs = band_objectives(result.problem, k)
+        F = pd.read_csv(path)[cols].to_numpy(dtype=float) * signs
+        if any((np.all(F <= f, axis=1) & np.any(F < f, axis=1)).any() for f in F):
+            problems.append(f"bands/pareto_band{k}.csv: a row is dominated")
     return problems
 
 

@@ -114,26 +114,29 @@ def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
     # a margin so that a path along the edges of the box stays visible
     ax.set_xlim(extent[0] - 0.04 * width, extent[1] + 0.04 * width)
     ax.set_ylim(extent[2] - 0.04 * height, extent[3] + 0.04 * height)
-    ax.set_xlabel(f"{axes[0]} ({unit})")
-    ax.set_ylabel(f"{axes[1]} ({unit})")
+    ax.set_xlabel(f"{axes[0]} [{unit}]")
+    ax.set_ylabel(f"{axes[1]} [{unit}]")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
     return fig
 
 
 def _save_atomic(fig, out: Path) -> None:
-    """Write the PNG atomically (io.write_atomic): a reader never sees half a file, an error names ``out``."""
+    """Write the figure atomically (io.save_figure, format from the suffix): a reader never sees half a file, and
+    an error names ``out``."""
     from scalesynth import io as rio
 
     rio.ensure_dir(out.parent)
-    rio.write_atomic(out, lambda fh: fig.savefig(fh, format="png", dpi=130), mode="wb")
+    rio.save_figure(fig, out)
 
 
 @app.command("plot-task")
 @handles_errors
 def plot_task_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML) of a planar mechanism with a task section")],
-    out: Annotated[Path | None, typer.Option("--out", help="PNG to write (default OUTDIR/plots/task_lci.png)")] = None,
+    out: Annotated[Path | None, typer.Option("--out", help="directory to write task_lci.<format> into (default "
+                                              "OUTDIR/plots); a name with a .png/.svg/.pdf suffix is the file")] = None,
+    fmt: Annotated[str, typer.Option("--format", help="png | svg | pdf")] = "png",
     sets: SetOpt = None,
     resolution: Annotated[int | None, typer.Option(help="cells per axis (default task/grid resolution)")] = None,
     field: Annotated[str, typer.Option("--field", help="field to map: lci or any of the mechanism's fields, e.g. "
@@ -146,6 +149,8 @@ def plot_task_cmd(
 
     from scalesynth.config import load_config
 
+    if fmt not in ("png", "svg", "pdf"):
+        raise ConfigError(f"--format: must be one of png, svg, pdf, got {fmt!r}")
     cfg = load_config(config, list(sets or []))
     tm = task_map(cfg, resolution, field)
     unit = cfg.units.length
@@ -159,7 +164,10 @@ def plot_task_cmd(
         v = tm.values[tm.lci >= 0]
         title += f"\n{tm.label}: {v.min():.4g} ... {v.max():.4g}" if v.size else ""
     fig = task_figure(tm, cfg.mech.task_axes[:2], unit, title)
-    target = out or cfg.output_dir() / "plots" / f"task_{field}.png"
+    if out is not None and out.suffix.lower() in (".png", ".svg", ".pdf"):
+        target = out
+    else:
+        target = (out or cfg.output_dir() / "plots") / f"task_{field}.{fmt}"
     try:
         _save_atomic(fig, target)
     finally:

@@ -47,28 +47,37 @@ def optimize_cmd(
     typer.echo(str(result.out_dir))
 
 
+PlotOut = Annotated[Path | None, typer.Option("--out", help="directory for the figures (default RUN_DIR/plots)")]
+PlotFormat = Annotated[str, typer.Option("--format", help="png | svg | pdf")]
+
+
+def _echo_files(run_dir: Path, files) -> None:
+    for f in files:
+        typer.echo(str(f if Path(f).is_absolute() else Path(run_dir) / f))
+
+
 @app.command("plot-front")
 @handles_errors
-def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")]) -> None:
+def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
+                   out: PlotOut = None, fmt: PlotFormat = "png") -> None:
     """Pareto front with the config's reference designs re-evaluated, and hypervolume per generation."""
     from scalesynth.report import plot_front
     from scalesynth.results import load
 
-    info = plot_front(load(run_dir, require_finished=False))
-    for f in info["files"]:
-        typer.echo(str(Path(run_dir) / f))
+    _echo_files(run_dir, plot_front(load(run_dir, require_finished=False), out, fmt)["files"])
 
 
 @app.command("plot-bands")
 @handles_errors
-def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")]) -> None:
-    """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs."""
+def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
+                   out: PlotOut = None, fmt: PlotFormat = "png") -> None:
+    """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs;
+    per-band Pareto sets (bands/pareto_band<k>.csv and their plots)."""
     from scalesynth.report import plot_bands
     from scalesynth.results import load
 
-    info = plot_bands(load(run_dir, require_finished=False))
-    for f in info["files"]:
-        typer.echo(str(Path(run_dir) / f))
+    info = plot_bands(load(run_dir, require_finished=False), out, fmt)
+    _echo_files(run_dir, info["files"] + info["band_files"])
 
 
 @app.command("select")

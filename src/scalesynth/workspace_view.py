@@ -1,0 +1,307 @@
+"""One design's workspace as data for views: per-voxel fields on a grid, dexterity-band regions and their
+connected components, the centroid, sections (planes sampled on their own, never through a full grid), and the
+design chosen from a results directory (knee, best-<metric>, row).
+
+Connectivity of regions: two cells of a band belong to one region when they share a face, an edge or a corner
+(26-connectivity in 3-D, 8 in 2-D, ``scipy.ndimage.label``); the face-only count (6 / 4) is reported beside it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from scalesynth.errors import ConfigError, InvalidParameter
+from scalesynth.evaluate import Grid, make_grid
+from scalesynth.kernels import grid as _grid
+
+CENTROID_RESOLUTION = 24  # coarse grid locating a section's default position (24^3 = 14k points)
+MAX_POINTS = 20_000  # boundary voxels drawn per 3-D panel (deterministic thinning beyond; drawing dominates show)
+
+
+def available_fields(mech) -> tuple[str, ...]:
+    """Per-voxel fields a mechanism's field kernel writes (lci, sigma_min, sigma_max and its own)."""
+    return tuple(mech.field_names)
+
+
+def check_field(mech, name: str) -> str:
+    known = available_fields(mech)
+    if name not in known:
+        raise ConfigError(f"--field: unknown per-voxel field {name!r} of {mech.name} (known: {', '.join(known)})")
+    return name
+
+
+@dataclass(frozen=True)
+class FieldGrid:
+    """A design's fields on a cell-centred grid: ``lci[i, j, k]`` (-1 = unreachable) at grid.axis(a) nodes."""
+
+    grid: Grid
+    lci: np.ndarray
+    fields: dict[str, np.ndarray]  # name -> (nx, ny, nz), NaN where unreachable
+
+    @property
+    def reachable(self) -> np.ndarray:
+        return self.lci >= 0
+
+    def axes(self) -> list[np.ndarray]:
+        return [self.grid.axis(a) for a in range(3)]
+
+
+def _packed(cfg, design: Mapping[str, float]) -> np.ndarray:
+    return cfg.mech.pack(cfg.mech.resolve_design(design), cfg.resolved_options())
+
+
+def sample_fields(cfg, design: Mapping[str, float], resolution: int) -> FieldGrid:
+    """Every field of ``design`` on the config's grid box at ``resolution`` cells per task axis."""
+    mech = cfg.mech
+    g = make_grid(mech, mech.resolve_design(design), cfg.resolved_options(), resolution, cfg.grid.region)
+    values = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), g.lo, g.step, g.shape)
+    lci = values[..., 0]
+    unreachable = lci < 0
+    fields = {}
+    for f, name in enumerate(mech.field_names):
+        v = values[..., f].copy()
+        v[unreachable] = np.nan
+        fields[name] = v
+    return FieldGrid(grid=g, lci=np.ascontiguousarray(lci), fields=fields)
+
+
+def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, resolution: int):
+    """LCI on the plane ``task axis normal = value`` only (the other axes at ``resolution`` cells over the grid box):
+    returns (2-D array indexed by the two remaining axes in order, their extent (a0, a1, b0, b1))."""
+    mech = cfg.mech
+    g = make_grid(mech, mech.resolve_design(design), cfg.resolved_options(), resolution, cfg.grid.region)
+    lo, step, shape = g.lo.copy(), g.step.copy(), g.shape.copy()
+    lo[normal] = value - 0.5 * step[normal]
+    shape[normal] = 1
+    plane = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), lo, step, shape)[..., 0]
+    others = [a for a in range(3) if a != normal]
+    values = np.take(plane, 0, axis=normal)
+    ext = []
+    for a in others:
+        ext += [g.lo[a], g.lo[a] + g.shape[a] * g.step[a]]
+    return values, tuple(float(e) for e in ext)
+
+
+def centroid(fg: FieldGrid) -> np.ndarray:
+    """Mean position of the reachable cells (3 entries; the grid centre for an empty workspace)."""
+    reach = fg.reachable
+    axes = fg.axes()
+    if not reach.any():
+        return np.array([ax.mean() for ax in axes])
+    idx = np.nonzero(reach)
+    return np.array([axes[a][idx[a]].mean() for a in range(3)])
+
+
+def nearest_nonempty(fg: FieldGrid, normal: int, value: float) -> tuple[int, bool]:
+    """Index of the grid plane normal to ``normal`` nearest to ``value`` that holds a reachable cell, and
+    whether it had to move away from the nearest plane (an empty workspace keeps the nearest one)."""
+    ax = fg.grid.axis(normal)
+    i0 = int(np.argmin(np.abs(ax - value)))
+    counts = fg.reachable.sum(axis=tuple(a for a in range(3) if a != normal))
+    if counts[i0] > 0 or not counts.any():
+        return i0, False
+    filled = np.nonzero(counts)[0]
+    return int(filled[np.argmin(np.abs(filled - i0))]), True
+
+
+def default_section_point(cfg, design: Mapping[str, float]) -> np.ndarray:
+    """Where sections go by default: the workspace centroid, from a coarse grid, moved per axis onto a plane that
+    cuts the workspace."""
+    fg = sample_fields(cfg, design, CENTROID_RESOLUTION)
+    c = centroid(fg)
+    out = c.copy()
+    for a in range(len(cfg.mech.task_axes)):
+        i, moved = nearest_nonempty(fg, a, c[a])
+        if moved:
+            out[a] = fg.grid.axis(a)[i]
+    return out
+
+
+def band_of(lci: np.ndarray, edges: Sequence[float]) -> np.ndarray:
+    """Band index of each LCI value, as the kernels count it: band k holds (e_k, e_k+1], band 0 also e_0."""
+    return np.searchsorted(np.asarray(edges, dtype=float)[1:-1], lci, side="left")
+
+
+def band_labels(edges: Sequence[float]) -> list[str]:
+    return [f"{'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]" for b in range(len(edges) - 1)]
+
+
+def _structures(ndim: int):
+    from scipy import ndimage
+
+    return ndimage.generate_binary_structure(ndim, ndim), ndimage.generate_binary_structure(ndim, 1)
+
+
+def connected_regions(mask: np.ndarray, full: bool = True) -> tuple[np.ndarray, int]:
+    """Connected components of a boolean mask (2-D or 3-D): (labels, count); ``full`` = 26 (8) connectivity, else
+    face connectivity 6 (4)."""
+    from scipy import ndimage
+
+    dense, faces = _structures(mask.ndim)
+    labels, n = ndimage.label(mask, structure=dense if full else faces)
+    return labels, int(n)
+
+
+def band_regions(fg: FieldGrid, edges: Sequence[float], ndim: int) -> list[dict[str, Any]]:
+    """Per dexterity band: cells, share of the workspace, measure, number of connected regions (26- and
+    6-connected in 3-D; 8 and 4 in 2-D), and the sizes of the largest regions (cells)."""
+    lci = fg.lci if ndim == 3 else fg.lci[:, :, 0]
+    reach = lci >= 0
+    band = band_of(lci, edges)
+    total = int(reach.sum())
+    cell = fg.grid.cell_measure
+    out = []
+    for k, label in enumerate(band_labels(edges)):
+        mask = reach & (band == k)
+        labels, n_full = connected_regions(mask, full=True)
+        _, n_faces = connected_regions(mask, full=False)
+        sizes = np.sort(np.bincount(labels.ravel())[1:])[::-1] if n_full else np.zeros(0, dtype=int)
+        cells = int(mask.sum())
+        out.append({
+            "band": k,
+            "label": label,
+            "cells": cells,
+            "share": cells / total if total else 0.0,
+            "measure": cells * cell,
+            "regions": n_full,
+            "regions_face_connected": n_faces,
+            # regions of at least 1 % of the band's cells: isolated cells at band edges are grid noise
+            "regions_over_1pct": int(np.sum(sizes >= 0.01 * cells)) if cells else 0,
+            "largest_regions_cells": [int(s) for s in sizes[:12]],
+            "_labels": labels,
+        })
+    return out
+
+
+def boundary_points(mask: np.ndarray, axes: Sequence[np.ndarray], max_points: int = MAX_POINTS):
+    """Cell centres of the boundary of a 3-D mask (cells with a face neighbour outside it), thinned
+    deterministically to at most ``max_points``: (points (n, 3), their flat indices into the mask)."""
+    from scipy import ndimage
+
+    inner = ndimage.binary_erosion(mask, structure=ndimage.generate_binary_structure(3, 1), border_value=0)
+    flat = np.flatnonzero(mask & ~inner)
+    if len(flat) > max_points:
+        flat = flat[np.linspace(0, len(flat) - 1, max_points).astype(np.int64)]
+    i, j, k = np.unravel_index(flat, mask.shape)
+    pts = np.column_stack([axes[0][i], axes[1][j], axes[2][k]])
+    return pts, flat
+
+
+def task_geometry(cfg):
+    """The task box as a (2, 3) array (lo, hi; planar: third axis 0) and the task path (n, 3), each or None."""
+    task = cfg.task
+    if task is None:
+        return None, None
+    box = np.zeros((2, 3))
+    for a, name in enumerate(cfg.mech.task_axes):
+        box[:, a] = task.box[name]
+    path = None
+    if task.path is not None:
+        p = np.asarray(task.path, dtype=float)
+        path = np.pad(p, ((0, 0), (0, 3 - p.shape[1])))[:, :3]
+    return box, path
+
+
+# ----- choosing a design of a run ----------------------------------------------------------------------------------
+def choose_row(result, choice: str) -> tuple[int, str]:
+    """Row of a run's pareto.csv for ``choice``: 'knee', 'best-<metric>' (a column of pareto.csv, or 'volume'/'area'
+    for the workspace measure; best = the objective's sense, otherwise the largest) or a row number. ``result``:
+    a results.RunResult. Returns (row, label)."""
+    from scalesynth.selection import choose
+
+    problem, pareto = result.problem, result.pareto
+    measure_key = result.cfg.mech.measure_key(result.cfg.units.length)
+    if not len(pareto):
+        raise InvalidParameter("--design: the front is empty (no feasible design), nothing to show")
+    if choice == "knee":
+        return choose(result.objective_matrix(), "knee"), "knee"
+    if choice.startswith("best-"):
+        metric = choice[5:]
+        col = measure_key if metric in ("volume", "area", "measure") else metric
+        if col not in pareto.columns:
+            known = ", ".join(c for c in pareto.columns if c not in problem.var_names)
+            raise InvalidParameter(f"--design: unknown metric {metric!r} in pareto.csv (known: {known})")
+        values = pareto[col].to_numpy(dtype=float)
+        sense = "max"
+        if col in problem.objective_keys:
+            sense = "min" if problem.signs[problem.objective_keys.index(col)] > 0 else "max"
+        row = int(np.argmin(values) if sense == "min" else np.argmax(values))
+        return row, f"best-{col}"
+    try:
+        row = int(choice)
+    except ValueError:
+        raise InvalidParameter(f"--design: expected knee, best-<metric> or a row number, got {choice!r}") from None
+    if not 0 <= row < len(pareto):
+        raise InvalidParameter(f"--design: row {row} is not in pareto.csv (rows 0..{len(pareto) - 1})")
+    return row, f"row{row}"
+
+
+def parse_at(items: Sequence[str] | None, mech) -> dict[int, float]:
+    """``--at axis=value`` items -> {axis index: value}; the axis by its task-axis name."""
+    out: dict[int, float] = {}
+    for item in items or []:
+        name, sep, raw = item.partition("=")
+        if not sep or name.strip() not in mech.task_axes:
+            raise InvalidParameter(
+                f"--at {item}: expected axis=value with axis one of {', '.join(mech.task_axes)}")
+        try:
+            value = float(raw)
+        except ValueError:
+            raise InvalidParameter(f"--at {item}: {raw!r} is not a number") from None
+        if not np.isfinite(value):
+            raise InvalidParameter(f"--at {item}: must be finite")
+        out[mech.task_axes.index(name.strip())] = value
+    return out
+
+
+# ----- the robot and the cycle path ------------------------------------------------------------------------------
+def cycle_path(cfg) -> np.ndarray | None:
+    """The config's pick-and-place cycle as a closed polyline (n, 3) in task units, or None without a cycle."""
+    if getattr(cfg, "cycle", None) is None:
+        return None
+    from scalesynth.cycle.config import vertices
+
+    v = np.asarray(vertices(cfg.cycle, cfg.mech, cfg.units.length), dtype=float)
+    v = np.vstack([v, v[:1]])
+    return np.pad(v, ((0, 0), (0, 3 - v.shape[1])))[:, :3]
+
+
+def default_pose(fg: FieldGrid, ndim: int) -> np.ndarray:
+    """The reachable grid node nearest to the workspace centroid (task coordinates, ``ndim`` entries)."""
+    c = centroid(fg)
+    idx = np.argwhere(fg.reachable)
+    if not len(idx):
+        return c[:ndim]
+    axes = fg.axes()
+    pts = np.column_stack([axes[a][idx[:, a]] for a in range(3)])
+    span = np.where(fg.grid.step > 0, fg.grid.step, 1.0)  # distance in cells: axes of different units
+    k = int(np.argmin((((pts - c) / span) ** 2).sum(axis=1)))
+    return pts[k, :ndim]
+
+
+def robot(cfg, design, pose) -> dict[str, Any]:
+    """Link geometry at ``pose`` in the kernel's working mode: {"pose", "branch", "segments": [{"name", "body",
+    "a", "b", "radius"}]} or {"pose", "missing": reason} when the mechanism has no link geometry or the pose is out
+    of reach."""
+    from scalesynth.errors import ScalesynthError
+
+    mech = cfg.mech
+    options = cfg.resolved_options()
+    design = mech.resolve_design(design)
+    pose = [float(v) for v in pose]
+    sols = mech.inverse_kinematics(design, options, pose)
+    if not sols:
+        return {"pose": pose, "missing": "the pose is out of reach"}
+    branch = mech.kernel_branch(options)
+    sol = next((s for s in sols if s.label == branch), sols[0])
+    try:
+        geo = mech.link_geometry(design, options, pose, sol.values)
+    except ScalesynthError as err:
+        return {"pose": pose, "missing": str(err)}
+    segs = [{"name": s.name, "body": s.body, "a": [float(v) for v in s.a], "b": [float(v) for v in s.b],
+             "radius": float(s.radius)} for s in geo.segments]
+    return {"pose": pose, "branch": sol.label, "segments": segs}
