@@ -50,7 +50,13 @@ def test_kernel_matches_numpy_twin(group, options, resolution):
     np.testing.assert_array_equal(fields[..., 0], lci)
     reach = lci >= 0
     assert reach.sum() > 100
-    np.testing.assert_allclose(fields[reach][:, 1:], twin[reach][:, 1:], rtol=1e-7)
+    # At an exactly singular node (LCI at rounding level: x = 0, z = e on the odd grids' mid-planes in mode +-) J does
+    # not exist; both sides report sigma_max at the cap there and their sigma_min is rounding noise, so it is compared
+    # only at the nodes where J is defined to working precision.
+    regular = reach & (lci > 1e-9)
+    assert regular.sum() > 0.9 * reach.sum()
+    np.testing.assert_allclose(fields[regular][:, 1:], twin[regular][:, 1:], rtol=1e-7)
+    assert (fields[reach & ~regular][:, 2] >= 1e9).all() and (twin[reach & ~regular][:, 2] >= 1e9).all()
     assert (fields[~reach][:, 1:] == 0).all()
     rep = evaluate(M, design, opts, resolution=resolution, band_edges=EDGES)
     assert rep.metrics["voxels"] == ref["count"]
@@ -166,8 +172,16 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     assert np.array_equal(generic[:, kgrid.COL_COUNT], fast[:, kgrid.COL_COUNT])
     bands = [kgrid.band_column(3, b) for b in range(3)]
     assert np.array_equal(generic[:, bands], fast[:, bands])
-    # every field's sums (summed in another order: the fast path weights mirrored cells) and extremes
-    np.testing.assert_allclose(fast, generic, rtol=1e-10, atol=1e-12)
+    # every field's sums (summed in another order: the fast path weights mirrored cells) and extremes. sigma_max is
+    # 1/sigma_min(dq/dx): within a few cells of a singular surface its relative rounding error grows like 1/LCI, and
+    # the fast path takes a cell's mirror image for the cell itself, so sigma_max's sums and squares agree to that
+    # conditioning only; they are compared exactly where the design keeps sigma_max below 1e4 (well conditioned).
+    smax = [kgrid.field_column(2, st) for st in (kgrid.STAT_SUM, kgrid.STAT_SUMSQ, kgrid.STAT_MAX)]
+    rest = [c for c in range(generic.shape[1]) if c not in smax]
+    np.testing.assert_allclose(fast[:, rest], generic[:, rest], rtol=1e-10, atol=1e-12)
+    calm = generic[:, kgrid.field_column(2, kgrid.STAT_MAX)] < 1e4
+    assert calm.sum() >= 1
+    np.testing.assert_allclose(fast[calm][:, smax], generic[calm][:, smax], rtol=1e-10, atol=1e-12)
     reachable = generic[:, kgrid.COL_COUNT] > 0
     assert reachable.any()
     np.testing.assert_array_equal(fast[reachable, kgrid.COL_MIN] <= fast[reachable, kgrid.COL_MAX], True)

@@ -78,7 +78,7 @@ def test_second_run_on_a_locked_directory_exits_1_naming_the_holder(tmp_path, re
     data, refs = reference_runs
     cfg_path = tmp_path / "cfg.yaml"
     cfg_path.write_text(yaml.safe_dump(data))
-    out = tmp_path / "shared"
+    out = tmp_path / "one_out"  # the one --out directory both runs are given
     first = _optimize(cfg_path, out, "--no-plots", "--seed", "3")
     _wait_for(lambda: _holder_pid(out) == first.pid, first)
     first.send_signal(signal.SIGSTOP)  # keep it mid-run, holding the lock, however fast the machine
