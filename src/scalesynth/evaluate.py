@@ -297,6 +297,89 @@ def evaluate_population(
     return _metrics_of(mech, resolved, options, packed, stats, cell, resolution, band_edges, unit, task)
 
 
+@dataclass(frozen=True)
+class Tolerance:
+    """Accuracy target of the adaptive evaluator: relative workspace-measure error and absolute GCI error."""
+
+    volume: float = 0.002
+    gci: float = 5.0e-4
+
+
+# adaptive plan: coarse cells per axis, first and last bisection level, LCI range that triggers refinement
+# (chosen with `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid)
+ADAPTIVE_COARSE = {2: 24, 3: 12}
+ADAPTIVE_LEVELS = (2, 6)
+ADAPTIVE_TAU = 0.1
+
+
+@dataclass
+class AdaptiveResult:
+    """Statistics of designs from ``adaptive_population_stats``: counts in coarse-cell units (``cell`` the coarse
+    cell measure per design), per-design error estimates and cost."""
+
+    stats: np.ndarray
+    cell: np.ndarray
+    error_volume: np.ndarray  # relative
+    error_gci: np.ndarray  # absolute
+    levels: np.ndarray  # bisection levels used per design (int64)
+    evaluations: np.ndarray  # field-kernel calls per design
+
+
+def _errors(mech: Mechanism, fine: np.ndarray, coarse: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Relative measure and absolute GCI differences of two statistics arrays (0 for empty workspaces)."""
+    c_f, c_c = fine[:, _grid.COL_COUNT], coarse[:, _grid.COL_COUNT]
+    ev = np.where(c_f > 0, np.abs(c_f - c_c) / np.where(c_f > 0, c_f, 1.0), 0.0)
+    g_f = np.where(c_f > 0, fine[:, _grid.COL_SUM] / np.where(c_f > 0, c_f, 1.0), 0.0)
+    g_c = np.where(c_c > 0, coarse[:, _grid.COL_SUM] / np.where(c_c > 0, c_c, 1.0), 0.0)
+    return ev, np.abs(g_f - g_c)
+
+
+def adaptive_population_stats(
+    mech: Mechanism,
+    designs: Sequence[Mapping[str, float]],
+    options: Mapping[str, Any],
+    packed: np.ndarray,
+    tolerance: Tolerance,
+    edges: np.ndarray,
+    region: Mapping[str, Sequence[float]] | None = None,
+    boxes: Grid | None = None,
+) -> AdaptiveResult:
+    """Statistics of every design by the adaptive evaluator (kernels.adaptive), deepening per design until its
+    error estimate meets ``tolerance`` or the last level is reached. ``boxes``: one fixed coarse grid for every
+    design (the task box) instead of each design's bounding box."""
+    from scalesynth.kernels.adaptive import adaptive_stats
+
+    n = len(designs)
+    ndim = len(mech.task_axes)
+    n0 = ADAPTIVE_COARSE[ndim]
+    if boxes is None:
+        grids = [make_grid(mech, d, options, n0, region) for d in designs]  # its lo + i step: cell corners
+    else:
+        step = boxes.step * boxes.shape / np.where(np.arange(3) < ndim, n0, 1)
+        grids = [Grid(lo=boxes.lo, step=step, shape=np.array([n0] * ndim + [1] * (3 - ndim)), ndim=ndim)] * n
+    lo = np.stack([g.lo for g in grids])
+    step = np.stack([g.step for g in grids])
+    shape = grids[0].shape
+    cell = np.array([g.cell_measure for g in grids])
+    stats = np.zeros((n, _grid.stat_columns(mech.n_fields, len(edges) - 1)))
+    err_v = np.zeros(n)
+    err_g = np.zeros(n)
+    used = np.zeros(n, dtype=np.int64)
+    evals = np.zeros(n)
+    todo = np.arange(n)
+    first, last = ADAPTIVE_LEVELS
+    for levels in range(first, last + 1):
+        if todo.size == 0:
+            break
+        s, s2, e = adaptive_stats(mech.field_kernel, mech.n_fields, packed[todo], lo[todo], step[todo], shape,
+                                  edges, ndim, levels, ADAPTIVE_TAU)
+        ev, eg = _errors(mech, s, s2)
+        stats[todo], err_v[todo], err_g[todo], used[todo] = s, ev, eg, levels
+        evals[todo] += e
+        todo = todo[(ev > tolerance.volume) | (eg > tolerance.gci)]
+    return AdaptiveResult(stats, cell, err_v, err_g, used, evals)
+
+
 def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid: bool = False) -> WorkspaceReport:
     """Evaluate ``design`` (default: the config's design) with the config's options, grid, bands and task."""
     return evaluate(
