@@ -6,8 +6,9 @@ Algorithm (per design; ``tests/naive.py::adaptive_stats`` is its NumPy twin):
 1. Evaluate every field at the (n0x + 1) x (n0y + 1) x (n0z + 1) corners of the coarse cells (``lo + i * step``;
    planar: ``ndim = 2``, z fixed at lo[2]).
 2. Visit the coarse cells in (i, j, k) order. A cell of level l (edge step / 2^l) is refined when l < ``levels``
-   and its corners disagree on reachability (the workspace boundary crosses it) or, all reachable, their LCI range
-   exceeds ``tau`` (the field varies fast). Refining evaluates the 3^ndim points of its bisection (the corners are
+   and its corners disagree on reachability (the workspace boundary crosses it), or it lies next to such a cell
+   (a coarse neighbour or a sibling: bulges of the workspace hide in cells whose corners are all outside), or,
+   all reachable, their LCI range exceeds ``tau`` (the field varies fast). Refining evaluates the 3^ndim points of its bisection (the corners are
    reused) and visits its 2^ndim children depth first, in a fixed order.
 3. A cell that is not refined is a leaf: each of its 2^ndim corners enters the statistics row with weight
    (cell measure / coarse cell measure) / 2^ndim (trapezoid rule; a boundary cell counts its reachable corners'
@@ -57,10 +58,48 @@ def _lattice(params, lo, step, shape, ndim):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _refine(corners, n_corners, level, levels, tau):
-    """Whether a cell with these corner fields (n_corners, n_fields) is bisected."""
+def _mixed(corners, n_corners):
+    """Whether the corners (n_corners, n_fields) disagree on reachability."""
+    n_in = 0
+    for c in range(n_corners):
+        if corners[c, 0] >= 0.0:
+            n_in += 1
+    return 0 < n_in < n_corners
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _coarse_mixed(lattice, d, i, j, k, ndim):
+    """Whether coarse cell (i, j, k) of design d, or one of its neighbours, has corners that disagree on
+    reachability (cells outside the grid do not count)."""
+    nx = lattice.shape[1] - 1
+    ny = lattice.shape[2] - 1
+    nz = lattice.shape[3] - 1 if ndim == 3 else 1
+    kr = 1 if ndim == 3 else 0
+    for a in range(max(i - 1, 0), min(i + 1, nx - 1) + 1):
+        for b in range(max(j - 1, 0), min(j + 1, ny - 1) + 1):
+            for c in range(max(k - kr, 0), min(k + kr, nz - 1) + 1):
+                n_in = 0
+                n_all = 0
+                for da in range(2):
+                    for db in range(2):
+                        for dc in range(kr + 1):
+                            n_all += 1
+                            if lattice[d, a + da, b + db, c + dc, 0] >= 0.0:
+                                n_in += 1
+                if 0 < n_in < n_all:
+                    return True
+    return False
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _refine(corners, n_corners, level, levels, tau, forced):
+    """Whether a cell with these corner fields (n_corners, n_fields) is bisected: below the last level, and
+    ``forced`` (next to the workspace boundary), or its corners disagree on reachability, or their LCI range
+    exceeds tau."""
     if level >= levels:
         return False
+    if forced:
+        return True
     n_in = 0
     lmin = 2.0
     lmax = -2.0
@@ -114,6 +153,7 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
         st_o = np.empty((cap, 3))
         st_l = np.empty(cap, dtype=np.int64)
         st_c = np.empty((cap, 8, n_fields))
+        st_f = np.empty(cap, dtype=np.bool_)
         n_eval = 0.0
         for j in range(ny):
             for k in range(nz):
@@ -128,13 +168,14 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
                 st_o[0, 1] = lo[d, 1] + j * step[d, 1]
                 st_o[0, 2] = lo[d, 2] + k * step[d, 2]
                 st_l[0] = 0
+                st_f[0] = _coarse_mixed(lattice, d, i, j, k, ndim)
                 top = 1
                 while top > 0:
                     top -= 1
                     level = st_l[top]
                     corners = st_c[top]
                     w = 1.0 / (1 << (ndim * level))
-                    if not _refine(corners, nc, level, levels, tau):
+                    if not _refine(corners, nc, level, levels, tau, st_f[top]):
                         _add_leaf(row, corners, nc, w, edges, vals)
                         if level <= levels - 1 or levels == 0:
                             _add_leaf(row2, corners, nc, w, edges, vals)
@@ -162,7 +203,11 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
                             n_eval += 1.0
                             for f in range(n_fields):
                                 sub[s, f] = cell[f]
-                    # children pushed in reverse so that child 0 is visited first
+                    # children pushed in reverse so that child 0 is visited first; all of them are refined further
+                    # when one is crossed by the boundary (a bulge of the workspace may hide in a child whose
+                    # corners are all outside)
+                    base = top
+                    any_mixed = False
                     for child in range(nc - 1, -1, -1):
                         ca = child & 1
                         cb = (child >> 1) & 1
@@ -175,7 +220,10 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
                         st_o[top, 1] = oy + cb * hy
                         st_o[top, 2] = oz + cz * hz
                         st_l[top] = level + 1
+                        any_mixed = any_mixed or _mixed(st_c[top], nc)
                         top += 1
+                    for t in range(base, top):
+                        st_f[t] = any_mixed
         evals[task] = n_eval
     out_evals = np.zeros(n_designs)
     for d in range(n_designs):
