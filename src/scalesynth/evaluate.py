@@ -231,7 +231,8 @@ def _metrics_of(
         edges = np.asarray(band_edges, dtype=float)
         if tolerance is not None and task.resolution is None:
             ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, boxes=tg)
-            tstats, tcell, tcells = ad.stats, ad.cell, float(ADAPTIVE_COARSE[len(mech.task_axes)] ** len(mech.task_axes))
+            ndim = len(mech.task_axes)
+            tstats, tcell, tcells = ad.stats, ad.cell, float(ADAPTIVE_COARSE[ndim] ** ndim)  # coarse-cell units
         else:
             tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
             tcell, tcells = np.full(n, tg.cell_measure), float(tg.n_cells)

@@ -8,8 +8,8 @@ Algorithm (per design; ``tests/naive.py::adaptive_stats`` is its NumPy twin):
 2. Visit the coarse cells in (i, j, k) order. A cell of level l (edge step / 2^l) is refined when l < ``levels``
    and its corners disagree on reachability (the workspace boundary crosses it), or it lies next to such a cell
    (a coarse neighbour or a sibling: bulges of the workspace hide in cells whose corners are all outside), or,
-   all reachable, their LCI range exceeds ``tau`` (the field varies fast). Refining evaluates the 3^ndim points of its bisection (the corners are
-   reused) and visits its 2^ndim children depth first, in a fixed order.
+   all reachable, their LCI range exceeds ``tau`` (the field varies fast). Refining evaluates the 3^ndim points
+   of its bisection (the corners are reused) and visits its 2^ndim children depth first, in a fixed order.
 3. A cell that is not refined is a leaf: each of its 2^ndim corners enters the statistics row with weight
    (cell measure / coarse cell measure) / 2^ndim (trapezoid rule; a boundary cell counts its reachable corners'
    share), so weights are binary fractions, exact in floating point, and every field's statistics use the same
