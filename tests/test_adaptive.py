@@ -3,8 +3,10 @@ algorithm level by level), the seed-000 volume against the exact quadrature, det
 
 import numpy as np
 import pytest
+import yaml
 
-from scalesynth.config import load_config
+from scalesynth.config import config_from_dict, load_config
+from scalesynth.errors import ConfigError
 from scalesynth.evaluate import Tolerance, adaptive_population_stats, evaluate_config, make_grid
 from scalesynth.kernels import grid as kgrid
 from scalesynth.kernels.adaptive import adaptive_stats
@@ -77,15 +79,25 @@ def test_adaptive_is_deterministic_and_weights_are_consistent():
     assert bands.sum() == pytest.approx(a.stats[0, 0], rel=1e-12)
 
 
-def test_tolerance_config_and_resolution_override(tmp_path):
-    """`grid: {tolerance: ...}` runs the adaptive evaluator and reports its error estimates; an explicit
-    resolution (what `--resolution N` sets) forces the uniform grid."""
-    cfg = load_config(config_for("rps-upu"), ["grid.tolerance={volume: 0.002, gci: 0.0005}"])
-    assert cfg.grid.resolution is not None
-    explicit = "resolution" in cfg.grid.model_fields_set
+def test_tolerance_config_and_resolution_override():
+    """`grid: {tolerance: ...}` without a resolution runs the adaptive evaluator and reports its error estimates
+    (within the tolerance on the config's design); an explicit resolution (what `--resolution N` sets) forces the
+    uniform grid; a bad tolerance is a one-line config error naming the field."""
+    data = yaml.safe_load(config_for("rps-upu").read_text())
+    data["grid"] = {"tolerance": {"volume": 0.002, "gci": 5.0e-4}}
+    cfg = config_from_dict(data)
+    assert cfg.grid.adaptive
     rep = evaluate_config(cfg)
-    if explicit:  # the config itself states a resolution: it wins
-        assert "error_volume" not in rep.metrics
-    forced = load_config(config_for("rps-upu"), ["grid.resolution=24"])
+    assert 0.0 <= rep.metrics["error_volume"] <= 0.002
+    assert 0.0 <= rep.metrics["error_gci"] <= 5.0e-4
+    forced = config_from_dict(data, ["grid.resolution=24"])
     assert not forced.grid.adaptive
-    assert "error_volume" not in evaluate_config(forced).metrics
+    rep24 = evaluate_config(forced)
+    assert "error_volume" not in rep24.metrics and rep24.resolution == 24
+    # within the tolerance of a fine uniform grid (192^3, 8x the cells per axis of the 24 above)
+    fine = evaluate_config(config_from_dict(data, ["grid.resolution=192"]))
+    assert rep.metrics["gci"] == pytest.approx(fine.metrics["gci"], abs=5.0e-4)
+    assert rep.measure == pytest.approx(fine.measure, rel=0.002)
+    data["grid"] = {"tolerance": {"volume": -1.0}}
+    with pytest.raises(ConfigError, match="grid.tolerance.volume"):
+        config_from_dict(data)
