@@ -120,7 +120,7 @@ def mechanisms_cmd(as_json: JsonOpt = False) -> None:
 def evaluate_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML)")],
     sets: SetOpt = None,
-    resolution: Annotated[int | None, typer.Option(help="cells per axis (overrides grid.resolution)")] = None,
+    resolution: Annotated[int | None, typer.Option(help="cells per axis; forces the uniform grid")] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Evaluate one design: workspace measure, GCI, FCI, band shares, voxels, seconds."""
@@ -152,9 +152,13 @@ def evaluate_cmd(
     for key in ("task_coverage", "task_gci", "task_fci", "task_min_lci", "path_min_lci", "path_mean_lci"):
         if key in out:
             typer.echo(f"  {key:<14} {out[key]:.6g}")
-    typer.echo(
-        f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
-    )
+    if "error_volume" in out:  # adaptive evaluator (grid.tolerance)
+        typer.echo(f"  adaptive grid: {out['grid_cells']} kernel calls, error estimate: measure "
+                   f"{100 * out['error_volume']:.3f} %, GCI {out['error_gci']:.1e}; {out['seconds']:.3f} s")
+    else:
+        typer.echo(
+            f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
+        )
 
 
 @app.command("ik")
