@@ -6,6 +6,7 @@
     python benchmarks/bench.py paper        # the paper-scale synthesis in a fresh process: wall time, peak memory
     python benchmarks/bench.py growth       # time against N and against population size
     python benchmarks/bench.py compile      # JIT: first call (empty cache) vs second process (cache)
+    python benchmarks/bench.py fastpath     # seed 000's fast path: this tree vs a baseline git ref (default main)
 
 Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
 Speed targets are compared as ratios measured in one run; absolute times are stated with the machine.
@@ -91,7 +92,9 @@ def bench_evaluator() -> dict:
         shape = grids[0].shape
         voxels = len(designs) * n**3
         t_fast = best_of(lambda: M.grid_stats(packed, lo, step, shape, EDGES), 5)  # noqa: B023
-        t_generic = best_of(lambda: kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, shape, EDGES), 3)  # noqa: B023
+        t_generic = best_of(
+            lambda: kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, shape, EDGES), 3  # noqa: B023
+        )
 
         def numpy_twin():
             for d, g in zip(designs, grids, strict=True):  # noqa: B023
@@ -212,8 +215,60 @@ def bench_compile() -> dict:
     return out
 
 
+# Throughput of seed 000's fast path (M.grid_stats) on the Table-4 designs, best of 7 after a warm-up, in CPU time
+# of the process (one Numba thread: on a shared, loaded machine wall time measures the other jobs); run in a
+# subprocess on either source tree (PYTHONPATH), so that the baseline and this tree are measured alike.
+FASTPATH_SNIPPET = """
+import json, time
+import numpy as np
+from scalesynth.evaluate import make_grid
+from scalesynth.mechanisms import get
+M = get("2pauu-ppap")
+T4 = TABLE4_HERE
+opts = M.resolve_options({})
+designs = [M.resolve_design(d) for d in T4]
+packed = np.stack([M.pack(d, opts) for d in designs])
+edges = np.array([0.0, 0.1, 0.3, 1.0])
+out = {}
+for n in (64, 128):
+    grids = [make_grid(M, d, opts, n) for d in designs]
+    lo = np.stack([g.lo for g in grids]); step = np.stack([g.step for g in grids])
+    M.grid_stats(packed, lo, step, grids[0].shape, edges)
+    best = 1e9
+    for _ in range(15):
+        t0 = time.process_time(); M.grid_stats(packed, lo, step, grids[0].shape, edges)
+        best = min(best, time.process_time() - t0)
+    out[str(n)] = len(designs) * n ** 3 / best / 1e6
+print(json.dumps(out))
+""".replace("TABLE4_HERE", repr(TABLE4))
+
+
+def bench_fastpath(baseline: str = "main", rounds: int = 3) -> dict:
+    """Seed 000's fast path before (git ref ``baseline``) and after (this tree), alternating A/B subprocesses
+    ``rounds`` times with NUMBA_NUM_THREADS=1 (a shared machine: one thread each, ratios in one run)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", baseline, "src"], capture_output=True, check=True)
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
+        trees = {"baseline": Path(tmp) / "src", "this tree": ROOT / "src"}
+        env = dict(os.environ, NUMBA_NUM_THREADS="1", NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
+        best: dict[str, dict[str, float]] = {k: {} for k in trees}
+        for _ in range(rounds):
+            for label, src in trees.items():
+                proc = subprocess.run([sys.executable, "-c", FASTPATH_SNIPPET], env=dict(env, PYTHONPATH=str(src)),
+                                      capture_output=True, text=True, check=True)
+                for n, rate in json.loads(proc.stdout).items():
+                    best[label][n] = max(best[label].get(n, 0.0), rate)
+    rows = [{"N": int(n), "baseline_Mvox_s": best["baseline"][n], "this_Mvox_s": best["this tree"][n],
+             "ratio": best["this tree"][n] / best["baseline"][n]} for n in sorted(best["baseline"], key=int)]
+    for r in rows:
+        print(f"N={r['N']}: baseline {r['baseline_Mvox_s']:.1f} Mvox/s, this tree {r['this_Mvox_s']:.1f} "
+              f"({100 * (r['ratio'] - 1):+.1f} %)", flush=True)
+    return {"baseline": baseline, "rounds": rounds, "numba_threads": 1, "rows": rows}
+
+
 PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": bench_paper, "growth": bench_growth,
-         "compile": bench_compile, "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all}
+         "compile": bench_compile, "fastpath": bench_fastpath, "adaptive": adaptive_bench.bench_adaptive,
+         "compile_all": adaptive_bench.bench_compile_all}
 
 
 def write_results_md() -> None:
@@ -282,6 +337,18 @@ def write_results_md() -> None:
                   "", "| process | import (s) | first evaluate, incl. compile or cache load (s) |", "|---|---|---|",
                   f"| first (empty cache) | {r['empty_cache']['import_s']:.2f} | {r['empty_cache']['first_evaluate_s']:.2f} |",
                   f"| second (cached) | {r['cached']['import_s']:.2f} | {r['cached']['first_evaluate_s']:.2f} |", ""]
+    if "fastpath" in data:
+        r = data["fastpath"]["result"]
+        lines += _header("Seed 000 fast path: before and after the multi-field kernels (issue 10)", data["fastpath"])
+        lines += [f"`M.grid_stats` on the six Table-4 designs, best of 15 per process (CPU time), {r['rounds']} alternating",
+                  f"processes per tree, NUMBA_NUM_THREADS={r['numba_threads']} for both (the machine was shared "
+                  "with other jobs,", f"so one thread each; compare the ratio). Baseline: git ref `{r['baseline']}` "
+                  "(LCI only); this tree: LCI, sigma_min and sigma_max through the shared accumulator.", "",
+                  "| N | baseline (Mvox/s) | this tree (Mvox/s) | change |", "|---|---|---|---|"]
+        for row in r["rows"]:
+            lines.append(f"| {row['N']} | {row['baseline_Mvox_s']:.1f} | {row['this_Mvox_s']:.1f} | "
+                         f"{100 * (row['ratio'] - 1):+.1f} % |")
+        lines.append("")
     (ROOT / "benchmarks" / "RESULTS.md").write_text("\n".join(lines) + "\n")
 
 
@@ -307,6 +374,10 @@ def _targets(data: dict) -> list[str]:
         gr = data["growth"]["result"]
         rows.append(("time grows no faster than N^3", f"exponent {gr['exponent_N']:.2f}", gr["exponent_N"] <= 3.05))
         rows.append(("time linear in designs", f"exponent {gr['exponent_population']:.2f}", gr["exponent_population"] <= 1.1))
+    if "fastpath" in data:
+        worst = min(row["ratio"] for row in data["fastpath"]["result"]["rows"])
+        rows.append(("seed-000 fast path within 10 % of the baseline's throughput", f"{100 * (worst - 1):+.1f} % "
+                     "(worst N)", worst >= 0.9))
     if "compile" in data:
         c = data["compile"]["result"]
         rows.append(("second process reuses compiled code", f"{c['empty_cache']['first_evaluate_s']:.1f} s -> "

@@ -5,83 +5,22 @@ Exit codes: 0 ok, 1 run failed, 2 bad input (one line on stderr naming what is w
 
 from __future__ import annotations
 
-import json
-import sys
-from collections.abc import Callable
-from functools import wraps
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-from scalesynth.errors import InvalidPose, ScalesynthError
-
-app = typer.Typer(
-    add_completion=False,
-    no_args_is_help=True,
-    help="Multi-objective dimensional synthesis of parallel mechanisms.",
-    pretty_exceptions_enable=False,
+from scalesynth.cliapp import (  # noqa: F401 - re-exported: app and the shared helpers live in cliapp
+    JsonOpt,
+    SetOpt,
+    _fail,
+    _mech_inputs,
+    _parse_vector,
+    _print_json,
+    _warn,
+    app,
+    handles_errors,
 )
-
-SetOpt = Annotated[
-    list[str] | None,
-    typer.Option("--set", "-s", help="override: design parameter, option or dotted config path, as key=value"),
-]
-JsonOpt = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout and nothing else")]
-
-
-def _fail(message: str, code: int) -> None:
-    typer.echo(f"error: {message}", err=True)
-    raise typer.Exit(code)
-
-
-def handles_errors(func: Callable) -> Callable:
-    """Map library errors to a one-line message and the contract's exit codes."""
-
-    @wraps(func)
-    def wrapper(*args, **kwargs):
-        try:
-            return func(*args, **kwargs)
-        except ScalesynthError as err:
-            _fail(str(err), err.exit_code)
-        except KeyboardInterrupt:
-            _fail("interrupted", 1)
-        except OSError as err:
-            _fail(f"{getattr(err, 'filename', '') or ''}: {err.strerror or err}", 1)
-
-    return wrapper
-
-
-def _warn(message: str) -> None:
-    typer.echo(f"warning: {message}", err=True)
-
-
-def _parse_vector(what: str, text: str, n: int) -> list[float]:
-    try:
-        values = [float(t) for t in text.split(",")]
-    except ValueError:
-        raise InvalidPose(f"{what}: expected {n} comma-separated numbers, got {text!r}") from None
-    if len(values) != n or any(v != v or v in (float("inf"), float("-inf")) for v in values):
-        raise InvalidPose(f"{what}: expected {n} finite comma-separated numbers, got {text!r}")
-    return values
-
-
-def _mech_inputs(mech_name: str, sets: list[str] | None):
-    from scalesynth.config import apply_overrides
-    from scalesynth.mechanisms import get
-
-    mech = get(mech_name)
-    data = apply_overrides({}, sets, set(mech.parameter_names))
-    extra = set(data) - {"design", "options"}
-    if extra:
-        raise InvalidPose(f"--set {sorted(extra)[0]}: only design parameters and options apply here")
-    design = mech.resolve_design(data.get("design"))
-    options = mech.resolve_options(data.get("options"))
-    return mech, design, options
-
-
-def _print_json(obj: Any) -> None:
-    sys.stdout.write(json.dumps(obj, indent=None, sort_keys=False) + "\n")
 
 
 @app.command("mechanisms")
@@ -142,19 +81,17 @@ def evaluate_cmd(
         _print_json(out)
         return
     typer.echo(f"{mech.name}  design " + ", ".join(f"{k}={v:g}" for k, v in design.items()))
-    typer.echo(f"  {report.measure_key:<14} {report.measure:.6g}")
-    for key in ("gci", "fci", "min_lci", "max_lci"):
-        typer.echo(f"  {key:<14} {out[key]:.6g}")
     edges = report.band_edges
-    for b in range(len(edges) - 1):
-        share = out[f"band{b}_share"] * 100
-        typer.echo(f"  band {b} LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}]: {share:6.2f} %")
-    for key in ("task_coverage", "task_gci", "task_fci", "task_min_lci", "path_min_lci", "path_mean_lci"):
-        if key in out:
-            typer.echo(f"  {key:<14} {out[key]:.6g}")
-    if "error_volume" in out:  # adaptive evaluator (grid.tolerance)
-        typer.echo(f"  adaptive grid: {out['grid_cells']} kernel calls, error estimate: measure "
-                   f"{100 * out['error_volume']:.3f} %, GCI {out['error_gci']:.1e}; {out['seconds']:.3f} s")
+    for key, value in report.metrics.items():  # every catalogue metric of this config, in catalogue order
+        if key == "voxels":
+            continue
+        label = key
+        if key.startswith("band") and key.endswith("_share"):
+            b = int(key[4:-6])
+            label = f"{key} (band {b}: LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}])"
+        typer.echo(f"  {label:<34} {value:.6g}")
+    if "error_volume" in out:  # adaptive evaluator (grid.tolerance): error_volume / error_gci printed above
+        typer.echo(f"  adaptive grid: {out['grid_cells']} kernel calls, {out['seconds']:.3f} s")
     else:
         typer.echo(
             f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"

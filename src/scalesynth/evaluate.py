@@ -17,7 +17,7 @@ import numpy as np
 from scalesynth import metrics as _metrics
 from scalesynth.kernels import grid as _grid
 from scalesynth.mechanisms.base import Mechanism
-from scalesynth.metrics import sample_path  # noqa: F401 - re-exported (path sampling lives with the catalogue)
+from scalesynth.paths import sample_path  # noqa: F401 - re-exported for callers of evaluate
 
 DEFAULT_BAND_EDGES = (0.0, 0.1, 0.3, 1.0)
 

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from scalesynth.mechanisms.base import Field, Mechanism
+from scalesynth.paths import sample_path
 
 FAMILIES = ("workspace", "task", "path", "design", "cycle")
 STATISTICS = ("mean", "std", "min", "max")
@@ -169,19 +170,6 @@ def _design_entry(mech: Mechanism, dm, length_unit: str) -> Metric:
         range=dm.range, better=dm.better, worst=WORST_BOUNDS_CORNERS, needs=(),
         description=f"{dm.description} ({unit})", compute=compute,
     )
-
-
-def sample_path(points: Sequence[Sequence[float]], samples: int) -> np.ndarray:
-    """``samples`` points evenly spaced by arc length along a polyline (ends included), padded to 3 columns."""
-    pts = np.asarray(points, dtype=float)
-    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    if s[-1] == 0.0:
-        out = np.repeat(pts[:1], samples, axis=0)
-    else:
-        t = np.linspace(0.0, s[-1], samples)
-        out = np.stack([np.interp(t, s, pts[:, a]) for a in range(pts.shape[1])], axis=1)
-    return np.pad(out, ((0, 0), (0, 3 - out.shape[1])))
 
 
 def _path_fields(ctx: EvalContext) -> np.ndarray:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
 
 
 @app.command("batch")

@@ -15,7 +15,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cli import _print_json, app, handles_errors
+from scalesynth.cliapp import _print_json, app, handles_errors
 from scalesynth.errors import ConfigError, InvalidPose
 from scalesynth.io import ensure_dir, save_figure, write_text
 

@@ -16,7 +16,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cli import SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 
 
@@ -146,7 +146,19 @@ def plot_task_cmd(
         _save_atomic(fig, target)
     finally:
         plt.close(fig)
+    shown = task_metrics_at(cfg, tm.lci.shape[0])
     if as_json:
-        _print_json({"out": str(target), "task_coverage": tm.coverage, "task_gci": tm.gci, "task_fci": tm.fci})
+        _print_json({"out": str(target), **shown})
     else:
-        typer.echo(f"wrote {target} (coverage {tm.coverage:.4f}, GCI {tm.gci:.4f}, FCI {tm.fci:.4f})")
+        typer.echo(f"wrote {target} (" + ", ".join(f"{k} {v:.4f}" for k, v in shown.items()) + ")")
+
+
+def task_metrics_at(cfg, resolution: int) -> dict[str, float]:
+    """The catalogue's task-box metrics of the config's design with ``resolution`` cells per axis (the map's)."""
+    from scalesynth.evaluate import evaluate_config
+    from scalesynth.metrics import catalogue
+
+    at = cfg.model_copy(update={"task": cfg.task.model_copy(update={"resolution": resolution})})
+    rep = evaluate_config(at)
+    task = [m.column for m in catalogue(cfg.mech, cfg.units.length).values() if m.family == "task"]
+    return {k: rep.metrics[k] for k in task if k in rep.metrics}

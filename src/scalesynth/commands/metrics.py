@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import JsonOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import JsonOpt, _print_json, app, handles_errors
 
 
 @app.command("metrics")

@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import JsonOpt, SetOpt, _mech_inputs, _print_json, app, handles_errors
+from scalesynth.cliapp import JsonOpt, SetOpt, _mech_inputs, _print_json, app, handles_errors
 from scalesynth.errors import InvalidParameter
 
 

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cli import SetOpt, app, handles_errors
+from scalesynth.cliapp import SetOpt, app, handles_errors
 
 
 @app.command("optimize")
@@ -92,7 +92,7 @@ def select_cmd(
             raise InvalidParameter(f"--weights: expected comma-separated numbers, got {weights!r}") from None
     chosen = select_design(run_dir, method, w, out)
     if as_json:
-        from scalesynth.cli import _print_json
+        from scalesynth.cliapp import _print_json
 
         _print_json(chosen)
         return

@@ -27,7 +27,7 @@ from numba import njit, prange
 
 from scalesynth.kernels.bind import bind
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.kernels.grid import accumulate_column, init_row, reduce_partials
+from scalesynth.kernels.grid import accumulate_cells, gather_column, init_row, reduce_partials
 
 # placeholders: kernels.bind gives each bound copy one mechanism's field kernel and field count
 FIELD_KERNEL = None
@@ -116,13 +116,20 @@ def _refine(corners, n_corners, level, levels, tau, forced):
     return lmax - lmin > tau
 
 
+_BUFFER = 4096  # cells buffered per statistics row before they are reduced into it (kernels.grid accumulator)
+
+
 @njit(cache=True, fastmath=FASTMATH)
-def _add_leaf(row, corners, n_corners, w, edges, vals):
-    """Add a leaf's corners, each with weight w / n_corners."""
+def _add_leaf(row, corners, n_corners, w, edges, vals, buf, wbuf, m):
+    """Buffer a leaf's corners, each with weight w / n_corners; reduce the buffer into the row when full.
+    Returns the new fill."""
     for c in range(n_corners):
         for f in range(vals.shape[0]):
             vals[f, c] = corners[c, f]
-    accumulate_column(row, vals, 0, n_corners - 1, w / n_corners, edges)
+    if m + n_corners > buf.shape[1]:
+        accumulate_cells(row, buf, wbuf, m, edges)
+        m = 0
+    return gather_column(buf, wbuf, m, vals, 0, n_corners - 1, w / n_corners)
 
 
 def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
@@ -154,6 +161,12 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
         st_l = np.empty(cap, dtype=np.int64)
         st_c = np.empty((cap, 8, n_fields))
         st_f = np.empty(cap, dtype=np.bool_)
+        buf = np.empty((n_fields, _BUFFER))
+        wbuf = np.empty(_BUFFER)
+        buf2 = np.empty((n_fields, _BUFFER))
+        wbuf2 = np.empty(_BUFFER)
+        m = 0
+        m2 = 0
         n_eval = 0.0
         for j in range(ny):
             for k in range(nz):
@@ -176,12 +189,12 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
                     corners = st_c[top]
                     w = 1.0 / (1 << (ndim * level))
                     if not _refine(corners, nc, level, levels, tau, st_f[top]):
-                        _add_leaf(row, corners, nc, w, edges, vals)
+                        m = _add_leaf(row, corners, nc, w, edges, vals, buf, wbuf, m)
                         if level <= levels - 1 or levels == 0:
-                            _add_leaf(row2, corners, nc, w, edges, vals)
+                            m2 = _add_leaf(row2, corners, nc, w, edges, vals, buf2, wbuf2, m2)
                         continue
                     if level == levels - 1:
-                        _add_leaf(row2, corners, nc, w, edges, vals)
+                        m2 = _add_leaf(row2, corners, nc, w, edges, vals, buf2, wbuf2, m2)
                     h = 0.5 / (1 << level)
                     hx = h * step[d, 0]
                     hy = h * step[d, 1]
@@ -224,6 +237,8 @@ def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
                         top += 1
                     for t in range(base, top):
                         st_f[t] = any_mixed
+        accumulate_cells(row, buf, wbuf, m, edges)
+        accumulate_cells(row2, buf2, wbuf2, m2, edges)
         evals[task] = n_eval
     out_evals = np.zeros(n_designs)
     for d in range(n_designs):

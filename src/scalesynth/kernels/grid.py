@@ -12,8 +12,9 @@ sigma_max of the homogenised Jacobian dx/dq; a mechanism may append its own fiel
 
 Each x-slab of each design accumulates into its own statistics row; the rows are reduced in a fixed order, so
 results do not depend on thread scheduling. Grids are cell-centred: node i of an axis sits at
-``lo + (i + 0.5) * step``. ``accumulate_column`` is THE accumulator: the generic kernel and every mechanism's
-fast path (seed 000) feed it columns of field values, so both produce the same statistics.
+``lo + (i + 0.5) * step``. ``gather_column`` + ``accumulate_cells`` are THE accumulator: the generic kernel and
+every mechanism's fast path (seed 000) gather the reachable cells of each column of an x-slab with their weights,
+then reduce the slab once (long, vectorised loops), so both produce the same statistics.
 
 Statistics row layout for ``n_fields`` fields and ``n_bands`` dexterity bands (``stat_columns``)::
 
@@ -107,43 +108,109 @@ def init_row(row, n_fields):
         row[1 + 4 * f + 3] = -math.inf
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def accumulate_column(row, vals, k0, k1, w, edges):
-    """Add cells k0..k1 of a column to a statistics row, each with weight ``w`` (symmetric grids visit a part).
+# The accumulator's sums may be reassociated (vectorised reductions): the order is fixed by the compiled code, so
+# results stay byte-identical run to run on one machine type. Counts are sums of small integer weights (exact).
+_ACC_FASTMATH = FASTMATH | {"reassoc"}
 
-    vals: (n_fields, nz) field values, vals[0, k] < 0 marks an unreachable cell. Per field the cells are summed in
-    k order into locals, then added to the row (the same order for every caller).
-    """
+
+@njit(cache=True, fastmath=FASTMATH)
+def gather_column(buf, wbuf, m, vals, k0, k1, w):
+    """Append cells k0..k1 of a column (fields ``vals[:, k]``) to the slab buffers buf (n_fields, capacity) and
+    wbuf (capacity) from index m, each with weight ``w`` if reachable (vals[0, k] >= 0), else 0; returns the new
+    fill. Symmetric grids visit a part of the grid and weight the cells (2 or 4)."""
     nf = vals.shape[0]
-    if k1 < k0:
+    n = k1 - k0 + 1
+    for f in range(nf):
+        src = vals[f, k0 : k1 + 1]
+        dst = buf[f, m : m + n]
+        for i in range(n):
+            dst[i] = src[i]
+    lci = vals[0, k0 : k1 + 1]
+    wdst = wbuf[m : m + n]
+    for i in range(n):
+        wdst[i] = w if lci[i] >= 0.0 else 0.0
+    return m + n
+
+
+@njit(cache=True, fastmath=_ACC_FASTMATH)
+def accumulate_cells(row, buf, wbuf, m, edges):
+    """Add the first m buffered cells to a statistics row; a cell of weight 0 is unreachable and ignored.
+
+    Weighted count, per field the weighted sum and sum of squares (vectorised) and min/max, and band counts of
+    LCI (field 0): band b holds (edges[b], edges[b+1]] (band 0 also its lower edge), from the weighted counts
+    above each inner edge."""
+    if m == 0:
         return
+    nf = buf.shape[0]
+    nb = edges.shape[0] - 1
     band0 = 1 + 4 * nf
+    wv = wbuf[:m]
+    lci = buf[0, :m]
+    # count and LCI's sums in one pass
     count = 0.0
-    for k in range(k0, k1 + 1):
-        v = vals[0, k]
-        if v >= 0.0:
-            count += w
-            row[band0 + _band_index(v, edges)] += w
+    s1 = 0.0
+    s2 = 0.0
+    for i in range(m):
+        count += wv[i]
+        wx = wv[i] * lci[i]
+        s1 += wx
+        s2 += wx * lci[i]
     if count == 0.0:
         return
     row[0] += count
-    for f in range(nf):
-        c = 1 + 4 * f
+    row[1] += s1
+    row[2] += s2
+    row[3], row[4] = _extremes(lci, wv, row[3], row[4])
+    # bands: weighted cells with LCI above each inner edge, two edges per pass
+    above = count
+    b = 0
+    while b < nb - 1:
+        e1 = edges[b + 1]
+        e2 = edges[b + 2] if b + 2 < nb else 2.0  # LCI <= 1: nothing is above 2
+        n1 = 0.0
+        n2 = 0.0
+        for i in range(m):
+            n1 += wv[i] if lci[i] > e1 else 0.0
+            n2 += wv[i] if lci[i] > e2 else 0.0
+        row[band0 + b] += above - n1
+        if b + 2 < nb:
+            row[band0 + b + 1] += n1 - n2
+        above = n2 if b + 2 < nb else n1
+        b += 2
+    row[band0 + nb - 1] += above
+    for f in range(1, nf):
+        xs = buf[f, :m]
         s1 = 0.0
         s2 = 0.0
-        vmin = row[c + 2]
-        vmax = row[c + 3]
-        for k in range(k0, k1 + 1):
-            if vals[0, k] >= 0.0:
-                x = vals[f, k]
-                s1 += w * x
-                s2 += w * x * x
-                vmin = min(vmin, x)
-                vmax = max(vmax, x)
+        for i in range(m):
+            wx = wv[i] * xs[i]
+            s1 += wx
+            s2 += wx * xs[i]
+        c = 1 + 4 * f
         row[c] += s1
         row[c + 1] += s2
-        row[c + 2] = vmin
-        row[c + 3] = vmax
+        row[c + 2], row[c + 3] = _extremes(xs, wv, row[c + 2], row[c + 3])
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _extremes(xs, wv, vmin, vmax):
+    """(min, max) of xs over the cells of weight > 0, folded into vmin, vmax; two interleaved chains (exact in any
+    order)."""
+    lo0, lo1, hi0, hi1 = vmin, vmin, vmax, vmax
+    n = xs.shape[0]
+    for i in range(0, n - 1, 2):
+        ra = wv[i] > 0.0
+        rb = wv[i + 1] > 0.0
+        a = xs[i]
+        b = xs[i + 1]
+        lo0 = a if ra and a < lo0 else lo0
+        lo1 = b if rb and b < lo1 else lo1
+        hi0 = a if ra and a > hi0 else hi0
+        hi1 = b if rb and b > hi1 else hi1
+    if n % 2 == 1 and wv[n - 1] > 0.0:
+        lo0 = xs[n - 1] if xs[n - 1] < lo0 else lo0
+        hi0 = xs[n - 1] if xs[n - 1] > hi0 else hi0
+    return min(lo0, lo1), max(hi0, hi1)
 
 
 @njit(cache=True)
@@ -185,13 +252,17 @@ def _population_stats(params, lo, step, shape, edges):
         init_row(row, n_fields)
         vals = np.empty((n_fields, nz))
         cell = np.empty(n_fields)
+        buf = np.empty((n_fields, ny * nz))
+        wbuf = np.empty(ny * nz)
+        m = 0
         for j in range(ny):
             y = lo[d, 1] + (j + 0.5) * step[d, 1]
             for k in range(nz):
                 FIELD_KERNEL(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
                 for f in range(n_fields):
                     vals[f, k] = cell[f]
-            accumulate_column(row, vals, 0, nz - 1, 1.0, edges)
+            m = gather_column(buf, wbuf, m, vals, 0, nz - 1, 1.0)
+        accumulate_cells(row, buf, wbuf, m, edges)
     return reduce_partials(partial, n_designs, nx, n_fields)
 
 

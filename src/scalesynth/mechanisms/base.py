@@ -224,7 +224,7 @@ class Mechanism(ABC):
 
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
         """Statistics rows of every field for many designs (layout in kernels.grid). A mechanism may override this
-        with a faster kernel that feeds the same accumulator (kernels.grid.accumulate_column)."""
+        with a faster kernel that feeds the same accumulator (kernels.grid.gather_column, accumulate_cells)."""
         from scalesynth.kernels import grid as _grid
 
         return _grid.population_stats(self.field_kernel, self.n_fields, packed, lo, step, shape, edges)

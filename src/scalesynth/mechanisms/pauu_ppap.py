@@ -224,32 +224,46 @@ def _column_pass2(k0, k1, targ):
         targ[k] = math.cos(math.acos(targ[k]) / 3.0)
 
 @njit(cache=True, fastmath=FASTMATH)
-def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, vals):
-    """Fields of cells k0..k1 into vals (N_FIELDS, nz), as point_fields: LCI from the largest eigenvalue and the
-    sum/product of the other two (as in sv_3x3), sigma_min = 1/sqrt(lmax) and sigma_max = sqrt(lmid/prod) of
-    J = M^-1; LCI -1 if unreachable."""
-    for k in range(k0, k1 + 1):
-        lmax = tq[k] + 2.0 * tp[k] * targ[k]
-        lmax = max(lmax, 1e-300)
-        prod = td2[k] / lmax
-        s = (tc2[k] - prod) / lmax
+def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, buf, wbuf, m, w):
+    """Fields of cells k0..k1 into the slab buffers from index m (as kernels.grid.gather_column: weight w if
+    reachable, else 0), as point_fields, branch-free: LCI from the largest eigenvalue and the sum/product of the
+    other two (as in sv_3x3); of J = M^-1, sigma_min = 1/sqrt(lmax) and sigma_max = 1/(LCI sqrt(lmax))
+    (= 1/sigma_min(M)), capped at SIGMA_CAP; LCI -1 if unreachable. Loops over slices from 0, so that the
+    compiler can drop index wraparound and vectorise."""
+    n = k1 - k0 + 1
+    fl = flag[k0 : k1 + 1]
+    ta = targ[k0 : k1 + 1]
+    q_ = tq[k0 : k1 + 1]
+    p_ = tp[k0 : k1 + 1]
+    c2 = tc2[k0 : k1 + 1]
+    d2 = td2[k0 : k1 + 1]
+    out_lci = buf[0, m : m + n]
+    out_lo = buf[1, m : m + n]
+    out_hi = buf[2, m : m + n]
+    out_w = wbuf[m : m + n]
+    for i in range(n):
+        lmax = q_[i] + 2.0 * p_[i] * ta[i]
+        il = 1.0 / max(lmax, 1e-300)
+        prod = d2[i] * il
+        s = (c2[i] - prod) * il
         disc = max(s * s - 4.0 * prod, 0.0)
         lmid = max(0.5 * (s + math.sqrt(disc)), 1e-300)
-        ratio = min(max(prod / lmid / lmax, 0.0), 1.0)
-        regular = (s > 0.0) & (prod > 0.0)
-        v = math.sqrt(ratio) if regular else 0.0
-        smin = math.sqrt(prod / lmid) if regular else 0.0
-        sig_lo, sig_hi = inverse_singular_values(smin, math.sqrt(lmax))
-        f = flag[k]
-        vals[0, k] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
-        vals[1, k] = sig_lo if f == 1.0 else 0.0
-        vals[2, k] = sig_hi if f == 1.0 else (SIGMA_CAP if f == 2.0 else 0.0)
+        ratio = min(max(prod / lmid * il, 0.0), 1.0)
+        v = math.sqrt(ratio)
+        v = v if (s > 0.0) & (prod > 0.0) else 0.0
+        sig_lo = min(math.sqrt(il), SIGMA_CAP)
+        sig_hi = min(sig_lo / max(v, 1e-300), SIGMA_CAP)
+        f = fl[i]
+        out_lci[i] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
+        out_lo[i] = sig_lo if f == 1.0 else 0.0
+        out_hi[i] = sig_hi if f == 1.0 else (SIGMA_CAP if f == 2.0 else 0.0)
+        out_w[i] = w if f > 0.0 else 0.0
 
 
 @njit(cache=True, parallel=True, fastmath=FASTMATH)
 def population_stats_fast(params, lo, step, shape, edges):
     """Same statistics as kernels.grid.population_stats(point_fields, N_FIELDS, ...), computed faster and fed to the
-    same accumulator (kernels.grid.accumulate_column).
+    same accumulator (kernels.grid.gather_column, accumulate_cells).
 
     Three savings: (1) for each (x, y) column the reachable z are the intersection of the two chains' annuli
     (spec §1.9), so only the cells of (at most two) z-intervals are visited, widened by one cell and then tested
@@ -291,6 +305,9 @@ def population_stats_fast(params, lo, step, shape, edges):
         td2 = np.empty(nz)
         vals = np.empty((N_FIELDS, nz))
         cell = np.empty(N_FIELDS)
+        buf = np.empty((N_FIELDS, ny * nz))
+        wbuf = np.empty(ny * nz)
+        m = 0
         x = lo[d, 0] + (i + 0.5) * step[d, 0]
         l1 = p[_L1]
         l2 = p[_L2]
@@ -335,11 +352,13 @@ def population_stats_fast(params, lo, step, shape, edges):
                         point_fields(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
                         for fi in range(N_FIELDS):
                             vals[fi, k] = cell[fi]
+                    m = _grid.gather_column(buf, wbuf, m, vals, k0, k1, w)
                 else:
                     _column_pass1(x, y, k0, k1, lo[d, 2], step[d, 2], p, flag, targ, tq, tp, tc2, td2)
                     _column_pass2(k0, k1, targ)
-                    _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, vals)
-                _grid.accumulate_column(row, vals, k0, k1, w, edges)
+                    _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, buf, wbuf, m, w)
+                    m += k1 - k0 + 1
+        _grid.accumulate_cells(row, buf, wbuf, m, edges)
     return _grid.reduce_partials(partial, n_designs, nx, N_FIELDS)
 
 

@@ -772,8 +772,8 @@ def drive_curves(
     Raises InvalidPose naming the first sample that is out of reach, outside a limit or where continuation
     fails (a singularity on the way).
     """
-    from scalesynth.evaluate import sample_path
     from scalesynth.kernels.grid import points_lci
+    from scalesynth.paths import sample_path
 
     mech = MECHANISM
     design = mech.resolve_design(design)

@@ -1,0 +1,87 @@
+"""The typer application and the helpers every command module shares (error mapping, --set/--json options).
+
+Command modules (``scalesynth.commands.*``, and ``scalesynth.cli`` itself) import ``app`` from here and register
+their commands on it; ``scalesynth.cli`` loads them. Importing this module loads no command, so no command
+module imports the module that loads it (no import cycle).
+
+Exit codes: 0 ok, 1 run failed, 2 bad input (one line on stderr naming what is wrong).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Callable
+from functools import wraps
+from typing import Annotated, Any
+
+import typer
+
+from scalesynth.errors import InvalidPose, ScalesynthError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="Multi-objective dimensional synthesis of parallel mechanisms.",
+    pretty_exceptions_enable=False,
+)
+
+SetOpt = Annotated[
+    list[str] | None,
+    typer.Option("--set", "-s", help="override: design parameter, option or dotted config path, as key=value"),
+]
+JsonOpt = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout and nothing else")]
+
+
+def _fail(message: str, code: int) -> None:
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(code)
+
+
+def handles_errors(func: Callable) -> Callable:
+    """Map library errors to a one-line message and the contract's exit codes."""
+
+    @wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except ScalesynthError as err:
+            _fail(str(err), err.exit_code)
+        except KeyboardInterrupt:
+            _fail("interrupted", 1)
+        except OSError as err:
+            _fail(f"{getattr(err, 'filename', '') or ''}: {err.strerror or err}", 1)
+
+    return wrapper
+
+
+def _warn(message: str) -> None:
+    typer.echo(f"warning: {message}", err=True)
+
+
+def _parse_vector(what: str, text: str, n: int) -> list[float]:
+    try:
+        values = [float(t) for t in text.split(",")]
+    except ValueError:
+        raise InvalidPose(f"{what}: expected {n} comma-separated numbers, got {text!r}") from None
+    if len(values) != n or any(v != v or v in (float("inf"), float("-inf")) for v in values):
+        raise InvalidPose(f"{what}: expected {n} finite comma-separated numbers, got {text!r}")
+    return values
+
+
+def _mech_inputs(mech_name: str, sets: list[str] | None):
+    from scalesynth.config import apply_overrides
+    from scalesynth.mechanisms import get
+
+    mech = get(mech_name)
+    data = apply_overrides({}, sets, set(mech.parameter_names))
+    extra = set(data) - {"design", "options"}
+    if extra:
+        raise InvalidPose(f"--set {sorted(extra)[0]}: only design parameters and options apply here")
+    design = mech.resolve_design(data.get("design"))
+    options = mech.resolve_options(data.get("options"))
+    return mech, design, options
+
+
+def _print_json(obj: Any) -> None:
+    sys.stdout.write(json.dumps(obj, indent=None, sort_keys=False) + "\n")
