@@ -30,6 +30,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import adaptive as adaptive_bench  # noqa: E402  (benchmarks/adaptive.py: issue-15 parts)
 
 from scalesynth.config import load_config  # noqa: E402
 from scalesynth.evaluate import evaluate_population, make_grid  # noqa: E402
@@ -306,7 +309,8 @@ def bench_fastpath(baseline: str = "main", rounds: int = 3) -> dict:
 
 
 PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": bench_paper, "growth": bench_growth,
-         "compile": bench_compile, "fastpath": bench_fastpath, "stiffness": bench_stiffness}
+         "compile": bench_compile, "fastpath": bench_fastpath, "stiffness": bench_stiffness,
+         "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all}
 
 
 def write_results_md() -> None:
@@ -319,6 +323,10 @@ def write_results_md() -> None:
              "Rebuilt by `python benchmarks/bench.py all` (or one part: `evaluator`, `accuracy`, `paper`, `growth`,",
              "`compile`, `fastpath`, `stiffness`). Each section states the machine and date it was measured on.", ""]
     lines += _targets(data)
+    for part, title in (("compile_all", "Issue 15: compile once, per mechanism"),
+                        ("adaptive", "Issue 15: adaptive evaluator against uniform grids at equal accuracy")):
+        if part in data:
+            lines += _header(title, data[part]) + adaptive_bench.markdown({part: data[part]})
     if "evaluator" in data:
         d = data["evaluator"]
         lines += _header("Evaluator throughput: Numba vs NumPy twin (same process, Table-4 designs)", d)
@@ -446,18 +454,34 @@ def _header(title: str, entry: dict) -> list[str]:
 
 
 def main(argv: list[str]) -> None:
+    if argv and argv[0] == "adaptive" and len(argv) > 1:  # adaptive MECH ...: a subset, merged into the stored part
+        _run_part("adaptive", lambda: _merge_adaptive(adaptive_bench.bench_adaptive(argv[1:])))
+        write_results_md()
+        return
     parts = list(PARTS) if not argv or argv[0] == "all" else argv
     for name in parts:
         if name not in PARTS:
             raise SystemExit(f"unknown part {name!r}; choose from all, {', '.join(PARTS)}")
-    RESULTS.mkdir(parents=True, exist_ok=True)
     for name in parts:
-        print(f"== {name}", flush=True)
-        result = PARTS[name]()
-        entry = {"part": name, "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), "machine": machine(),
-                 "result": result}
-        (RESULTS / f"{name}.json").write_text(json.dumps(entry, indent=2) + "\n")
+        _run_part(name, PARTS[name])
     write_results_md()
+
+
+def _run_part(name: str, fn) -> None:
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    print(f"== {name}", flush=True)
+    result = fn()
+    entry = {"part": name, "date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), "machine": machine(),
+             "result": result}
+    (RESULTS / f"{name}.json").write_text(json.dumps(entry, indent=2) + "\n")
+
+
+def _merge_adaptive(new: dict) -> dict:
+    """The stored adaptive rows with those of ``new`` replaced or added (per mechanism, config order)."""
+    path = RESULTS / "adaptive.json"
+    rows = {m["mechanism"]: m for m in (json.loads(path.read_text())["result"]["mechanisms"] if path.exists() else [])}
+    rows.update({m["mechanism"]: m for m in new["mechanisms"]})
+    return {"mechanisms": [rows[k] for k in adaptive_bench.CONFIGS if k in rows]}
 
 
 if __name__ == "__main__":

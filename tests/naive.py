@@ -439,3 +439,82 @@ def rps_upu_tool_fields(design, options, x, y, z):
     fields[~keep] = (-1.0, 0.0, 0.0)
     out[np.nonzero(ok)[0]] = fields
     return out.reshape(x.shape + (3,))
+
+
+def adaptive_stats(fields, n_fields, lo, step, shape, edges, ndim, levels, tau):
+    """NumPy twin of kernels.adaptive.adaptive_stats for one design, level by level (breadth first) instead of
+    depth first: ``fields(points (m, 3)) -> (m, n_fields)`` (field 0 LCI, -1 unreachable); lo, step: origin and
+    edge of the coarse cells; shape: coarse cells per axis. Returns (stats row, row one level coarser,
+    evaluations), the row in the layout of kernels.grid (counts in coarse-cell units)."""
+    lo, step = np.asarray(lo, float), np.asarray(step, float)
+    n = [int(shape[a]) if a < ndim else 0 for a in range(3)]
+    axes = [lo[a] + np.arange(n[a] + 1) * step[a] for a in range(3)]
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    lat = fields(np.c_[X.ravel(), Y.ravel(), Z.ravel()]).reshape(n[0] + 1, n[1] + 1, n[2] + 1, n_fields)
+    evals = lat.shape[0] * lat.shape[1] * lat.shape[2]
+    nc = 1 << ndim
+    bits = np.array([[(c >> a) & 1 if a < ndim else 0 for a in range(3)] for c in range(nc)])
+    ii, jj, kk = np.meshgrid(*[np.arange(max(n[a], 1)) for a in range(3)], indexing="ij")
+    cells = np.c_[ii.ravel(), jj.ravel(), kk.ravel()]  # (i, j, k) order, as the kernel visits them
+    corners = np.stack([lat[cells[:, 0] + b[0], cells[:, 1] + b[1], cells[:, 2] + b[2]] for b in bits], axis=1)
+    origin = lo + cells * step
+
+    def mixed_of(c):
+        n_in = (c[:, :, 0] >= 0).sum(axis=1)
+        return (n_in > 0) & (n_in < nc)
+
+    # coarse cells next to a boundary cell (3^ndim neighbourhood inside the grid) are forced
+    m = mixed_of(corners).reshape(max(n[0], 1), max(n[1], 1), max(n[2], 1))
+    pad = np.pad(m, 1)
+    forced = np.zeros_like(m)
+    for da in (-1, 0, 1):
+        for db in (-1, 0, 1):
+            for dc in ((-1, 0, 1) if ndim == 3 else (0,)):
+                forced |= pad[1 + da:pad.shape[0] - 1 + da, 1 + db:pad.shape[1] - 1 + db,
+                              1 + dc:pad.shape[2] - 1 + dc]
+    forced = forced.ravel()
+    leaves = ([], [])  # (corner values, weights) of the leaves, for the result and for the coarser result
+    sub_idx = np.array([[a, b, c] for c in range(3 if ndim == 3 else 1) for b in range(3) for a in range(3)])
+    for level in range(levels + 1):
+        w = 1.0 / (1 << (ndim * level))
+        lci = corners[:, :, 0]
+        n_in = (lci >= 0).sum(axis=1)
+        rng = lci.max(axis=1) - lci.min(axis=1)
+        refine = (level < levels) & (forced | ((n_in > 0) & ((n_in < nc) | (rng > tau))))
+        leaf = ~refine
+        for target in ((0, 1) if level <= levels - 1 or levels == 0 else (0,)):
+            leaves[target].append((corners[leaf].reshape(-1, n_fields), np.full(leaf.sum() * nc, w / nc)))
+        if level == levels - 1:
+            leaves[1].append((corners[refine].reshape(-1, n_fields), np.full(refine.sum() * nc, w / nc)))
+        if not refine.any():
+            break
+        c_r, o_r = corners[refine], origin[refine]
+        h = 0.5 / (1 << level) * step
+        pts = o_r[:, None, :] + sub_idx[None, :, :] * h
+        is_corner = np.all(sub_idx != 1, axis=1)
+        sub = np.empty((c_r.shape[0], sub_idx.shape[0], n_fields))
+        src = (sub_idx[is_corner] >> 1) @ np.array([1, 2, 4])
+        sub[:, is_corner] = c_r[:, src]
+        sub[:, ~is_corner] = fields(pts[:, ~is_corner].reshape(-1, 3)).reshape(c_r.shape[0], -1, n_fields)
+        evals += c_r.shape[0] * int((~is_corner).sum())
+        child_bits = bits
+        s_of = ((child_bits[:, None, :] + bits[None, :, :]) @ np.array([1, 3, 9]))  # (child, corner) -> sub index
+        corners = sub[:, s_of].reshape(-1, nc, n_fields)
+        origin = (o_r[:, None, :] + child_bits[None, :, :] * h).reshape(-1, 3)
+        forced = np.repeat(mixed_of(corners).reshape(-1, nc).any(axis=1), nc)
+    rows = []
+    nb = len(edges) - 1
+    for target in (0, 1):
+        v = np.concatenate([a for a, _ in leaves[target]])
+        wt = np.concatenate([b for _, b in leaves[target]])
+        keep = v[:, 0] >= 0
+        v, wt = v[keep], wt[keep]
+        row = np.zeros(1 + 4 * n_fields + nb)
+        row[0] = wt.sum()
+        for f in range(n_fields):
+            row[1 + 4 * f: 5 + 4 * f] = [(wt * v[:, f]).sum(), (wt * v[:, f] ** 2).sum(),
+                                         v[:, f].min() if len(v) else np.inf, v[:, f].max() if len(v) else -np.inf]
+        band = np.searchsorted(np.asarray(edges)[1:-1], v[:, 0], side="left")
+        row[1 + 4 * n_fields:] = np.bincount(band, weights=wt, minlength=nb)
+        rows.append(row)
+    return rows[0], rows[1], evals

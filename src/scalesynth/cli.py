@@ -60,7 +60,7 @@ def mechanisms_cmd(as_json: JsonOpt = False) -> None:
 def evaluate_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML)")],
     sets: SetOpt = None,
-    resolution: Annotated[int | None, typer.Option(help="cells per axis (overrides grid.resolution)")] = None,
+    resolution: Annotated[int | None, typer.Option(help="cells per axis; forces the uniform grid")] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Evaluate one design: workspace measure, GCI, FCI, band shares, voxels, seconds."""
@@ -94,9 +94,12 @@ def evaluate_cmd(
             b = int(key[4:-6])
             label = f"{key} (band {b}: LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}])"
         typer.echo(f"  {label:<34} {value:.6g}")
-    typer.echo(
-        f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
-    )
+    if "error_volume" in out:  # adaptive evaluator (grid.tolerance): error_volume / error_gci printed above
+        typer.echo(f"  adaptive grid: {out['grid_cells']} kernel calls, {out['seconds']:.3f} s")
+    else:
+        typer.echo(
+            f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"
+        )
 
 
 @app.command("ik")

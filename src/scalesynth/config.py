@@ -24,8 +24,20 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=False)
 
 
+class ToleranceConfig(_Strict):
+    """Accuracy target of the adaptive evaluator (per design, from its own error estimate)."""
+
+    volume: float = Field(0.002, gt=0.0, le=0.5, description="relative error of the workspace measure")
+    gci: float = Field(5.0e-4, gt=0.0, le=0.5, description="absolute error of the GCI")
+
+
 class GridConfig(_Strict):
+    """Either ``tolerance`` (adaptive evaluator) or ``resolution`` (uniform grid). A given ``resolution`` wins
+    (``--resolution N`` forces the uniform reference grid); ``resolution`` also sets the uniform grids of plots,
+    the report's sections and task boxes without their own resolution."""
+
     resolution: int = Field(64, ge=4, le=1024, description="cells per axis")
+    tolerance: ToleranceConfig | None = Field(None, description="accuracy target: adaptive evaluator")
     region: dict[str, tuple[float, float]] | None = Field(
         None, description="override of the mechanism's bounding box, per task axis name: [lo, hi]"
     )
@@ -40,6 +52,11 @@ class GridConfig(_Strict):
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
             _magnitude(axis, lo, hi)
         return v
+
+    @property
+    def adaptive(self) -> bool:
+        """Whether the adaptive evaluator runs: a tolerance is given and no resolution is."""
+        return self.tolerance is not None and "resolution" not in self.model_fields_set
 
 
 def _magnitude(key: str, *values: float) -> None:

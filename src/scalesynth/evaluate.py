@@ -80,6 +80,89 @@ def task_grid(mech: Mechanism, task: Any, resolution: int) -> Grid:
     return Grid(lo=lo, step=step, shape=shape, ndim=ndim)
 
 
+@dataclass(frozen=True)
+class Tolerance:
+    """Accuracy target of the adaptive evaluator: relative workspace-measure error and absolute GCI error."""
+
+    volume: float = 0.002
+    gci: float = 5.0e-4
+
+
+# adaptive plan: coarse cells per axis, first and last bisection level, LCI range that triggers refinement
+# (chosen with `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid)
+ADAPTIVE_COARSE = {2: 24, 3: 12}
+ADAPTIVE_LEVELS = (2, 6)
+ADAPTIVE_TAU = 0.1
+
+
+@dataclass
+class AdaptiveResult:
+    """Statistics of designs from ``adaptive_population_stats``: counts in coarse-cell units (``cell`` the coarse
+    cell measure per design), per-design error estimates and cost."""
+
+    stats: np.ndarray
+    cell: np.ndarray
+    error_volume: np.ndarray  # relative
+    error_gci: np.ndarray  # absolute
+    levels: np.ndarray  # bisection levels used per design (int64)
+    evaluations: np.ndarray  # field-kernel calls per design
+
+
+def _errors(mech: Mechanism, fine: np.ndarray, coarse: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Relative measure and absolute GCI differences of two statistics arrays (0 for empty workspaces)."""
+    c_f, c_c = fine[:, _grid.COL_COUNT], coarse[:, _grid.COL_COUNT]
+    ev = np.where(c_f > 0, np.abs(c_f - c_c) / np.where(c_f > 0, c_f, 1.0), 0.0)
+    g_f = np.where(c_f > 0, fine[:, _grid.COL_SUM] / np.where(c_f > 0, c_f, 1.0), 0.0)
+    g_c = np.where(c_c > 0, coarse[:, _grid.COL_SUM] / np.where(c_c > 0, c_c, 1.0), 0.0)
+    return ev, np.abs(g_f - g_c)
+
+
+def adaptive_population_stats(
+    mech: Mechanism,
+    designs: Sequence[Mapping[str, float]],
+    options: Mapping[str, Any],
+    packed: np.ndarray,
+    tolerance: Tolerance,
+    edges: np.ndarray,
+    region: Mapping[str, Sequence[float]] | None = None,
+    boxes: Grid | None = None,
+) -> AdaptiveResult:
+    """Statistics of every design by the adaptive evaluator (kernels.adaptive), deepening per design until its
+    error estimate meets ``tolerance`` or the last level is reached. ``boxes``: one fixed coarse grid for every
+    design (the task box) instead of each design's bounding box."""
+    from scalesynth.kernels.adaptive import adaptive_stats
+
+    n = len(designs)
+    ndim = len(mech.task_axes)
+    n0 = ADAPTIVE_COARSE[ndim]
+    if boxes is None:
+        grids = [make_grid(mech, d, options, n0, region) for d in designs]  # its lo + i step: cell corners
+    else:
+        step = boxes.step * boxes.shape / np.where(np.arange(3) < ndim, n0, 1)
+        grids = [Grid(lo=boxes.lo, step=step, shape=np.array([n0] * ndim + [1] * (3 - ndim)), ndim=ndim)] * n
+    lo = np.stack([g.lo for g in grids])
+    step = np.stack([g.step for g in grids])
+    shape = grids[0].shape
+    cell = np.array([g.cell_measure for g in grids])
+    stats = np.zeros((n, _grid.stat_columns(mech.n_fields, len(edges) - 1)))
+    err_v = np.zeros(n)
+    err_g = np.zeros(n)
+    used = np.zeros(n, dtype=np.int64)
+    evals = np.zeros(n)
+    todo = np.arange(n)
+    first, last = ADAPTIVE_LEVELS
+    for levels in range(first, last + 1):
+        if todo.size == 0:
+            break
+        s, s2, e = adaptive_stats(mech.field_kernel, mech.n_fields, packed[todo], lo[todo], step[todo], shape,
+                                  edges, ndim, levels, ADAPTIVE_TAU)
+        ev, eg = _errors(mech, s, s2)
+        stats[todo], err_v[todo], err_g[todo], used[todo] = s, ev, eg, levels
+        evals[todo] += e
+        todo = todo[(ev > tolerance.volume) | (eg > tolerance.gci)]
+    return AdaptiveResult(stats, cell, err_v, err_g, used, evals)
+
+
 def stats_to_metrics(
     mech: Mechanism,
     stats: np.ndarray,
@@ -134,9 +217,10 @@ def _metrics_of(
     unit: str,
     task: Any,
     cycle: Any = None,
+    tolerance: Tolerance | None = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of the designs: workspace statistics given, task statistics and the computed
-    families (design, path) evaluated here."""
+    families (design, path) evaluated here (task box: adaptive evaluator when ``tolerance`` is given)."""
     has_path = task is not None and task.path is not None
     entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
     n_bands = len(band_edges) - 1
@@ -146,8 +230,14 @@ def _metrics_of(
     if task is not None:
         tg = task_grid(mech, task, resolution)
         edges = np.asarray(band_edges, dtype=float)
-        tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
-        out.update(stats_to_metrics(mech, tstats, np.full(n, tg.cell_measure), float(tg.n_cells),
+        if tolerance is not None and task.resolution is None:
+            ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, boxes=tg)
+            ndim = len(mech.task_axes)
+            tstats, tcell, tcells = ad.stats, ad.cell, float(ADAPTIVE_COARSE[ndim] ** ndim)  # coarse-cell units
+        else:
+            tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
+            tcell, tcells = np.full(n, tg.cell_measure), float(tg.n_cells)
+        out.update(stats_to_metrics(mech, tstats, tcell, tcells,
                                     [m for m in entries if m.family == "task" and m.compute is None], n_bands))
     ctx = _metrics.EvalContext(mech, resolved, options, packed, task, resolution, band_edges, unit, cycle)
     for m in entries:
@@ -231,22 +321,35 @@ def evaluate(
     keep_grid: bool = False,
     task: Any = None,
     cycle: Any = None,
+    tolerance: Tolerance | None = None,
 ) -> WorkspaceReport:
-    """Evaluate one design on a ``resolution``-per-axis grid. ``seconds`` (the workspace grid alone) excludes JIT
-    compilation. ``keep_grid``: keep every per-voxel field (WorkspaceReport.field_grid). ``cycle`` (a config
-    CycleConfig): also the cycle metrics."""
+    """Evaluate one design on a ``resolution``-per-axis grid, or with ``tolerance`` by the adaptive evaluator
+    (metrics then include ``error_volume`` and ``error_gci``). ``seconds`` (the workspace evaluation alone)
+    excludes JIT compilation. ``keep_grid``: keep every per-voxel field of the uniform ``resolution`` grid
+    (WorkspaceReport.field_grid). ``cycle`` (a config CycleConfig): also the cycle metrics."""
     design = mech.resolve_design(design)
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     g = make_grid(mech, design, options, resolution, region)
     edges = np.asarray(band_edges, dtype=float)
     packed = mech.pack(design, options)[None, :]
-    warm_up(mech, packed, edges)
-    t0 = time.perf_counter()
-    stats = mech.grid_stats(packed, g.lo[None, :], g.step[None, :], g.shape, edges)
-    seconds = time.perf_counter() - t0
-    values = _metrics_of(mech, [design], options, packed, stats, np.array([g.cell_measure]), resolution, band_edges,
-                         unit, task, cycle)
+    if tolerance is not None:
+        adaptive_population_stats(mech, [design], options, packed, tolerance, edges, region)  # compile or load
+        t0 = time.perf_counter()
+        ad = adaptive_population_stats(mech, [design], options, packed, tolerance, edges, region)
+        seconds = time.perf_counter() - t0
+        values = _metrics_of(mech, [design], options, packed, ad.stats, ad.cell, resolution, band_edges, unit, task,
+                             cycle, tolerance)
+        values.update(error_volume=ad.error_volume, error_gci=ad.error_gci)
+        n_cells = int(ad.evaluations[0])
+    else:
+        warm_up(mech, packed, edges)
+        t0 = time.perf_counter()
+        stats = mech.grid_stats(packed, g.lo[None, :], g.step[None, :], g.shape, edges)
+        seconds = time.perf_counter() - t0
+        values = _metrics_of(mech, [design], options, packed, stats, np.array([g.cell_measure]), resolution,
+                             band_edges, unit, task, cycle)
+        n_cells = g.n_cells
     metrics = {k: v[0].item() for k, v in values.items()}
     fields = None
     if keep_grid:
@@ -258,7 +361,7 @@ def evaluate(
         metrics=metrics,
         band_edges=[float(e) for e in band_edges],
         resolution=resolution,
-        grid_cells=g.n_cells,
+        grid_cells=n_cells,
         seconds=seconds,
         field_names=mech.field_names,
         field_grid=fields,
@@ -291,10 +394,13 @@ def evaluate_population(
     length_unit: str | None = None,
     task: Any = None,
     cycle: Any = None,
+    tolerance: Tolerance | None = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of many designs, column name -> (n,) array; the workspace grids in one parallel
     kernel call (no Python work per voxel); with ``task`` (a config TaskConfig) also the task-box and path
-    metrics, with ``cycle`` (a config CycleConfig) the cycle metrics."""
+    metrics, with ``cycle`` (a config CycleConfig) the cycle metrics. With ``tolerance`` the adaptive evaluator
+    replaces the uniform ``resolution`` grid and the result also has ``error_volume`` (relative) and
+    ``error_gci`` (its per-design error estimates)."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
@@ -304,13 +410,27 @@ def evaluate_population(
         cols = _metrics.result_columns(mech, unit, len(band_edges) - 1, task is not None, has_path, options, cycle)
         return {k: np.zeros(0) for k in cols}
     packed = np.stack([mech.pack(d, options) for d in resolved])
+    edges = np.asarray(band_edges, dtype=float)
+    if tolerance is not None:
+        ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, region)
+        out = _metrics_of(mech, resolved, options, packed, ad.stats, ad.cell, resolution, band_edges, unit, task,
+                          cycle, tolerance)
+        out["error_volume"] = ad.error_volume
+        out["error_gci"] = ad.error_gci
+        return out
     grids = [make_grid(mech, d, options, resolution, region) for d in resolved]
     lo = np.stack([g.lo for g in grids])
     step = np.stack([g.step for g in grids])
-    edges = np.asarray(band_edges, dtype=float)
     stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
     cell = np.array([g.cell_measure for g in grids])
     return _metrics_of(mech, resolved, options, packed, stats, cell, resolution, band_edges, unit, task, cycle)
+
+
+def config_tolerance(cfg) -> Tolerance | None:
+    """The config's accuracy target when it asks for the adaptive evaluator (``GridConfig.adaptive``), else None."""
+    if not cfg.grid.adaptive:
+        return None
+    return Tolerance(volume=cfg.grid.tolerance.volume, gci=cfg.grid.tolerance.gci)
 
 
 def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid: bool = False) -> WorkspaceReport:
@@ -326,6 +446,7 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
         keep_grid=keep_grid,
         task=cfg.task,
         cycle=cfg.cycle,
+        tolerance=config_tolerance(cfg),
     )
 
 
@@ -344,4 +465,5 @@ def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> d
         length_unit=cfg.units.length,
         task=cfg.task,
         cycle=searched(cfg),
+        tolerance=config_tolerance(cfg),
     )

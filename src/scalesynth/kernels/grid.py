@@ -23,9 +23,9 @@ Statistics row layout for ``n_fields`` fields and ``n_bands`` dexterity bands (`
 so ``field_column(f, STAT_SUM)`` = 1 + 4 f; bands start at ``band_column(n_fields, 0)`` = 1 + 4 n_fields; the
 band counts (and count) are weighted cell counts, bands classify LCI (field 0).
 
-The functions that take a point kernel as an argument are compiled per mechanism and NOT cached on disk: Numba
-keys such cache entries by the dispatcher object, so they never hit in a new process and a stale entry can break
-later saves. Mechanisms that need a fast start provide their own cached ``grid_stats`` (seed 000 does).
+The evaluators that take a field kernel (``population_stats``, ``sample_fields``, ...) are plain functions over
+templates that ``kernels.bind`` compiles once per field kernel with the kernel as a global: Numba disk-caches those
+copies, so a second process loads them instead of compiling (a kernel passed as an argument could not be cached).
 """
 
 import math
@@ -33,8 +33,13 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from scalesynth.kernels.bind import bind
 from scalesynth.kernels.conditioning import SIGMA_CAP
 from scalesynth.kernels.flags import FASTMATH
+
+# names a template's bound copy resolves to one mechanism's kernel (kernels.bind); placeholders here
+FIELD_KERNEL = None
+N_FIELDS = 0
 
 # field slots every mechanism provides
 FIELD_LCI, FIELD_SIGMA_MIN, FIELD_SIGMA_MAX = 0, 1, 2
@@ -230,13 +235,9 @@ def reduce_partials(partial, n_designs, nx, n_fields):
     return out
 
 
-@njit(parallel=True, fastmath=FASTMATH)
-def population_stats(field_kernel, n_fields, params, lo, step, shape, edges):
-    """Workspace statistics of every field for every design on its own grid.
-
-    params: (n_designs, k) packed designs; lo, step: (n_designs, 3); shape: int64[3] (nx, ny, nz);
-    edges: dexterity band edges. Returns (n_designs, stat_columns(n_fields, n_bands)) float64.
-    """
+def _population_stats(params, lo, step, shape, edges):
+    """Template of population_stats (FIELD_KERNEL, N_FIELDS bound by kernels.bind)."""
+    n_fields = N_FIELDS
     n_designs = params.shape[0]
     nx, ny, nz = shape[0], shape[1], shape[2]
     nb = edges.shape[0] - 1
@@ -257,7 +258,7 @@ def population_stats(field_kernel, n_fields, params, lo, step, shape, edges):
         for j in range(ny):
             y = lo[d, 1] + (j + 0.5) * step[d, 1]
             for k in range(nz):
-                field_kernel(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
+                FIELD_KERNEL(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
                 for f in range(n_fields):
                     vals[f, k] = cell[f]
             m = gather_column(buf, wbuf, m, vals, 0, nz - 1, 1.0)
@@ -265,9 +266,9 @@ def population_stats(field_kernel, n_fields, params, lo, step, shape, edges):
     return reduce_partials(partial, n_designs, nx, n_fields)
 
 
-@njit(parallel=True, fastmath=FASTMATH)
-def sample_fields(field_kernel, n_fields, p, lo, step, shape):
-    """Every field at every node of one design's grid: (nx, ny, nz, n_fields); field 0 (LCI) -1 = unreachable."""
+def _sample_fields(p, lo, step, shape):
+    """Template of sample_fields."""
+    n_fields = N_FIELDS
     nx, ny, nz = shape[0], shape[1], shape[2]
     out = np.empty((nx, ny, nz, n_fields))
     for i in prange(nx):
@@ -276,15 +277,14 @@ def sample_fields(field_kernel, n_fields, p, lo, step, shape):
         for j in range(ny):
             y = lo[1] + (j + 0.5) * step[1]
             for k in range(nz):
-                field_kernel(p, x, y, lo[2] + (k + 0.5) * step[2], cell)
+                FIELD_KERNEL(p, x, y, lo[2] + (k + 0.5) * step[2], cell)
                 out[i, j, k, :] = cell
     return out
 
 
-@njit(parallel=True, fastmath=FASTMATH)
-def population_points_fields(field_kernel, n_fields, params, pts):
-    """Every field of every design at the same points: params (n_designs, k), pts (n, 3) ->
-    (n_designs, n, n_fields); field 0 (LCI) -1 where unreachable."""
+def _population_points_fields(params, pts):
+    """Template of population_points_fields."""
+    n_fields = N_FIELDS
     n_designs = params.shape[0]
     n = pts.shape[0]
     out = np.empty((n_designs, n, n_fields))
@@ -292,27 +292,20 @@ def population_points_fields(field_kernel, n_fields, params, pts):
         p = params[d]
         cell = np.empty(n_fields)
         for i in range(n):
-            field_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2], cell)
+            FIELD_KERNEL(p, pts[i, 0], pts[i, 1], pts[i, 2], cell)
             out[d, i, :] = cell
     return out
 
 
-def lci_kernel(field_kernel, n_fields: int):
-    """A scalar kernel ``f(p, x, y, z) -> LCI or -1`` over a field kernel (for single points and the LCI-only
-    helpers below; the evaluators use the field kernel itself)."""
-
-    @njit(fastmath=FASTMATH)
-    def point_lci(p, x, y, z):
-        out = np.empty(n_fields)
-        field_kernel(p, x, y, z, out)
-        return out[0]
-
-    return point_lci
+def _point_lci(p, x, y, z):
+    """Template of the scalar LCI kernel over a field kernel."""
+    out = np.empty(N_FIELDS)
+    FIELD_KERNEL(p, x, y, z, out)
+    return out[0]
 
 
-@njit(parallel=True, fastmath=FASTMATH)
-def sample_grid(point_kernel, p, lo, step, shape):
-    """LCI at every node of one design's grid, shape (nx, ny, nz), from a scalar LCI kernel; -1 = unreachable."""
+def _sample_grid(p, lo, step, shape):
+    """Template of sample_grid (FIELD_KERNEL is a scalar LCI kernel here)."""
     nx, ny, nz = shape[0], shape[1], shape[2]
     out = np.empty((nx, ny, nz))
     for i in prange(nx):
@@ -320,16 +313,54 @@ def sample_grid(point_kernel, p, lo, step, shape):
         for j in range(ny):
             y = lo[1] + (j + 0.5) * step[1]
             for k in range(nz):
-                z = lo[2] + (k + 0.5) * step[2]
-                out[i, j, k] = point_kernel(p, x, y, z)
+                out[i, j, k] = FIELD_KERNEL(p, x, y, lo[2] + (k + 0.5) * step[2])
     return out
 
 
-@njit(fastmath=FASTMATH)
-def points_lci(point_kernel, p, pts):
-    """LCI (or -1) at arbitrary points, pts shape (n, 3), from a scalar LCI kernel."""
+def _points_lci(p, pts):
+    """Template of points_lci (FIELD_KERNEL is a scalar LCI kernel)."""
     n = pts.shape[0]
     out = np.empty(n)
     for i in range(n):
-        out[i] = point_kernel(p, pts[i, 0], pts[i, 1], pts[i, 2])
+        out[i] = FIELD_KERNEL(p, pts[i, 0], pts[i, 1], pts[i, 2])
     return out
+
+
+_PARALLEL = {"parallel": True, "fastmath": FASTMATH}
+_SERIAL = {"fastmath": FASTMATH}
+
+
+def population_stats(field_kernel, n_fields, params, lo, step, shape, edges):
+    """Workspace statistics of every field for every design on its own grid.
+
+    params: (n_designs, k) packed designs; lo, step: (n_designs, 3); shape: int64[3] (nx, ny, nz);
+    edges: dexterity band edges. Returns (n_designs, stat_columns(n_fields, n_bands)) float64.
+    """
+    return bind(_population_stats, field_kernel, n_fields, **_PARALLEL)(params, lo, step, shape, edges)
+
+
+def sample_fields(field_kernel, n_fields, p, lo, step, shape):
+    """Every field at every node of one design's grid: (nx, ny, nz, n_fields); field 0 (LCI) -1 = unreachable."""
+    return bind(_sample_fields, field_kernel, n_fields, **_PARALLEL)(p, lo, step, shape)
+
+
+def population_points_fields(field_kernel, n_fields, params, pts):
+    """Every field of every design at the same points: params (n_designs, k), pts (n, 3) ->
+    (n_designs, n, n_fields); field 0 (LCI) -1 where unreachable."""
+    return bind(_population_points_fields, field_kernel, n_fields, **_PARALLEL)(params, pts)
+
+
+def lci_kernel(field_kernel, n_fields: int):
+    """A scalar kernel ``f(p, x, y, z) -> LCI or -1`` over a field kernel (for single points and the LCI-only
+    helpers below; the evaluators use the field kernel itself). Disk-cached like the grid kernels."""
+    return bind(_point_lci, field_kernel, n_fields, **_SERIAL)
+
+
+def sample_grid(point_kernel, p, lo, step, shape):
+    """LCI at every node of one design's grid, shape (nx, ny, nz), from a scalar LCI kernel; -1 = unreachable."""
+    return bind(_sample_grid, point_kernel, 0, **_PARALLEL)(p, lo, step, shape)
+
+
+def points_lci(point_kernel, p, pts):
+    """LCI (or -1) at arbitrary points, pts shape (n, 3), from a scalar LCI kernel."""
+    return bind(_points_lci, point_kernel, 0, **_SERIAL)(p, pts)

@@ -1,0 +1,234 @@
+"""Issue-15 benchmarks: the adaptive evaluator against uniform grids at equal accuracy, and compile times.
+
+    python benchmarks/bench.py adaptive [MECH ...]   # accuracy and cost per mechanism (default: every config)
+    python benchmarks/bench.py compile_all           # first-process JIT time and second-process start, per mechanism
+
+Accuracy: 20 random designs within the config's bounds (seed 0); the reference is a uniform grid 3x finer than
+the resolution the config used before the tolerance form (``OLD_RESOLUTION``). "Uniform at equal accuracy" is the
+coarsest uniform grid of a ladder whose worst volume and GCI errors on those designs meet the same tolerance.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from scalesynth.config import load_config  # noqa: E402
+from scalesynth.evaluate import Tolerance, adaptive_population_stats, make_grid  # noqa: E402
+
+import naive  # noqa: E402
+
+CONFIGS = {
+    "2pauu-ppap": "paper_2pauu_ppap.yaml",
+    "planar-fivebar": "fivebar_packing.yaml",
+    "pprs-rprs": "pprs_rprs.yaml",
+    "rps-upu": "rps_upu.yaml",
+    "rps-upu-tool": "rps_upu_tool.yaml",
+    "ups-sspr": "ups_sspr.yaml",
+}
+# grid.resolution of each config before issue 15 (the hand-chosen uniform grids)
+OLD_RESOLUTION = {"2pauu-ppap": 56, "planar-fivebar": 256, "pprs-rprs": 32, "rps-upu": 32, "rps-upu-tool": 32,
+                  "ups-sspr": 64}
+LADDER = (8, 12, 16, 20, 24, 32, 40, 48, 56, 64, 80, 96, 128, 160, 192, 256, 320, 384, 512)
+TWINS = {
+    "2pauu-ppap": naive.pauu_fields,
+    "planar-fivebar": lambda d, o, x, y, z: naive.fivebar_fields(d, o, x, y),
+    "pprs-rprs": naive.pprs_fields,
+    "rps-upu": naive.rps_upu_fields,
+    "rps-upu-tool": naive.rps_upu_tool_fields,
+    "ups-sspr": naive.ups_sspr_fields,
+}
+N_DESIGNS = 20
+
+
+def random_designs(cfg, n: int, seed: int = 0) -> list[dict[str, float]]:
+    rng = np.random.default_rng(seed)
+    base = cfg.resolved_design()
+    out = []
+    for _ in range(n):
+        d = dict(base)
+        d.update({k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()})
+        out.append(cfg.mech.resolve_design(d))
+    return out
+
+
+def uniform(mech, designs, options, n, edges, region):
+    """(volume, gci, seconds per design) on the uniform n-per-axis grid."""
+    grids = [make_grid(mech, d, options, n, region) for d in designs]
+    packed = np.stack([mech.pack(d, options) for d in designs])
+    lo, step = np.stack([g.lo for g in grids]), np.stack([g.step for g in grids])
+    mech.grid_stats(packed[:1], lo[:1], step[:1], grids[0].shape, edges)  # compiled or loaded
+    t0 = time.perf_counter()
+    s = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
+    sec = (time.perf_counter() - t0) / len(designs)
+    cell = np.array([g.cell_measure for g in grids])
+    return s[:, 0] * cell, gci_of(s), sec
+
+
+def gci_of(s):
+    return np.where(s[:, 0] > 0, s[:, 1] / np.where(s[:, 0] > 0, s[:, 0], 1.0), 0.0)
+
+
+def errors(vol, gci, ref_vol, ref_gci):
+    ev = np.where(ref_vol > 0, np.abs(vol - ref_vol) / np.where(ref_vol > 0, ref_vol, 1.0), np.abs(vol))
+    return float(ev.max()), float(np.abs(gci - ref_gci).max())
+
+
+def bench_mechanism(name: str) -> dict:
+    cfg = load_config(ROOT / "configs" / CONFIGS[name])
+    mech, options = cfg.mech, cfg.resolved_options()
+    tol = Tolerance(**cfg.grid.tolerance.model_dump()) if cfg.grid.tolerance is not None else Tolerance()
+    edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
+    region = cfg.grid.region
+    designs = random_designs(cfg, N_DESIGNS)
+    n_ref = 3 * OLD_RESOLUTION[name]
+    ref_vol, ref_gci, ref_sec = uniform(mech, designs, options, n_ref, edges, region)
+    print(f"{name}: reference N = {n_ref}: {ref_sec * 1e3:.1f} ms/design", flush=True)
+    packed = np.stack([mech.pack(d, options) for d in designs])
+    adaptive_population_stats(mech, designs[:1], options, packed[:1], tol, edges, region)
+    t0 = time.perf_counter()
+    ad = adaptive_population_stats(mech, designs, options, packed, tol, edges, region)
+    ad_sec = (time.perf_counter() - t0) / len(designs)
+    ad_ev, ad_eg = errors(ad.stats[:, 0] * ad.cell, gci_of(ad.stats), ref_vol, ref_gci)
+    print(f"  adaptive: {ad_sec * 1e3:.2f} ms/design, volume error {100 * ad_ev:.3f} %, GCI error {ad_eg:.1e}, "
+          f"{ad.evaluations.mean():.0f} kernel calls/design", flush=True)
+    equal = None
+    for n in LADDER:
+        if n >= n_ref:
+            break
+        vol, gci, sec = uniform(mech, designs, options, n, edges, region)
+        ev, eg = errors(vol, gci, ref_vol, ref_gci)
+        if ev <= tol.volume and eg <= tol.gci:
+            equal = {"N": n, "s_per_design": sec, "volume_error": ev, "gci_error": eg,
+                     "kernel_calls": float(n ** len(mech.task_axes))}
+            print(f"  uniform at equal accuracy: N = {n}, {sec * 1e3:.2f} ms/design", flush=True)
+            break
+    # the NumPy twin of the same algorithm on two designs (NumPy field twins of tests/naive.py)
+    twin = TWINS[name]
+    ndim = len(mech.task_axes)
+    from scalesynth.evaluate import ADAPTIVE_COARSE, ADAPTIVE_TAU
+
+    t0 = time.perf_counter()
+    for d, lv in zip(designs[:2], ad.levels[:2], strict=True):
+        g = make_grid(mech, d, options, ADAPTIVE_COARSE[ndim], region)
+        naive.adaptive_stats(lambda pts, d=d: twin(d, options, pts[:, 0], pts[:, 1], pts[:, 2]), mech.n_fields,
+                             g.lo, g.step, g.shape, edges, ndim, int(lv), ADAPTIVE_TAU)
+    twin_sec = (time.perf_counter() - t0) / 2
+    t0 = time.perf_counter()
+    adaptive_population_stats(mech, designs[:2], options, packed[:2], tol, edges, region)
+    ad2_sec = (time.perf_counter() - t0) / 2
+    return {
+        "mechanism": name, "config": CONFIGS[name], "tolerance": {"volume": tol.volume, "gci": tol.gci},
+        "designs": len(designs), "reference_N": n_ref, "reference_s_per_design": ref_sec,
+        "adaptive": {"s_per_design": ad_sec, "volume_error": ad_ev, "gci_error": ad_eg,
+                     "estimate_volume_max": float(ad.error_volume.max()), "estimate_gci_max": float(ad.error_gci.max()),
+                     "kernel_calls": float(ad.evaluations.mean()), "levels": [int(v) for v in ad.levels],
+                     "projected_40000_s": ad_sec * 40000},
+        "uniform_equal_accuracy": equal,
+        "old_resolution": OLD_RESOLUTION[name],
+        "numpy_twin_s_per_design": twin_sec, "adaptive_same_designs_s": ad2_sec,
+    }
+
+
+def bench_adaptive(names: list[str] | None = None) -> dict:
+    names = names or list(CONFIGS)
+    return {"mechanisms": [bench_mechanism(n) for n in names]}
+
+
+_PROBE = """
+import sys, time
+t0 = time.perf_counter()
+from scalesynth.config import load_config
+from scalesynth.evaluate import evaluate_config_population
+cfg = load_config(sys.argv[1])
+t1, c1 = time.perf_counter(), time.process_time()
+evaluate_config_population(cfg, [cfg.resolved_design()])
+print(t1 - t0, time.perf_counter() - t1, time.process_time() - c1)
+"""
+
+
+def bench_compile_all() -> dict:
+    """Per mechanism, in fresh processes: import + first evaluation of the config's design with an empty Numba
+    cache directory (compilation), then again with that cache (second process)."""
+    rows = []
+    env = dict(os.environ)
+    for name, config in CONFIGS.items():
+        with tempfile.TemporaryDirectory() as cache:
+            env["NUMBA_CACHE_DIR"] = cache
+            times = []
+            for _ in range(2):
+                out = subprocess.run([sys.executable, "-c", _PROBE, str(ROOT / "configs" / config)], env=env,
+                                     capture_output=True, text=True, check=True)
+                times.append([float(v) for v in out.stdout.split()[-3:]])
+        rows.append({"mechanism": name, "config": config, "first_import_s": times[0][0],
+                     "first_evaluation_s": times[0][1], "second_import_s": times[1][0],
+                     "second_evaluation_s": times[1][1], "first_evaluation_cpu_s": times[0][2],
+                     "second_evaluation_cpu_s": times[1][2]})
+        print(f"{name}: first process {times[0][1]:.2f} s to first evaluation, second {times[1][1]:.2f} s", flush=True)
+    return {"rows": rows}
+
+
+CONDITIONS = ("Conditions: measured with NUMBA_NUM_THREADS=1 while the 2-core machine was shared with other jobs "
+              "(load average 12 to 15), so absolute times are several times those of an idle machine; compare the "
+              "ratios, which come from one run.")
+
+
+def markdown(data: dict) -> list[str]:
+    """RESULTS.md sections of the stored issue-15 parts."""
+    out: list[str] = [CONDITIONS, ""]
+    if "compile_all" in data:
+        out += ["### Compile once (fresh processes, empty Numba cache, then the same cache)", "",
+                "Wall seconds from the loaded config to the first evaluated design (CPU seconds of the process in "
+                "brackets: on a shared machine the wall time includes waiting for a core), and the imports before.",
+                "", "| mechanism | first process (empty cache) | second process (cache) | second process: imports |",
+                "|---|---|---|---|"]
+        def cpu(r, key):
+            return f" ({r[key]:.2f})" if key in r else ""
+
+        for r in data["compile_all"]["result"]["rows"]:
+            out.append(f"| {r['mechanism']} | {r['first_evaluation_s']:.2f} s{cpu(r, 'first_evaluation_cpu_s')} | "
+                       f"{r['second_evaluation_s']:.2f} s{cpu(r, 'second_evaluation_cpu_s')} | "
+                       f"{r['second_import_s']:.2f} s |")
+        out.append("")
+    if "adaptive" in data:
+        for m in data["adaptive"]["result"]["mechanisms"]:
+            a, u = m["adaptive"], m["uniform_equal_accuracy"]
+            tol = m["tolerance"]
+            ok = a["volume_error"] <= tol["volume"] and a["gci_error"] <= tol["gci"]
+            out += [f"### {m['mechanism']} ({m['config']})", "",
+                    f"{m['designs']} random designs in the bounds; reference: uniform N = {m['reference_N']} "
+                    f"(3x the old resolution {m['old_resolution']}); tolerance volume {100 * tol['volume']:.2g} %, "
+                    f"GCI {tol['gci']:.1e}.", "",
+                    "| evaluator | ms/design | max volume error | max GCI error | kernel calls/design | "
+                    "projected 40 000 designs |", "|---|---|---|---|---|---|"]
+            out.append(f"| adaptive (levels {min(a['levels'])}-{max(a['levels'])}) | {1e3 * a['s_per_design']:.2f} | "
+                       f"{100 * a['volume_error']:.3f} % | {a['gci_error']:.1e} | {a['kernel_calls']:.0f} | "
+                       f"{a['projected_40000_s']:.0f} s |")
+            if u is not None:
+                out.append(f"| uniform N = {u['N']} (coarsest meeting the tolerance) | {1e3 * u['s_per_design']:.2f} | "
+                           f"{100 * u['volume_error']:.3f} % | {u['gci_error']:.1e} | {u['kernel_calls']:.0f} | "
+                           f"{u['s_per_design'] * 40000:.0f} s |")
+            ratio = (f"{u['s_per_design'] / a['s_per_design']:.2f}x" if u else
+                     "not measured: no uniform grid below the reference meets the tolerance on every design")
+            out += ["", f"- tolerance met by the adaptive evaluator on every design: {'yes' if ok else 'NO'} "
+                    f"(its own estimate, max: volume {100 * a['estimate_volume_max']:.3f} %, GCI "
+                    f"{a['estimate_gci_max']:.1e})",
+                    f"- cost ratio uniform-at-equal-accuracy / adaptive: {ratio} (goal >= 10x)",
+                    f"- NumPy twin of the same algorithm: {m['numpy_twin_s_per_design']:.2f} s/design, "
+                    f"{m['numpy_twin_s_per_design'] / m['adaptive_same_designs_s']:.0f}x the Numba kernel on the "
+                    "same designs", ""]
+    return out
+
+
+if __name__ == "__main__":
+    print(json.dumps(bench_adaptive(sys.argv[1:]), indent=2))

@@ -1,0 +1,71 @@
+"""Compile once: grid kernels bound to one field kernel, cached on disk like any module-level @njit function.
+
+Numba cannot disk-cache a function that takes another jitted function as an argument ("dynamic globals"), nor a
+closure over one (its cache key pickles the dispatcher, whose uuid differs per process). A *template* here is a
+plain Python function that calls the field kernel through the global names ``FIELD_KERNEL`` / ``N_FIELDS``;
+``bind`` makes a copy of it whose globals hold one mechanism's kernel, so Numba compiles a direct call and the
+result caches and hits across processes.
+
+Cache identity of a bound copy: its file is the field kernel's source file (Numba's staleness check follows that
+file's time stamp and size) and its name carries a hash of the sources of ``scalesynth/kernels/*.py`` and of that
+file, so editing either the mechanism or a shared kernel module compiles afresh (Numba alone would not notice an
+edited callee in another file).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import types
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from numba import njit
+
+_KERNELS_DIR = Path(__file__).resolve().parent
+_BOUND: dict[tuple[Any, int, str], Any] = {}
+_SOURCE_HASH: dict[str, str] = {}
+
+
+def _sources_hash(kernel_file: str) -> str:
+    """Short hash of the kernel package's sources and the field kernel's file ('' if a file cannot be read)."""
+    h = _SOURCE_HASH.get(kernel_file)
+    if h is None:
+        digest = hashlib.sha256()
+        try:
+            for path in sorted(_KERNELS_DIR.glob("*.py")) + [Path(kernel_file)]:
+                digest.update(path.read_bytes())
+            h = digest.hexdigest()[:12]
+        except OSError:
+            h = ""
+        _SOURCE_HASH[kernel_file] = h
+    return h
+
+
+def bind(template: Callable, field_kernel: Any, n_fields: int, **jit_options) -> Any:
+    """The template compiled for ``field_kernel`` (an @njit dispatcher) with ``n_fields`` slots; memoised per
+    process, disk-cached when the kernel comes from a real source file."""
+    key = (field_kernel, int(n_fields), template.__name__)
+    out = _BOUND.get(key)
+    if out is not None:
+        return out
+    py = getattr(field_kernel, "py_func", field_kernel)
+    kernel_file = py.__code__.co_filename
+    cacheable = os.path.isfile(kernel_file) and bool(_sources_hash(kernel_file))
+    module = re.sub(r"\W", "_", getattr(py, "__module__", "") or "kernel")
+    qual = re.sub(r"\W", "_", py.__qualname__)
+    name = f"{template.__name__.lstrip('_')}__{module}__{qual}__{n_fields}"
+    if cacheable:
+        name += f"__{_sources_hash(kernel_file)}"
+    code = template.__code__.replace(co_name=name, co_qualname=name,
+                                     co_filename=kernel_file if cacheable else template.__code__.co_filename)
+    env = dict(template.__globals__)
+    env["FIELD_KERNEL"] = field_kernel
+    env["N_FIELDS"] = int(n_fields)
+    fn = types.FunctionType(code, env, name, template.__defaults__)
+    fn.__qualname__ = name
+    fn.__module__ = template.__module__
+    out = _BOUND[key] = njit(cache=cacheable, **jit_options)(fn)
+    return out
