@@ -108,9 +108,12 @@ def init_row(row, n_fields):
         row[1 + 4 * f + 3] = -math.inf
 
 
-# The accumulator's sums may be reassociated (vectorised reductions): the order is fixed by the compiled code, so
-# results stay byte-identical run to run on one machine type. Counts are sums of small integer weights (exact).
-_ACC_FASTMATH = FASTMATH | {"reassoc"}
+# The accumulator's sums are NOT reassociated: with fastmath 'reassoc' LLVM vectorises the reductions, and the
+# code it generates for a kernel compiled in this process (callees inlined from the same module) and for the same
+# kernel loaded from Numba's disk cache summed in different orders, so a run resumed in a new process or on another
+# worker differed from an uninterrupted one in the last bits (found by the kill -9 resume tests on a fresh cache).
+# Counts are sums of small integer weights (exact).
+_ACC_FASTMATH = FASTMATH
 
 
 @njit(cache=True, fastmath=FASTMATH)
