@@ -324,6 +324,11 @@ def band_pareto_figure(all_x, all_y, x, y, xlabel: str, ylabel: str, title: str)
     order = np.argsort(x)
     ax.plot(np.asarray(x)[order], np.asarray(y)[order], "-", c=FRONT, lw=1)
     ax.scatter(x, y, s=24, c=FRONT, label=f"non-dominated ({len(x)})", zorder=3)
+    return _finish(fig, ax, xlabel, ylabel, title)
+
+
+def _finish(fig, ax, xlabel: str, ylabel: str, title: str):
+    """Labels, title, grid, legend and a tight layout: the common end of the scatter figures."""
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
@@ -347,13 +352,7 @@ def compare_figure(series: Sequence[dict], xlabel: str, ylabel: str, title: str)
         for name, sx, sy in s.get("selected", []):
             ax.scatter([sx], [sy], marker="*", s=170, c=colour, edgecolors="k", zorder=5)
             ax.annotate(f"{s['label']}: {name}", (sx, sy), textcoords="offset points", xytext=(6, 6), fontsize=7)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, ax, xlabel, ylabel, title)
 
 
 def task_figure(lci: np.ndarray, extent, path: np.ndarray | None, band_edges, xlabel, ylabel, title):
