@@ -143,7 +143,7 @@ def _column_pass1(x, y, k0, k1, lo_z, step_z, p, flag, targ, tq, tp, tc2, td2):
     """Cells k0..k1 of column (x, y), no theta limits: everything of point_fields up to the trigonometric step of
     lci_3x3, written branch-free into scratch arrays so that the compiler can vectorise the loop.
 
-    flag: 1 reachable, 2 reachable but inverse-singular (LCI 0), 0 unreachable; targ: argument of acos; tq, tp: the
+    flag: 1 reachable, 0 reachable but inverse-singular (LCI 0), -1 unreachable; targ: argument of acos; tq, tp: the
     centre and scale of the eigenvalue problem; tc2: sum of the squared 2x2 minors; td2: det^2 (see lci_3x3).
     """
     delta = p[_DELTA]
@@ -218,7 +218,7 @@ def _column_pass1(x, y, k0, k1, lo_z, step_z, p, flag, targ, tq, tp, tc2, td2):
         tp[k] = pp_
         tc2[k] = c2
         td2[k] = det * det
-        flag[k] = 0.0 if not ok else (2.0 if sing else 1.0)
+        flag[k] = -1.0 if not ok else (0.0 if sing else 1.0)
 
 @njit(cache=True, fastmath=FASTMATH)
 def _column_pass2(k0, k1, targ):
@@ -229,10 +229,15 @@ def _column_pass2(k0, k1, targ):
 @njit(cache=True, fastmath=FASTMATH)
 def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, buf, wbuf, m, w):
     """Fields of cells k0..k1 into the slab buffers from index m (as kernels.grid.gather_column: weight w if
-    reachable, else 0), as point_fields, branch-free: LCI from the largest eigenvalue and the sum/product of the
-    other two (as in sv_3x3); of J = M^-1, sigma_min = 1/sqrt(lmax) and sigma_max = 1/(LCI sqrt(lmax))
-    (= 1/sigma_min(M)), capped at SIGMA_CAP; LCI -1 if unreachable. Loops over slices from 0, so that the
-    compiler can drop index wraparound and vectorise."""
+    reachable, else 0), as point_fields: LCI from the largest eigenvalue and the sum/product of the other two (as
+    in sv_3x3); of J = M^-1, sigma_min = 1/sqrt(lmax) and sigma_max = 1/(LCI sqrt(lmax)) (= 1/sigma_min(M)),
+    capped at SIGMA_CAP; LCI -1 if unreachable.
+
+    Loops over slices from 0 (no index wraparound) and is branch-free so that the compiler vectorises it: every
+    value is computed for every cell, and the flag (1 regular, 0 singular, -1 unreachable) selects by arithmetic
+    (min, products with 0 or 1, exact), because a conditional expression becomes a branch that the vectoriser
+    gives up on. Unreachable cells may carry garbage (even NaN): the clamps put the constant first, which Python's
+    and Numba's min/max return when the other argument is NaN, so every output is finite."""
     n = k1 - k0 + 1
     fl = flag[k0 : k1 + 1]
     ta = targ[k0 : k1 + 1]
@@ -246,21 +251,23 @@ def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, buf, wbuf, m, w):
     out_w = wbuf[m : m + n]
     for i in range(n):
         lmax = q_[i] + 2.0 * p_[i] * ta[i]
-        il = 1.0 / max(lmax, 1e-300)
+        il = 1.0 / max(1e-300, lmax)
         prod = d2[i] * il
         s = (c2[i] - prod) * il
-        disc = max(s * s - 4.0 * prod, 0.0)
-        lmid = max(0.5 * (s + math.sqrt(disc)), 1e-300)
-        ratio = min(max(prod / lmid * il, 0.0), 1.0)
+        disc = max(0.0, s * s - 4.0 * prod)
+        lmid = max(1e-300, 0.5 * (s + math.sqrt(disc)))
+        ratio = min(1.0, max(0.0, prod / lmid * il))
         v = math.sqrt(ratio)
         v = v if (s > 0.0) & (prod > 0.0) else 0.0
-        sig_lo = min(math.sqrt(il), SIGMA_CAP)
-        sig_hi = min(sig_lo / max(v, 1e-300), SIGMA_CAP)
+        sig_lo = min(SIGMA_CAP, math.sqrt(il))
+        sig_hi = min(SIGMA_CAP, sig_lo / max(1e-300, v))
         f = fl[i]
-        out_lci[i] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
-        out_lo[i] = sig_lo if f == 1.0 else 0.0
-        out_hi[i] = sig_hi if f == 1.0 else (SIGMA_CAP if f == 2.0 else 0.0)
-        out_w[i] = w if f > 0.0 else 0.0
+        ok = max(0.0, f)  # 1 regular, else 0
+        reach = min(1.0, f + 1.0)  # 1 reachable, else 0
+        out_lci[i] = min(v, f)
+        out_lo[i] = sig_lo * ok
+        out_hi[i] = sig_hi * ok + SIGMA_CAP * (reach - ok)
+        out_w[i] = w * reach
 
 
 @njit(cache=True, parallel=True, fastmath=FASTMATH)
