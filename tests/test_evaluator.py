@@ -55,7 +55,7 @@ def test_kernel_matches_numpy_twin(group, options, resolution):
     # only at the nodes where J is defined to working precision.
     regular = reach & (lci > 1e-9)
     assert regular.sum() > 0.9 * reach.sum()
-    np.testing.assert_allclose(fields[regular][:, 1:], twin[regular][:, 1:], rtol=1e-7)
+    np.testing.assert_allclose(fields[regular][:, 1:3], twin[regular][:, 1:3], rtol=1e-7)  # slot 3: clearance
     assert (fields[reach & ~regular][:, 2] >= 1e9).all() and (twin[reach & ~regular][:, 2] >= 1e9).all()
     assert (fields[~reach][:, 1:] == 0).all()
     rep = evaluate(M, design, opts, resolution=resolution, band_edges=EDGES)
@@ -165,9 +165,18 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     lo = np.stack([g.lo for g in grids])
     step = np.stack([g.step for g in grids])
     edges = np.array(EDGES)
-    generic = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
+    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
     fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    # the fast path has the three fields lci, sigma_min, sigma_max; the field kernel adds clearance (slot 3)
+    assert M.field_names[3] == "clearance" and full.shape == (16, kgrid.stat_columns(4, 3))
+    head = kgrid.band_column(3, 0)
+    generic = np.hstack([full[:, :head], full[:, kgrid.band_column(4, 0):]])
     assert fast.shape == generic.shape == (16, kgrid.stat_columns(3, 3))
+    # what the evaluator gets (options without link_radius): the fast rows in the four-field layout
+    widened = M.grid_stats(packed, lo, step, grids[0].shape, edges)
+    assert widened.shape == full.shape
+    assert np.array_equal(widened[:, :head], fast[:, :head])
+    assert np.array_equal(widened[:, kgrid.band_column(4, 0):], fast[:, head:])
     assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
     assert np.array_equal(generic[:, kgrid.COL_COUNT], fast[:, kgrid.COL_COUNT])
     bands = [kgrid.band_column(3, b) for b in range(3)]
