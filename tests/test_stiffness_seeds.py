@@ -41,6 +41,30 @@ def cli(*args):
     return CliRunner().invoke(app, ["stiffness", *args])
 
 
+def assert_converges(gaps):
+    """Gaps to the rigid-link limit at three decades of link stiffness: < 1e-4 at the last, 10x smaller per decade."""
+    assert gaps[2] < 1e-4
+    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+
+
+def assert_spd(model, dofs):
+    """Not singular, platform DOFs ``dofs``, K symmetric positive definite."""
+    res = solve(model)
+    assert not res.singular and res.dofs == dofs and res.K.shape == (len(dofs), len(dofs))
+    assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
+    assert np.linalg.eigvalsh(res.K)[0] > 0
+
+
+def assert_linear(model_with_load):
+    """Superposition: the deflection under f1 + f2 is the sum of those under f1 and f2 (to 1e-12)."""
+    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
+    d1, d2, d3 = (solve(model_with_load(f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
+    assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+
+
+SPATIAL = ("x", "y", "z", "rx", "ry", "rz")
+
+
 # ----- seed 001: pprs-rprs ----------------------------------------------------------------------------------------
 PPRS = get("pprs-rprs")
 PPRS_DESIGN = PPRS.resolve_design({})  # paper Table 1: r = 160, R = 180, L1 = 100, L2 = L3 = 120 mm
@@ -82,19 +106,13 @@ def test_pprs_rprs_rigid_links_give_the_jacobian_model():
     for e in (1e3, 1e4, 1e5):
         C = solve(pprs_model(pose, youngs_modulus=70 * e, actuator_stiffness=k, beta_stiffness=kb)).C
         gaps.append(np.max(np.abs(scaled(C - cj, r))) / np.max(np.abs(scaled(cj, r))))
-    assert gaps[2] < 1e-4
-    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+    assert_converges(gaps)
 
 
 def test_pprs_rprs_spd_and_linear():
     for pose in PPRS_POSES:
-        res = solve(pprs_model(pose))
-        assert not res.singular and res.K.shape == (6, 6) and res.dofs == ("x", "y", "z", "rx", "ry", "rz")
-        assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
-        assert np.linalg.eigvalsh(res.K)[0] > 0
-    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
-    d1, d2, d3 = (solve(pprs_model(PPRS_POSES[0], load=f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
-    assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+        assert_spd(pprs_model(pose), SPATIAL)
+    assert_linear(lambda f: pprs_model(PPRS_POSES[0], load=f))
     # the default load is 150 N along -z (gravity) at O1
     assert pprs_model(PPRS_POSES[0]).to_dict()["load"]["force"] == [0.0, 0.0, -150.0]
 
@@ -211,21 +229,15 @@ def test_rps_upu_rigid_links_give_the_jacobian_model(mech, pose, opts):
     for e in (1e2, 1e3, 1e4):
         C = solve(rps_model(mech, pose, youngs_modulus=70 * e, actuator_stiffness=k, **opts)).C
         gaps.append(np.max(np.abs(scaled(C - cj, h))) / np.max(np.abs(scaled(cj, h))))
-    assert gaps[2] < 1e-4
-    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+    assert_converges(gaps)
 
 
 def test_rps_upu_spd_and_linear():
     for mech, pose, opts in ([(RPS, p, o) for p, o in RPS_POSES] + [(TOOL, p, o) for p, o in TOOL_POSES]
                              + [(RPS, p, {"model": "C", "c3_variant": "upu"}) for p in UPU_POSES]):
-        res = solve(rps_model(mech, pose, **opts))
-        assert not res.singular and res.K.shape == (6, 6) and res.dofs == ("x", "y", "z", "rx", "ry", "rz")
-        assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
-        assert np.linalg.eigvalsh(res.K)[0] > 0
-    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
+        assert_spd(rps_model(mech, pose, **opts), SPATIAL)
     for mech, pose in ((RPS, RPS_POSES[0][0]), (TOOL, TOOL_POSES[1][0])):
-        d1, d2, d3 = (solve(rps_model(mech, pose, load=f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
-        assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+        assert_linear(lambda f, mech=mech, pose=pose: rps_model(mech, pose, load=f))
 
 
 def test_rps_upu_frame_is_the_constraint_consistent_placement():
@@ -324,19 +336,13 @@ def test_2pauu_ppap_rigid_links_give_the_jacobian_model():
         res = solve(pauu_model(pose, youngs_modulus=70 * e, actuator_stiffness=k, stroke_stiffness=kd))
         assert res.dofs == ("x", "y", "z")
         gaps.append(np.max(np.abs(res.C - cj)) / np.max(np.abs(cj)))
-    assert gaps[2] < 1e-4
-    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+    assert_converges(gaps)
 
 
 def test_2pauu_ppap_spd_linear_and_parallelograms_matter():
     for pose in PAUU_POSES:
-        res = solve(pauu_model(pose))
-        assert not res.singular and res.K.shape == (3, 3) and res.dofs == ("x", "y", "z")
-        assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
-        assert np.linalg.eigvalsh(res.K)[0] > 0
-    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
-    d1, d2, d3 = (solve(pauu_model(PAUU_POSES[1], load=f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
-    assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+        assert_spd(pauu_model(pose), ("x", "y", "z"))
+    assert_linear(lambda f: pauu_model(PAUU_POSES[1], load=f))
     # where the platform is off the xz-plane (y != 0) the arm links carry load (the U-U links' constraint couples and
     # their y forces bend the parallelograms out of plane): a 10x thinner-walled arm link makes the platform 41 %
     # softer at this corner (measured 1.409); at y = 0 the U-U links lie in the xz-plane, nothing loads the arm

@@ -634,7 +634,8 @@ class PauuPpap(Mechanism):
         it holds the platform's rotations rigidly, so the platform DOFs are x, y, z. The platform is rigid with
         reference point P; the load is a force at P. ``joints`` 'bonded' welds the passive revolute and universal
         joints (the slides stay slides)."""
-        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.builder import FrameBuilder, unit
+        from scalesynth.stiffness.model import Body
         from scalesynth.stiffness.sections import tube_section
 
         x, y, z = self.check_vector("pose", pose, 3)
@@ -647,26 +648,7 @@ class PauuPpap(Mechanism):
         e = self.offset_e(design, options)
         yhat, zhat = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
         k, k_d = options["actuator_stiffness"], options["stroke_stiffness"]
-        sec = {g: tube_section(options, g, "m") for g in LINK_GROUPS}
-        links_, js = [], []
-
-        def unit(v):
-            v = np.asarray(v, dtype=float)
-            return v / np.linalg.norm(v)
-
-        def link(name, group, start, end):
-            q_ = sec[group]
-            d = unit(end - start)
-            up = zhat if abs(d[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-            links_.append(Link(name, group, np.array(start, float), np.array(end, float), q_.EA, q_.EI, q_.EI, q_.GJ,
-                               up))
-
-        def joint(name, kind, at, part_a, part_b, axes=(), stiffness=None):
-            if joints == "bonded" and stiffness is None and kind != "prismatic":
-                kind, axes = "fixed", ()
-            js.append(Joint(name, kind, np.array(at, float), (part_a, part_b), tuple(unit(a) for a in axes),
-                            stiffness))
-
+        fb = FrameBuilder({g: tube_section(options, g, "m") for g in LINK_GROUPS}, joints)
         p = np.array([x, y, z])
         bodies = [Body("base", np.zeros(3))]
         for i, (sgn, t) in enumerate(((1.0, q[0]), (-1.0, q[1])), 1):
@@ -674,31 +656,28 @@ class PauuPpap(Mechanism):
             ci = np.array([sgn * (m + l1 * math.cos(t)), 0.0, e - l1 * math.sin(t)])
             di = p + np.array([sgn * n, 0.0, 0.0])
             ti = unit(np.cross(yhat, di - ci))
-            link(f"arm{i}", "arm", a, ci)
-            link(f"arm_link{i}", "arm_link", a - c * zhat, ci - c * zhat)
-            link(f"link{i}", "link", ci, di)
+            fb.link(f"arm{i}", "arm", a, ci)
+            fb.link(f"arm_link{i}", "arm_link", a - c * zhat, ci - c * zhat)
+            fb.link(f"link{i}", "link", ci, di)
             bodies.append(Body(f"plate{i}", ci.copy()))
-            joint(f"actuator{i}", "revolute", a, f"arm{i}.a", "base", (yhat,), k)
-            joint(f"elbow{i}", "revolute", ci, f"arm{i}.b", f"plate{i}", (yhat,))
-            joint(f"arm_link_base{i}", "revolute", a - c * zhat, f"arm_link{i}.a", "base", (yhat,))
-            joint(f"arm_link_plate{i}", "revolute", ci - c * zhat, f"arm_link{i}.b", f"plate{i}", (yhat,))
-            joint(f"U_C{i}", "universal", ci, f"link{i}.a", f"plate{i}", (yhat, ti))
-            joint(f"U_D{i}", "universal", di, f"link{i}.b", "platform", (ti, yhat))
+            fb.joint(f"actuator{i}", "revolute", a, f"arm{i}.a", "base", (yhat,), k)
+            fb.joint(f"elbow{i}", "revolute", ci, f"arm{i}.b", f"plate{i}", (yhat,))
+            fb.joint(f"arm_link_base{i}", "revolute", a - c * zhat, f"arm_link{i}.a", "base", (yhat,))
+            fb.joint(f"arm_link_plate{i}", "revolute", ci - c * zhat, f"arm_link{i}.b", f"plate{i}", (yhat,))
+            fb.joint(f"U_C{i}", "universal", ci, f"link{i}.a", f"plate{i}", (yhat, ti))
+            fb.joint(f"U_D{i}", "universal", di, f"link{i}.b", "platform", (ti, yhat))
         cos_phi = min(1.0, max(-1.0, x / (design["l1"] + design["l2"])))
         sin_phi = math.sqrt(1.0 - cos_phi * cos_phi)
         bodies += [Body("ppap_carriage", p.copy()), Body("ppap_slide", p.copy()), Body("platform", p.copy())]
-        joint("P_d", "prismatic", p, "ppap_carriage", "base", (yhat,), k_d)
-        joint("Pa_ppap", "prismatic", p, "ppap_slide", "ppap_carriage", ((-sin_phi, 0.0, cos_phi),))
-        joint("P_z", "prismatic", p, "platform", "ppap_slide", (zhat,))
+        fb.joint("P_d", "prismatic", p, "ppap_carriage", "base", (yhat,), k_d)
+        fb.joint("Pa_ppap", "prismatic", p, "ppap_slide", "ppap_carriage", ((-sin_phi, 0.0, cos_phi),))
+        fb.joint("P_z", "prismatic", p, "platform", "ppap_slide", (zhat,))
         notes = ["spatial frame of spec §1.1 (z up, m); rigid platform with reference point P; the PPaP chain (rigid "
                  "bodies, slides d along y, the parallelogram's translation and z) holds the platform's rotations, so "
                  "its DOFs are x, y, z; the load is a force at P",
                  f"parallelograms: arm and arm link (offset -c z, c = {c:g}) with a rigid hinge plate; working mode "
                  f"{options['mode']}"]
-        if joints == "bonded":
-            notes.append("joints bonded: every passive revolute and universal joint welded, slides and actuators kept")
-        return FrameModel(3, "m", tuple(links_), tuple(js), tuple(bodies), "platform",
-                          np.asarray(options["load"], float), tuple(notes))
+        return fb.model("m", bodies, options["load"], notes)
 
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):

@@ -800,7 +800,8 @@ class RpsUpu(Mechanism):
         return self._frame(design, options, x, variant, ref, joints)
 
     def _frame(self, design, options, x, variant, ref, joints):
-        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.builder import FrameBuilder, unit
+        from scalesynth.stiffness.model import Body
         from scalesynth.stiffness.sections import tube_section
 
         g, h, c, e = self._geom(design)
@@ -809,41 +810,27 @@ class RpsUpu(Mechanism):
         base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
         top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
         k = options["actuator_stiffness"]
-        sec = tube_section(options, "leg", "mm")
+        fb = FrameBuilder({"leg": tube_section(options, "leg", "mm")}, joints)
         xhat, yhat = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-        links_, js = [], []
-
-        def unit(v):
-            v = np.asarray(v, dtype=float)
-            return v / np.linalg.norm(v)
-
-        def joint(name, kind, at, part_a, part_b, axes=(), stiffness=None):
-            if joints == "bonded" and stiffness is None:
-                kind, axes = "fixed", ()
-            js.append(Joint(name, kind, np.array(at, float), (part_a, part_b), tuple(unit(a) for a in axes),
-                            stiffness))
-
         w = rot[:, 2]
         m_axis = unit(np.cross(xhat, w))
         for i in range(3):
             n = i + 1
             a, b = base[i], top[i]
             mid = 0.5 * (a + b)
-            d = unit(b - a)
-            up = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.9 else xhat
-            for name, s0, s1 in ((f"cylinder{n}", a, mid), (f"rod{n}", mid, b)):
-                links_.append(Link(name, "leg", s0.copy(), s1.copy(), sec.EA, sec.EI, sec.EI, sec.GJ, up))
+            fb.link(f"cylinder{n}", "leg", a, mid)
+            fb.link(f"rod{n}", "leg", mid, b)
             if n < 3:
-                joint(f"R{n}", "revolute", a, f"cylinder{n}.a", "base", (xhat,))
+                fb.joint(f"R{n}", "revolute", a, f"cylinder{n}.a", "base", (xhat,))
             elif variant == "upu":
-                joint("U3_base", "universal", a, "cylinder3.a", "base", (xhat, m_axis))
+                fb.joint("U3_base", "universal", a, "cylinder3.a", "base", (xhat, m_axis))
             else:
-                joint("R3", "revolute", a, "cylinder3.a", "base", (yhat,))
-            joint(f"P{n}", "prismatic", mid, f"cylinder{n}.b", f"rod{n}.a", (b - a,), k)
+                fb.joint("R3", "revolute", a, "cylinder3.a", "base", (yhat,))
+            fb.joint(f"P{n}", "prismatic", mid, f"cylinder{n}.b", f"rod{n}.a", (b - a,), k)
             if n == 3 and variant == "upu":
-                joint("U3_platform", "universal", b, "rod3.b", "platform", (m_axis, w))
+                fb.joint("U3_platform", "universal", b, "rod3.b", "platform", (m_axis, w))
             else:
-                joint(f"S{n}", "spherical", b, f"rod{n}.b", "platform")
+                fb.joint(f"S{n}", "spherical", b, f"rod{n}.b", "platform")
         bodies = (Body("base", np.zeros(3)), Body("platform", np.asarray(ref, float).copy()))
         notes = [f"spatial frame O-xyz of spec §2.1 (z up, mm) at the constraint-consistent (C-model, chain 3 "
                  f"'{variant}') placement of (z, theta, psi) = ({', '.join(f'{v:g}' for v in x)}): yaw phi = "
@@ -853,10 +840,7 @@ class RpsUpu(Mechanism):
         if options.get("model", "P") == "P":
             notes.append("the P-model violates the RPS joint constraints (spec §2.3): the frame uses the C-model "
                          "placement")
-        if joints == "bonded":
-            notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
-        return FrameModel(3, "mm", tuple(links_), tuple(js), bodies, "platform", np.asarray(options["load"], float),
-                          tuple(notes))
+        return fb.model("mm", bodies, options["load"], notes)
 
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
