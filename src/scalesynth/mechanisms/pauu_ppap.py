@@ -35,6 +35,13 @@ from scalesynth.mechanisms.base import (
 from scalesynth.stiffness.sections import check_positive_option, check_stiffness_options, stiffness_options
 
 MODES = ("++", "+-", "-+", "--")
+# stiffness (scalesynth.stiffness, docs/stiffness.md): link groups, the actuated long links of the parallelograms
+# (arm), their second long links (arm_link) and the U-U links (link); actuator stiffness defaults (assumptions, the
+# paper gives none): 1e5 N m/rad for theta1, theta2 (a servo with a stiff precision reducer), 2e7 N/m (2e4 N/mm, a
+# ball-screw axis) for the stroke d
+LINK_GROUPS = ("arm", "arm_link", "link")
+ACTUATOR_STIFFNESS = 1e5
+STROKE_STIFFNESS = 2e7
 # default capsule radii (m), illustrative (the paper gives no cross-sections)
 LINK_RADII = {"base": 0.05, "arm1": 0.03, "arm2": 0.03, "link1": 0.02, "link2": 0.02, "platform": 0.05}
 
@@ -43,13 +50,6 @@ _DELTA, _L1, _L2, _E, _S1, _S2 = 0, 1, 2, 3, 4, 5
 _T1LO, _T1HI, _T2LO, _T2HI, _DLO, _DHI, _ZMIN, _HAS_THETA = 6, 7, 8, 9, 10, 11, 12, 13
 N_PACKED = 14
 N_FIELDS = 3  # lci, sigma_min, sigma_max (MECHANISM.fields)
-# stiffness (scalesynth.stiffness, docs/stiffness.md): link groups, the actuated long links of the parallelograms
-# (arm), their second long links (arm_link) and the U-U links (link); actuator stiffness defaults (assumptions, the
-# paper gives none): 1e5 N m/rad for theta1, theta2 (a servo with a stiff precision reducer), 2e7 N/m (2e4 N/mm, a
-# ball-screw axis) for the stroke d
-LINK_GROUPS = ("arm", "arm_link", "link")
-ACTUATOR_STIFFNESS = 1e5
-STROKE_STIFFNESS = 2e7
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -402,6 +402,8 @@ class PauuPpap(Mechanism):
     """Seed-000 mechanism; see module docstring."""
 
     def check_options(self, options: dict[str, Any]) -> None:
+        check_stiffness_options(options, 3, LINK_GROUPS)
+        check_positive_option(options, "stroke_stiffness")
         if options["mode"] not in MODES:
             raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
         for name in ("theta1_limits", "theta2_limits", "stroke_limits"):
@@ -413,8 +415,6 @@ class PauuPpap(Mechanism):
                     raise InvalidParameter(f"options.{name}: expected a finite number or null, got {value!r}")
                 options[name] = float(value)
         links.check_radius_option(options, LINK_RADII)
-        check_stiffness_options(options, 3, LINK_GROUPS)
-        check_positive_option(options, "stroke_stiffness")
 
     def offset_e(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         e = options.get("e")
@@ -618,6 +618,61 @@ class PauuPpap(Mechanism):
         with np.errstate(divide="ignore", invalid="ignore"):
             return jac["Jx"] / np.diag(jac["Jq"])[:, None]
 
+    # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
+    def topology(self, design, options):
+        """Joint list of paper §1 for the G-K counts, each parallelogram Pa counted as one 1-DOF joint:
+        chains PaUU, PaUU and PPaP; n = 8 (base, platform, two links per chain), g = 9, sum f = 13. The
+        classical count 6(8 - 9 - 1) + 13 = 1 misses nu = 2 redundant constraints: each PaUU chain exerts
+        one couple and PPaP three, and together they span only the three couples: the modified count is 3."""
+        from scalesynth.mobility import Topology
+
+        return Topology(
+            n_links=8,
+            chains=(("PaUU-1", ("Pa", "U", "U")), ("PaUU-2", ("Pa", "U", "U")), ("PPaP", ("P", "Pa", "P"))),
+            redundant=2,
+            note="the paper (§1.2, POC sets) counts F = sum f - sum xi_L = 13 - (6 + 4) = 3; as a modified "
+            "G-K count the chains' 1 + 1 + 3 constraint couples span 3: nu = 2",
+        )
+
+    def joint_screws(self, design, options, pose, q):
+        """Unit joint screws (omega; v) per chain at pose P = (x, y, z) with inputs q = (theta1, theta2, d),
+        in the fixed frame of spec §1.1 (design length units).
+
+        PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction
+        (-s_i sin theta_i, 0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes)
+        then about t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about
+        t_i then y, so the chain's one constraint is a couple along the xz-projection of w_i.
+
+        PPaP: the paper gives no dimensions, only three translations in different directions (its eq. 4);
+        taken as the stroke d along y, a parallelogram in the xz-plane with long links L = l1 + l2 pivoted at
+        x = 0 (so every |x| of the workspace is reachable; its moving link translates along
+        (-sin phi, 0, cos phi), cos phi = x / L) and a slide along z."""
+        from scalesynth.mobility import Joint, chain_screws
+
+        x, y, z = self.check_vector("pose", pose, 3)
+        t1, t2, _ = self.check_vector("inputs", q, 3)
+        m, n, l1 = design["m"], design["n"], design["l1"]
+        e = self.offset_e(design, options)
+        yhat = (0.0, 1.0, 0.0)
+        chains = []
+        for s, t in ((1.0, t1), (-1.0, t2)):
+            c = np.array([s * (m + l1 * math.cos(t)), 0.0, e - l1 * math.sin(t)])
+            d = np.array([x + s * n, y, z])
+            axis_t = np.cross(yhat, d - c)
+            chains.append(chain_screws([
+                Joint("Pa", axes=((-s * math.sin(t), 0.0, -math.cos(t)),)),
+                Joint("U", c, (yhat, axis_t)),
+                Joint("U", d, (axis_t, yhat)),
+            ]))
+        cos_phi = min(1.0, max(-1.0, x / (design["l1"] + design["l2"])))
+        sin_phi = math.sqrt(1.0 - cos_phi * cos_phi)
+        chains.append(chain_screws([
+            Joint("P", axes=(yhat,)),
+            Joint("Pa", axes=((-sin_phi, 0.0, cos_phi),)),
+            Joint("P", axes=((0.0, 0.0, 1.0),)),
+        ]))
+        return chains
+
     # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
         """Frame model (scalesynth.stiffness.FrameModel, spatial, m, N) at P = (x, y, z) in the working mode
@@ -679,61 +734,6 @@ class PauuPpap(Mechanism):
                  f"{options['mode']}"]
         return fb.model("m", bodies, options["load"], notes)
 
-    # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
-    def topology(self, design, options):
-        """Joint list of paper §1 for the G-K counts, each parallelogram Pa counted as one 1-DOF joint:
-        chains PaUU, PaUU and PPaP; n = 8 (base, platform, two links per chain), g = 9, sum f = 13. The
-        classical count 6(8 - 9 - 1) + 13 = 1 misses nu = 2 redundant constraints: each PaUU chain exerts
-        one couple and PPaP three, and together they span only the three couples: the modified count is 3."""
-        from scalesynth.mobility import Topology
-
-        return Topology(
-            n_links=8,
-            chains=(("PaUU-1", ("Pa", "U", "U")), ("PaUU-2", ("Pa", "U", "U")), ("PPaP", ("P", "Pa", "P"))),
-            redundant=2,
-            note="the paper (§1.2, POC sets) counts F = sum f - sum xi_L = 13 - (6 + 4) = 3; as a modified "
-            "G-K count the chains' 1 + 1 + 3 constraint couples span 3: nu = 2",
-        )
-
-    def joint_screws(self, design, options, pose, q):
-        """Unit joint screws (omega; v) per chain at pose P = (x, y, z) with inputs q = (theta1, theta2, d),
-        in the fixed frame of spec §1.1 (design length units).
-
-        PaUU_i: the parallelogram's moving link translates along dC_i/dtheta_i, direction
-        (-s_i sin theta_i, 0, -cos theta_i); the U at C_i turns about y (parallel to the parallelogram's axes)
-        then about t_i = y x w_i / |y x w_i| (w_i = D_i - C_i: t_i is normal to the link), the U at D_i about
-        t_i then y, so the chain's one constraint is a couple along the xz-projection of w_i.
-
-        PPaP: the paper gives no dimensions, only three translations in different directions (its eq. 4);
-        taken as the stroke d along y, a parallelogram in the xz-plane with long links L = l1 + l2 pivoted at
-        x = 0 (so every |x| of the workspace is reachable; its moving link translates along
-        (-sin phi, 0, cos phi), cos phi = x / L) and a slide along z."""
-        from scalesynth.mobility import Joint, chain_screws
-
-        x, y, z = self.check_vector("pose", pose, 3)
-        t1, t2, _ = self.check_vector("inputs", q, 3)
-        m, n, l1 = design["m"], design["n"], design["l1"]
-        e = self.offset_e(design, options)
-        yhat = (0.0, 1.0, 0.0)
-        chains = []
-        for s, t in ((1.0, t1), (-1.0, t2)):
-            c = np.array([s * (m + l1 * math.cos(t)), 0.0, e - l1 * math.sin(t)])
-            d = np.array([x + s * n, y, z])
-            axis_t = np.cross(yhat, d - c)
-            chains.append(chain_screws([
-                Joint("Pa", axes=((-s * math.sin(t), 0.0, -math.cos(t)),)),
-                Joint("U", c, (yhat, axis_t)),
-                Joint("U", d, (axis_t, yhat)),
-            ]))
-        cos_phi = min(1.0, max(-1.0, x / (design["l1"] + design["l2"])))
-        sin_phi = math.sqrt(1.0 - cos_phi * cos_phi)
-        chains.append(chain_screws([
-            Joint("P", axes=(yhat,)),
-            Joint("Pa", axes=((-sin_phi, 0.0, cos_phi),)),
-            Joint("P", axes=((0.0, 0.0, 1.0),)),
-        ]))
-        return chains
-
 
 MECHANISM = PauuPpap(
     name="2pauu-ppap",
@@ -758,13 +758,13 @@ MECHANISM = PauuPpap(
         Option("theta2_limits", None, "[lo, hi] rad for theta2 (convention T), null = none"),
         Option("stroke_limits", None, "[lo, hi] for the stroke d = y, null = none"),
         Option("z_min", None, "keep only z >= z_min, null = none"),
-        Option("link_radius", None, "capsule radius of every body, or {body: radius}; null = defaults base 0.05, "
-               "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative)"),
         *stiffness_options("m", ACTUATOR_STIFFNESS, "torsional stiffness of each parallelogram actuator theta1, "
                            "theta2, N m/rad (an assumption)", [0.0, 0.0, -150.0],
                            "default 150 N along -z, the gravity direction (z up), at P"),
         Option("stroke_stiffness", STROKE_STIFFNESS, "stiffness: axial stiffness of the PPaP chain's linear actuator "
                "d, N/m (2e4 N/mm, an assumption)"),
+        Option("link_radius", None, "capsule radius of every body, or {body: radius}; null = defaults base 0.05, "
+               "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative)"),
     ),
     default_length_unit="m",
     fields=base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is dimensionless; "

@@ -565,6 +565,7 @@ class RpsUpu(Mechanism):
             raise InvalidParameter(f"options.model: must be 'P' or 'C', got {options['model']!r}")
         if options["c3_variant"] not in C3_VARIANTS:
             raise InvalidParameter(f"options.c3_variant: must be 'plane' or 'upu', got {options['c3_variant']!r}")
+        check_stiffness_options(options, 3, LINK_GROUPS)
         self._check_limits(options)
         length = options["characteristic_length"]
         if length is not None:
@@ -574,7 +575,6 @@ class RpsUpu(Mechanism):
                 raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
             options["characteristic_length"] = float(length)
         links.check_radius_option(options, LINK_RADII)
-        check_stiffness_options(options, 3, LINK_GROUPS)
 
     @staticmethod
     def _check_limits(options: dict[str, Any]) -> None:
@@ -768,6 +768,54 @@ class RpsUpu(Mechanism):
             return np.full((3, 3), np.inf)
         return jac["dq_dx"]
 
+    # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
+    def topology(self, design, options):
+        """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
+        g = 9, sum f = 15, classical G-K 6(8 - 9 - 1) + 15 = 3 with no redundant constraint."""
+        from scalesynth.mobility import Topology
+
+        return Topology(
+            n_links=8,
+            chains=(("RPS-1", ("R", "P", "S")), ("RPS-2", ("R", "P", "S")), ("UPU", ("U", "P", "U"))),
+            note="spec §2.2 (paper): classical G-K; three coplanar constraint forces. Joint screws at the "
+            "C-model placement of the pose (the P-model violates the RPS joint constraints, spec §2.3)",
+        )
+
+    def joint_screws(self, design, options, pose, q=None):
+        """Joint screws (omega; v) per chain at pose (z, theta, psi), fixed frame O-xyz of spec §2.1 (mm);
+        ``q`` is not needed (the legs follow from the pose).
+
+        The P-model violates the RPS joint constraints (spec §2.3: B1, B2 leave the plane x = 0), so the
+        joints are placed at the constraint-consistent C-model pose with the same (z, theta, psi) and the
+        configured chain-3 variant. RPS_i: revolute about x through A_i, prismatic along A_i -> B_i, S at B_i.
+        UPU, variant 'upu': U at A3 about x and then the middle axis m = x x w, prismatic along the leg, U at
+        B3 about m and then the platform axis w = R z. Variant 'plane' (B3 held in y = 0, spec §2.3) has no
+        stated joint axes: its chain enters as the five twists reciprocal to its constraint force along y
+        through B3 (a revolute about y through A3, the leg prismatic, S at B3)."""
+        from scalesynth.mobility import Joint, chain_screws
+
+        x = self.check_vector("pose", pose, 3)
+        g, h, c, e = self._geom(design)
+        variant = options.get("c3_variant", "plane")
+        # RpsUpu's own platform_pose: a subclass (the tool workspace) pins its override to the P-model
+        plat = RpsUpu.platform_pose(self, design, {**options, "model": "C", "c3_variant": variant}, x)
+        rot, p = plat["R"], plat["p"]
+        base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
+        xhat = np.array([1.0, 0.0, 0.0])
+        chains = []
+        for i in (0, 1):
+            leg_i = Joint("P", axes=(top[i] - base[i],))
+            chains.append(chain_screws([Joint("R", base[i], (xhat,)), leg_i, Joint("S", top[i])]))
+        leg = Joint("P", axes=(top[2] - base[2],))
+        if variant == "upu":
+            w = rot[:, 2]
+            m = np.cross(xhat, w)
+            chains.append(chain_screws([Joint("U", base[2], (xhat, m)), leg, Joint("U", top[2], (m, w))]))
+        else:
+            chains.append(chain_screws([Joint("R", base[2], ((0.0, 1.0, 0.0),)), leg, Joint("S", top[2])]))
+        return chains
+
     # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
     def _in_box(self, options, x) -> bool:
         return all(options[name][0] <= v <= options[name][1]
@@ -842,54 +890,6 @@ class RpsUpu(Mechanism):
                          "placement")
         return fb.model("mm", bodies, options["load"], notes)
 
-    # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
-    def topology(self, design, options):
-        """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
-        g = 9, sum f = 15, classical G-K 6(8 - 9 - 1) + 15 = 3 with no redundant constraint."""
-        from scalesynth.mobility import Topology
-
-        return Topology(
-            n_links=8,
-            chains=(("RPS-1", ("R", "P", "S")), ("RPS-2", ("R", "P", "S")), ("UPU", ("U", "P", "U"))),
-            note="spec §2.2 (paper): classical G-K; three coplanar constraint forces. Joint screws at the "
-            "C-model placement of the pose (the P-model violates the RPS joint constraints, spec §2.3)",
-        )
-
-    def joint_screws(self, design, options, pose, q=None):
-        """Joint screws (omega; v) per chain at pose (z, theta, psi), fixed frame O-xyz of spec §2.1 (mm);
-        ``q`` is not needed (the legs follow from the pose).
-
-        The P-model violates the RPS joint constraints (spec §2.3: B1, B2 leave the plane x = 0), so the
-        joints are placed at the constraint-consistent C-model pose with the same (z, theta, psi) and the
-        configured chain-3 variant. RPS_i: revolute about x through A_i, prismatic along A_i -> B_i, S at B_i.
-        UPU, variant 'upu': U at A3 about x and then the middle axis m = x x w, prismatic along the leg, U at
-        B3 about m and then the platform axis w = R z. Variant 'plane' (B3 held in y = 0, spec §2.3) has no
-        stated joint axes: its chain enters as the five twists reciprocal to its constraint force along y
-        through B3 (a revolute about y through A3, the leg prismatic, S at B3)."""
-        from scalesynth.mobility import Joint, chain_screws
-
-        x = self.check_vector("pose", pose, 3)
-        g, h, c, e = self._geom(design)
-        variant = options.get("c3_variant", "plane")
-        # RpsUpu's own platform_pose: a subclass (the tool workspace) pins its override to the P-model
-        plat = RpsUpu.platform_pose(self, design, {**options, "model": "C", "c3_variant": variant}, x)
-        rot, p = plat["R"], plat["p"]
-        base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
-        top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
-        xhat = np.array([1.0, 0.0, 0.0])
-        chains = []
-        for i in (0, 1):
-            leg_i = Joint("P", axes=(top[i] - base[i],))
-            chains.append(chain_screws([Joint("R", base[i], (xhat,)), leg_i, Joint("S", top[i])]))
-        leg = Joint("P", axes=(top[2] - base[2],))
-        if variant == "upu":
-            w = rot[:, 2]
-            m = np.cross(xhat, w)
-            chains.append(chain_screws([Joint("U", base[2], (xhat, m)), leg, Joint("U", top[2], (m, w))]))
-        else:
-            chains.append(chain_screws([Joint("R", base[2], ((0.0, 1.0, 0.0),)), leg, Joint("S", top[2])]))
-        return chains
-
 
 DESIGN_METRICS = (
     DesignMetric(
@@ -930,9 +930,9 @@ MECHANISM = RpsUpu(
         Option("theta_range", [-0.314, 0.314], "workspace box in theta (rad), the paper's"),
         Option("psi_range", [-0.314, 0.314], "workspace box in psi (rad), the paper's"),
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
+        *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6 (illustrative)"),
-        *STIFFNESS_OPTIONS,
     ),
     default_length_unit="mm",
     fields=FIELDS,
@@ -1036,12 +1036,12 @@ class RpsUpuTool(RpsUpu):
 
     def check_options(self, options: dict[str, Any]) -> None:
         self._check_limits(options)
+        check_stiffness_options(options, 3, LINK_GROUPS)
         d = options["tool_offset"]
         if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) or d <= 0:
             raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
         options["tool_offset"] = float(d)
         links.check_radius_option(options, TOOL_RADII)
-        check_stiffness_options(options, 3, LINK_GROUPS)
 
     @staticmethod
     def _p(options: Mapping[str, Any]) -> dict[str, Any]:
@@ -1247,9 +1247,9 @@ TOOL_MECHANISM = RpsUpuTool(
     options=(
         Option("tool_offset", 50.0, "d (mm): T = O' + R (0, 0, -d); illustrative default, the paper has no tool"),
         *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
+        *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6, tool 4 (illustrative)"),
-        *STIFFNESS_OPTIONS,
     ),
     default_length_unit="mm",
     fields=base_fields("1", "J = dT/dq of the tool point (mm/mm)"),
