@@ -106,7 +106,7 @@ class ColumnPlan:
 
 # per task dimension, and per mechanism where its workspaces need more (chosen with
 # `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid)
-ADAPTIVE_PLAN = {2: ColumnPlan(48, 32, 8, 5), 3: ColumnPlan(24, 8, 6, 3)}
+ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6), 3: ColumnPlan(24, 8, 6, 3)}
 ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {}
 
 
