@@ -136,9 +136,17 @@ def bench_mechanism(name: str) -> dict:
     twin = TWINS[name]
     ndim = len(mech.task_axes)
     t0 = time.perf_counter()
+    def twin_fields(pts, d):
+        """The NumPy field twins' fields, zero-padded to the mechanism's slots where they compute fewer (the
+        clearance field has no NumPy twin here): a timing twin, not a check."""
+        if len(pts) == 0:
+            return np.zeros((0, mech.n_fields))
+        out = np.asarray(twin(d, options, pts[:, 0], pts[:, 1], pts[:, 2])).reshape(len(pts), -1)
+        return np.pad(out, ((0, 0), (0, mech.n_fields - out.shape[1])))
+
     for d in designs[:2]:
         g = make_grid(mech, d, options, 1, region)
-        naive.column_stats(lambda pts, d=d: twin(d, options, pts[:, 0], pts[:, 1], pts[:, 2]), mech.n_fields,
+        naive.column_stats(lambda pts, d=d: twin_fields(pts, d), mech.n_fields,
                            g.lo, g.lo + g.step * g.shape, ndim, plan.columns, plan.cells, plan.bisections,
                            plan.levels, tol.volume, tol.gci, edges)
     twin_sec = (time.perf_counter() - t0) / 2
@@ -213,9 +221,9 @@ CONDITIONS = ("Conditions: measured with NUMBA_NUM_THREADS=1 while the 2-core ma
 
 def markdown(data: dict) -> list[str]:
     """RESULTS.md sections of the stored issue-15 parts."""
-    out: list[str] = [CONDITIONS, ""]
+    out: list[str] = []
     if "compile_all" in data:
-        out += ["### Compile once (fresh processes, empty Numba cache, then the same cache)", "",
+        out += [CONDITIONS, "", "### Compile once (fresh processes, empty Numba cache, then the same cache)", "",
                 "Wall seconds from the loaded config to the first evaluated design (CPU seconds of the process in "
                 "brackets: on a shared machine the wall time includes waiting for a core), and the imports before.",
                 "", "| mechanism | first process (empty cache) | second process (cache) | second process: imports |",
@@ -229,7 +237,10 @@ def markdown(data: dict) -> list[str]:
                        f"{r['second_import_s']:.2f} s |")
         out.append("")
     if "adaptive" in data:
-        out += ["Algorithm (docs/config.md, grid.tolerance): columns along the last task axis; per column the "
+        out += ["Conditions: NUMBA_NUM_THREADS=1 on the 2-core machine shared with other jobs (the load average of "
+                "each mechanism's run is given with it), so absolute times are several times those of an idle "
+                "machine; compare the ratios, which come from one run.", "",
+                "Algorithm (docs/config.md, grid.tolerance): columns along the last task axis; per column the "
                 "reachable intervals from m + 1 nodes plus bisection, the fields by a 2-point Gauss rule on each "
                 "piece; the column grid refined (3 x 3) where the column measures curve; error estimate = change "
                 "from the previous level. Errors are against the uniform reference on every design, and in "

@@ -457,6 +457,11 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     hy = (hi[1] - lo[1]) / n if ndim == 3 else 1.0
     gx = 1.0 / np.sqrt(3.0)
     evals = 0
+    nb = len(edges) - 1
+    if not (hz > 0 and hx > 0 and hy > 0):  # an empty box: nothing reachable
+        row = np.zeros(1 + 4 * n_fields + nb)
+        row[3:1 + 4 * n_fields:4], row[4:1 + 4 * n_fields:4] = np.inf, -np.inf
+        return row, 0.0, 0.0, 0, 0
 
     def pts(xx, yy, zz):
         return np.c_[xx, yy, zz] if ndim == 3 else np.c_[xx, zz, np.full(zz.shape, lo[2])]
@@ -537,7 +542,6 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     v, wt = np.concatenate(kept_v), np.concatenate(kept_w)
     keep = wt > 0
     v, wt = v[keep], wt[keep]
-    nb = len(edges) - 1
     row = np.zeros(1 + 4 * n_fields + nb)
     row[0] = wt.sum()
     for f in range(n_fields):

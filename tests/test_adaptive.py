@@ -111,6 +111,25 @@ def test_adaptive_empty_workspace_is_zero_not_nan():
     assert out["error_volume"][0] == 0.0 and out["error_gci"][0] == 0.0
 
 
+def test_adaptive_zero_size_box_is_an_empty_workspace():
+    """A five-bar whose arms cannot meet (l1 + l2 < r) has a zero-size bounding box: kernel and twin give an empty
+    row (count 0) without dividing by the zero cell size, and the metrics are 0."""
+    mech = get("planar-fivebar")
+    cfg = load_config(config_for("planar-fivebar"))
+    options = cfg.resolved_options()
+    design = mech.resolve_design({**cfg.resolved_design(), "r": 400.0, "l1": 100.0, "l2": 100.0})
+    lo, hi = _box(mech, design, options)
+    assert np.all(lo[:2] == hi[:2])
+    packed = mech.pack(design, options)[None, :]
+    s, ev, eg, lv, ne = column_stats(mech.field_kernel, mech.n_fields, packed, lo[None], hi[None], 2, 8, 8, 4, 2,
+                                     0.002, 5e-4, EDGES)
+    row, *_ = column_twin(lambda pts: None, mech.n_fields, lo, hi, 2, 8, 8, 4, 2, 0.002, 5e-4, EDGES)
+    assert s[0, 0] == 0.0 and ne[0] == 0.0 and ev[0] == 0.0 and eg[0] == 0.0
+    np.testing.assert_array_equal(s[0], row)
+    out = evaluate_population(mech, [design], options, tolerance=Tolerance())
+    assert out[mech.measure_key(mech.default_length_unit)][0] == 0.0 and out["gci"][0] == 0.0
+
+
 def test_plan_levels_refine_and_the_estimate_tracks_the_change():
     """With more levels allowed and a tolerance that cannot be met, the evaluator refines to the last level; the
     error estimate it reports is the change of the measure between the last two levels."""

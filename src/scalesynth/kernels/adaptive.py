@@ -132,6 +132,9 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, 
     hx = (hi_d[0] - lo_d[0]) / n
     hy = (hi_d[1] - lo_d[1]) / n if ndim == 3 else 1.0
     zfix = lo_d[2]
+    info[:] = 0.0
+    if not (hz > 0.0 and hx > 0.0 and hy > 0.0):
+        return  # an empty box (a degenerate design's bounding box): nothing reachable
     cell = np.empty(n_fields)
     nodes = np.empty((m + 1, n_fields))
     buf = np.empty((n_fields, 2 * m))
