@@ -2,6 +2,10 @@
 same algorithm level by level), the seed-000 volume against the exact quadrature, determinism, degenerate designs
 and the config form."""
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import yaml
@@ -168,3 +172,31 @@ def test_tolerance_config_and_resolution_override():
     data["grid"] = {"tolerance": {"volume": -1.0}}
     with pytest.raises(ConfigError, match="grid.tolerance.volume"):
         config_from_dict(data)
+
+
+_THREADS_PROBE = """
+import sys
+import numpy as np
+from scalesynth.config import load_config
+from scalesynth.evaluate import Tolerance, adaptive_population_stats
+cfg = load_config(sys.argv[1])
+mech, options = cfg.mech, cfg.resolved_options()
+base = cfg.resolved_design()
+k0 = list(base)[0]
+designs = [{**base, k0: base[k0] * f} for f in (1.0, 1.05, 0.95, 1.1)]
+packed = np.stack([mech.pack(d, options) for d in designs])
+r = adaptive_population_stats(mech, designs, options, packed, Tolerance(), np.array([0.0, 0.1, 0.3, 1.0]))
+sys.stdout.write(r.stats.tobytes().hex())
+"""
+
+
+def test_adaptive_rows_do_not_depend_on_the_thread_count():
+    """The same population evaluated with 1 and with 2 Numba threads (fresh processes, shared disk cache) gives
+    byte-identical statistics rows."""
+    out = []
+    for threads in ("1", "2"):
+        env = dict(os.environ, NUMBA_NUM_THREADS=threads)
+        res = subprocess.run([sys.executable, "-c", _THREADS_PROBE, str(config_for("rps-upu"))], env=env,
+                             capture_output=True, text=True, timeout=600, check=True)
+        out.append(res.stdout)
+    assert out[0] and out[0] == out[1]
