@@ -148,7 +148,7 @@ def bench_mechanism(name: str) -> dict:
         g = make_grid(mech, d, options, 1, region)
         naive.column_stats(lambda pts, d=d: twin_fields(pts, d), mech.n_fields,
                            g.lo, g.lo + g.step * g.shape, ndim, plan.columns, plan.cells, plan.bisections,
-                           plan.levels, tol.volume, tol.gci, edges)
+                           plan.levels, tol.volume, tol.gci, edges, plan.beta)
     twin_sec = (time.perf_counter() - t0) / 2
     t0 = time.perf_counter()
     adaptive_population_stats(mech, designs[:2], options, packed[:2], tol, edges, region)
@@ -157,7 +157,8 @@ def bench_mechanism(name: str) -> dict:
         "mechanism": name, "config": CONFIGS[name], "tolerance": {"volume": tol.volume, "gci": tol.gci},
         "designs": len(designs), "slivers": int((~solid).sum()), "reference_N": n_ref, "ndim": ndim,
         "reference_s_per_design": ref_sec,
-        "plan": {"columns": plan.columns, "cells": plan.cells, "bisections": plan.bisections, "levels": plan.levels},
+        "plan": {"columns": plan.columns, "cells": plan.cells, "bisections": plan.bisections, "levels": plan.levels,
+                 "beta": plan.beta},
         "adaptive": {"s_per_design": ad_sec, "volume_error": ad_ev, "gci_error": ad_eg,
                      "volume_error_solid": ad_sv, "gci_error_solid": ad_sg,
                      "designs_within_tolerance": int(within.sum()),
@@ -278,7 +279,8 @@ def markdown(data: dict) -> list[str]:
                     f"{m['designs']} random designs in the bounds ({m['slivers']} slivers); reference: uniform "
                     f"N = {m['reference_N']} (3x the old resolution {m['old_resolution']}); tolerance volume "
                     f"{100 * tol['volume']:.2g} %, GCI {tol['gci']:.1e}; plan: {pl['columns']} columns per cross "
-                    f"axis, {pl['cells']} z-cells, {pl['bisections']} bisections, up to {pl['levels']} levels. "
+                    f"axis, {pl['cells']} z-cells, {pl['bisections']} bisections, up to {pl['levels']} levels, beta "
+                    f"{pl.get('beta', 1.0):g}. "
                     f"Load average (1 min, 2 cores) {m['load_average'][0]:.1f} before, {m['load_average'][1]:.1f} "
                     "after.", "",
                     "| evaluator | ms/design | max volume error | max GCI error | error estimate (max) | "

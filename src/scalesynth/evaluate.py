@@ -92,12 +92,14 @@ class Tolerance:
 class ColumnPlan:
     """Resolution of the adaptive (column) evaluator (kernels.adaptive): coarse columns per cross axis, z-cells
     per column, bisection steps per boundary crossing, most refinement levels (each triples the columns per cross
-    axis where the column measures curve)."""
+    axis where the column measures curve), and the share of the tolerance one coarse column's error indicator may
+    take before it is refined (larger: fewer refined columns)."""
 
     columns: int
     cells: int
     bisections: int
     levels: int
+    beta: float = 1.0
 
     def coarse_cells(self, ndim: int) -> int:
         """Cells of the coarse grid (the unit of the statistics rows' counts)."""
@@ -107,8 +109,8 @@ class ColumnPlan:
 # per task dimension, and per mechanism where its workspaces need less (chosen with
 # `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid on 20 random
 # designs): planar workspaces have parts thinner than 1/64 of the box along y; ups-sspr's are smooth and simple
-ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6), 3: ColumnPlan(24, 8, 6, 3)}
-ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {"ups-sspr": ColumnPlan(8, 6, 5, 3)}
+ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6), 3: ColumnPlan(24, 8, 5, 3, beta=3.0)}
+ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {"ups-sspr": ColumnPlan(8, 6, 5, 3, beta=3.0)}
 
 
 def adaptive_plan(mech: Mechanism) -> ColumnPlan:
@@ -157,7 +159,7 @@ def adaptive_population_stats(
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
     stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
                                                       plan.columns, plan.cells, plan.bisections, plan.levels,
-                                                      tolerance.volume, tolerance.gci, edges)
+                                                      tolerance.volume, tolerance.gci, edges, plan.beta)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 

@@ -47,7 +47,6 @@ GAUSS_X = 1.0 / math.sqrt(3.0)  # 2-point Gauss-Legendre abscissa on [-1, 1] (we
 # themselves, and reachability exactly on a limit depends on rounding (fused multiply-adds differ between two
 # compilations of the same field kernel)
 END_NUDGE = 2.0**-20
-BETA = 1.0  # share of the tolerance one coarse cell's indicator may take before it is refined
 
 
 @njit(cache=True)
@@ -118,7 +117,7 @@ def refine_grid(g, ndim):
     return out
 
 
-def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, row, info):
+def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges, row, info):
     """Template (serial): statistics row of one design into ``row``; info: error_volume, error_gci, level,
     evaluations."""
     n_fields = N_FIELDS
@@ -256,8 +255,8 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, 
         flags = np.zeros(n_active, dtype=np.bool_)
         if not stop:
             ncell0 = n * ny
-            flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * BETA / ncell0,
-                         tol_g * vol * BETA / ncell0, flags)
+            flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
+                         tol_g * vol * beta / ncell0, flags)
         n_flag = 0
         for a in range(n_active):
             if flags[a]:
@@ -290,22 +289,25 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, 
     info[3] = evals
 
 
-def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges):
+def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges):
     """Template (parallel over designs): FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel."""
     n_designs = params.shape[0]
     stats = np.zeros((n_designs, 1 + 4 * N_FIELDS + edges.shape[0] - 1))
     info = np.zeros((n_designs, 4))
     for d in prange(n_designs):
-        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, stats[d], info[d])
+        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges, stats[d],
+                     info[d])
     return stats, info
 
 
-def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges):
+def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
+                 beta=1.0):
     """Statistics rows of every design by the column algorithm (module docstring).
 
     params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
     per cross axis; m: z-cells per column; nbis: bisection steps per boundary crossing; maxlev: most refinement
-    levels; tol_v, tol_g: relative measure and absolute GCI tolerance; edges: band edges. Returns (stats (d,
+    levels; tol_v, tol_g: relative measure and absolute GCI tolerance; edges: band edges; beta: share of the
+    tolerance one coarse column's error indicator may take before it is refined. Returns (stats (d,
     stat_columns), error_volume (d,), error_gci (d,), levels (d,) int64, evaluations (d,)): counts in units of the
     coarse cell (hx hy hz with hx = (hi - lo)[0] / n, ...; planar hx hz).
     """
@@ -313,5 +315,5 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
     stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),
                       np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), int(m), int(nbis), int(maxlev),
-                      float(tol_v), float(tol_g), np.ascontiguousarray(edges, dtype=float))
+                      float(tol_v), float(tol_g), float(beta), np.ascontiguousarray(edges, dtype=float))
     return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()
