@@ -21,7 +21,8 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    the new columns, with the others held at their coarser values.
 4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
    (absolute) from level l-1; the design stops at the first level whose estimate meets the tolerance, or at
-   ``maxlev``, or when no column is flagged (estimate 0 then: the midpoint rule sees no curvature).
+   ``maxlev``, or when no column is flagged for refinement (the estimate is then the last change, reported as
+   it is even when above the tolerance; 0 if that happens at level 0: the midpoint rule sees no curvature).
 
 Counts are in units of the coarse cell (cross cell x hz): measure = count x hx hy hz. Parallel over designs, each
 design serial with a fixed order of columns: deterministic whatever the thread count.
