@@ -441,80 +441,112 @@ def rps_upu_tool_fields(design, options, x, y, z):
     return out.reshape(x.shape + (3,))
 
 
-def adaptive_stats(fields, n_fields, lo, step, shape, edges, ndim, levels, tau):
-    """NumPy twin of kernels.adaptive.adaptive_stats for one design, level by level (breadth first) instead of
-    depth first: ``fields(points (m, 3)) -> (m, n_fields)`` (field 0 LCI, -1 unreachable); lo, step: origin and
-    edge of the coarse cells; shape: coarse cells per axis. Returns (stats row, row one level coarser,
-    evaluations), the row in the layout of kernels.grid (counts in coarse-cell units)."""
-    lo, step = np.asarray(lo, float), np.asarray(step, float)
-    n = [int(shape[a]) if a < ndim else 0 for a in range(3)]
-    axes = [lo[a] + np.arange(n[a] + 1) * step[a] for a in range(3)]
-    X, Y, Z = np.meshgrid(*axes, indexing="ij")
-    lat = fields(np.c_[X.ravel(), Y.ravel(), Z.ravel()]).reshape(n[0] + 1, n[1] + 1, n[2] + 1, n_fields)
-    evals = lat.shape[0] * lat.shape[1] * lat.shape[2]
-    nc = 1 << ndim
-    bits = np.array([[(c >> a) & 1 if a < ndim else 0 for a in range(3)] for c in range(nc)])
-    ii, jj, kk = np.meshgrid(*[np.arange(max(n[a], 1)) for a in range(3)], indexing="ij")
-    cells = np.c_[ii.ravel(), jj.ravel(), kk.ravel()]  # (i, j, k) order, as the kernel visits them
-    corners = np.stack([lat[cells[:, 0] + b[0], cells[:, 1] + b[1], cells[:, 2] + b[2]] for b in bits], axis=1)
-    origin = lo + cells * step
-
-    def mixed_of(c):
-        n_in = (c[:, :, 0] >= 0).sum(axis=1)
-        return (n_in > 0) & (n_in < nc)
-
-    # coarse cells next to a boundary cell (3^ndim neighbourhood inside the grid) are forced
-    m = mixed_of(corners).reshape(max(n[0], 1), max(n[1], 1), max(n[2], 1))
-    pad = np.pad(m, 1)
-    forced = np.zeros_like(m)
-    for da in (-1, 0, 1):
-        for db in (-1, 0, 1):
-            for dc in ((-1, 0, 1) if ndim == 3 else (0,)):
-                forced |= pad[1 + da:pad.shape[0] - 1 + da, 1 + db:pad.shape[1] - 1 + db,
-                              1 + dc:pad.shape[2] - 1 + dc]
-    forced = forced.ravel()
-    leaves = ([], [])  # (corner values, weights) of the leaves, for the result and for the coarser result
-    sub_idx = np.array([[a, b, c] for c in range(3 if ndim == 3 else 1) for b in range(3) for a in range(3)])
-    for level in range(levels + 1):
-        w = 1.0 / (1 << (ndim * level))
-        lci = corners[:, :, 0]
-        n_in = (lci >= 0).sum(axis=1)
-        rng = lci.max(axis=1) - lci.min(axis=1)
-        refine = (level < levels) & (forced | ((n_in > 0) & ((n_in < nc) | (rng > tau))))
-        leaf = ~refine
-        for target in ((0, 1) if level <= levels - 1 or levels == 0 else (0,)):
-            leaves[target].append((corners[leaf].reshape(-1, n_fields), np.full(leaf.sum() * nc, w / nc)))
-        if level == levels - 1:
-            leaves[1].append((corners[refine].reshape(-1, n_fields), np.full(refine.sum() * nc, w / nc)))
-        if not refine.any():
-            break
-        c_r, o_r = corners[refine], origin[refine]
-        h = 0.5 / (1 << level) * step
-        pts = o_r[:, None, :] + sub_idx[None, :, :] * h
-        is_corner = np.all(sub_idx != 1, axis=1)
-        sub = np.empty((c_r.shape[0], sub_idx.shape[0], n_fields))
-        src = (sub_idx[is_corner] >> 1) @ np.array([1, 2, 4])
-        sub[:, is_corner] = c_r[:, src]
-        sub[:, ~is_corner] = fields(pts[:, ~is_corner].reshape(-1, 3)).reshape(c_r.shape[0], -1, n_fields)
-        evals += c_r.shape[0] * int((~is_corner).sum())
-        child_bits = bits
-        s_of = ((child_bits[:, None, :] + bits[None, :, :]) @ np.array([1, 3, 9]))  # (child, corner) -> sub index
-        corners = sub[:, s_of].reshape(-1, nc, n_fields)
-        origin = (o_r[:, None, :] + child_bits[None, :, :] * h).reshape(-1, 3)
-        forced = np.repeat(mixed_of(corners).reshape(-1, nc).any(axis=1), nc)
-    rows = []
+def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, beta=1.0):
+    """NumPy twin of kernels.adaptive.column_stats for one design, vectorised over the active columns of a level:
+    ``fields(points (k, 3)) -> (k, n_fields)`` (field 0 LCI, -1 unreachable); lo, hi: the design's box (3,).
+    Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
+    level, evaluations)."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    ca = ndim - 1
+    zlo = lo[ca]
+    hz = (hi[ca] - zlo) / m
+    zn = zlo + np.arange(m + 1) * hz
+    nudge = 2.0**-20  # kernels.adaptive.END_NUDGE: the end nodes are evaluated just inside the box
+    z_eval = zlo + np.r_[nudge, np.arange(1, m), m - nudge] * hz
+    hx = (hi[0] - lo[0]) / n
+    hy = (hi[1] - lo[1]) / n if ndim == 3 else 1.0
+    gx = 1.0 / np.sqrt(3.0)
+    evals = 0
     nb = len(edges) - 1
-    for target in (0, 1):
-        v = np.concatenate([a for a, _ in leaves[target]])
-        wt = np.concatenate([b for _, b in leaves[target]])
-        keep = v[:, 0] >= 0
-        v, wt = v[keep], wt[keep]
+    if not (hz > 0 and hx > 0 and hy > 0):  # an empty box: nothing reachable
         row = np.zeros(1 + 4 * n_fields + nb)
-        row[0] = wt.sum()
-        for f in range(n_fields):
-            row[1 + 4 * f: 5 + 4 * f] = [(wt * v[:, f]).sum(), (wt * v[:, f] ** 2).sum(),
-                                         v[:, f].min() if len(v) else np.inf, v[:, f].max() if len(v) else -np.inf]
-        band = np.searchsorted(np.asarray(edges)[1:-1], v[:, 0], side="left")
-        row[1 + 4 * n_fields:] = np.bincount(band, weights=wt, minlength=nb)
-        rows.append(row)
-    return rows[0], rows[1], evals
+        row[3:1 + 4 * n_fields:4], row[4:1 + 4 * n_fields:4] = np.inf, -np.inf
+        return row, 0.0, 0.0, 0, 0
+
+    def pts(xx, yy, zz):
+        return np.c_[xx, yy, zz] if ndim == 3 else np.c_[xx, zz, np.full(zz.shape, lo[2])]
+
+    def columns(X, Y, area):
+        """Column measure L, LCI sum S (z in units of hz) and the Gauss points (fields, weights x area) of each."""
+        nonlocal evals
+        nc = X.size
+        lci = fields(pts(np.repeat(X, m + 1), np.repeat(Y, m + 1), np.tile(z_eval, nc)))[:, 0].reshape(nc, m + 1)
+        evals += nc * (m + 1)
+        r = lci >= 0
+        ci, ck = np.nonzero(r[:, :-1] != r[:, 1:])
+        a, b, ra = zn[ck], zn[ck + 1], r[ci, ck]
+        for _ in range(nbis):
+            mid = 0.5 * (a + b)
+            same = (fields(pts(X[ci], Y[ci], mid))[:, 0] >= 0) == ra
+            evals += mid.size
+            a, b = np.where(same, mid, a), np.where(same, b, mid)
+        cross = 0.5 * (a + b)
+        full = r[:, :-1] & r[:, 1:]
+        za = np.where(full, zn[None, :-1], np.nan)
+        zb = np.where(full, zn[None, 1:], np.nan)
+        za[ci, ck] = np.where(ra, zn[ck], cross)
+        zb[ci, ck] = np.where(ra, cross, zn[ck + 1])
+        pc, pk = np.nonzero(~np.isnan(za))
+        za, zb = za[pc, pk], zb[pc, pk]
+        half, mid = 0.5 * (zb - za), 0.5 * (za + zb)
+        zq = np.c_[mid - half * gx, mid + half * gx].ravel()
+        q = fields(pts(np.repeat(X[pc], 2), np.repeat(Y[pc], 2), zq)).reshape(-1, 2, n_fields)
+        evals += zq.size
+        ok = q[:, :, 0] >= 0
+        w = np.where(ok, np.where(ok.sum(axis=1) == 2, half, 2 * half)[:, None] / hz, 0.0)
+        L = np.bincount(pc, weights=w.sum(axis=1), minlength=nc)
+        S = np.bincount(pc, weights=(w * np.where(ok, q[:, :, 0], 0.0)).sum(axis=1), minlength=nc)
+        return L, S, np.repeat(pc, 2), q.reshape(-1, n_fields), w.ravel() * area
+
+    ny = n if ndim == 3 else 1
+    ci, cj = (v.ravel() for v in np.meshgrid(np.arange(n), np.arange(ny), indexing="ij"))
+    lg, sg = np.zeros((n, ny)), np.zeros((n, ny))
+    kept_v, kept_w = [], []
+    prev = None
+    err_v = err_g = 0.0
+    level = 0
+    while True:
+        scale = 3.0 ** level
+        area = 1.0 / scale ** (ndim - 1)
+        X = lo[0] + (ci + 0.5) * hx / scale
+        Y = lo[1] + (cj + 0.5) * hy / scale
+        L, S, owner, qv, qw = columns(X, Y, area)
+        lg[ci, cj], sg[ci, cj] = L, S
+        vol, ssum = lg.sum() * area, sg.sum() * area
+        gci = ssum / vol if vol > 0 else 0.0
+        if prev is not None:
+            err_v = abs(vol - prev[0]) / vol if vol > 0 else (0.0 if prev[0] == 0 else 1.0)
+            err_g = abs(gci - prev[1])
+        prev = (vol, gci)
+        stop = level >= maxlev or (level >= 1 and err_v <= tol_v and err_g <= tol_g)
+        flag = np.zeros(ci.size, dtype=bool)
+        if not stop:  # second differences along each cross axis, neighbours clamped at the box
+            for axis in range(ndim - 1):
+                sh = lg.shape[axis]
+                lo_i = (np.maximum(ci - 1, 0), cj) if axis == 0 else (ci, np.maximum(cj - 1, 0))
+                hi_i = (np.minimum(ci + 1, sh - 1), cj) if axis == 0 else (ci, np.minimum(cj + 1, sh - 1))
+                for g, tol in ((lg, tol_v), (sg, tol_g)):
+                    d2 = np.abs(g[hi_i] + g[lo_i] - 2.0 * g[ci, cj])
+                    flag |= d2 * area / 24.0 > tol * vol * beta / (n * ny)
+        keep = ~flag[owner]
+        kept_v.append(qv[keep])
+        kept_w.append(qw[keep])
+        if stop or not flag.any():
+            break
+        da, db = (v.ravel() for v in np.meshgrid(np.arange(3), np.arange(3 if ndim == 3 else 1), indexing="ij"))
+        ci = (3 * ci[flag][:, None] + da[None, :]).ravel()
+        cj = (3 * cj[flag][:, None] + db[None, :]).ravel() if ndim == 3 else np.zeros(ci.size, dtype=np.int64)
+        lg = np.repeat(np.repeat(lg, 3, axis=0), 3 if ndim == 3 else 1, axis=1)
+        sg = np.repeat(np.repeat(sg, 3, axis=0), 3 if ndim == 3 else 1, axis=1)
+        level += 1
+    v, wt = np.concatenate(kept_v), np.concatenate(kept_w)
+    keep = wt > 0
+    v, wt = v[keep], wt[keep]
+    row = np.zeros(1 + 4 * n_fields + nb)
+    row[0] = wt.sum()
+    for f in range(n_fields):
+        row[1 + 4 * f: 5 + 4 * f] = [(wt * v[:, f]).sum(), (wt * v[:, f] ** 2).sum(),
+                                     v[:, f].min() if len(v) else np.inf, v[:, f].max() if len(v) else -np.inf]
+    band = np.searchsorted(np.asarray(edges)[1:-1], v[:, 0], side="left")
+    row[1 + 4 * n_fields:] = np.bincount(band, weights=wt, minlength=nb)
+    return row, err_v, err_g, level, evals

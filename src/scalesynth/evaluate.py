@@ -88,11 +88,33 @@ class Tolerance:
     gci: float = 5.0e-4
 
 
-# adaptive plan: coarse cells per axis, first and last bisection level, LCI range that triggers refinement
-# (chosen with `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid)
-ADAPTIVE_COARSE = {2: 24, 3: 12}
-ADAPTIVE_LEVELS = (2, 6)
-ADAPTIVE_TAU = 0.1
+@dataclass(frozen=True)
+class ColumnPlan:
+    """Resolution of the adaptive (column) evaluator (kernels.adaptive): coarse columns per cross axis, z-cells
+    per column, bisection steps per boundary crossing, most refinement levels (each triples the columns per cross
+    axis where the column measures curve), and the share of the tolerance one coarse column's error indicator may
+    take before it is refined (larger: fewer refined columns)."""
+
+    columns: int
+    cells: int
+    bisections: int
+    levels: int
+    beta: float = 1.0
+
+    def coarse_cells(self, ndim: int) -> int:
+        """Cells of the coarse grid (the unit of the statistics rows' counts)."""
+        return self.columns ** (ndim - 1) * self.cells
+
+
+# per task dimension, and per mechanism where its workspaces need less (chosen with
+# `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid on 20 random
+# designs): planar workspaces have parts thinner than 1/64 of the box along y; ups-sspr's are smooth and simple
+ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6), 3: ColumnPlan(24, 8, 5, 3, beta=3.0)}
+ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {"ups-sspr": ColumnPlan(8, 6, 5, 3, beta=3.0)}
+
+
+def adaptive_plan(mech: Mechanism) -> ColumnPlan:
+    return ADAPTIVE_PLAN_OF.get(mech.name, ADAPTIVE_PLAN[len(mech.task_axes)])
 
 
 @dataclass
@@ -104,17 +126,9 @@ class AdaptiveResult:
     cell: np.ndarray
     error_volume: np.ndarray  # relative
     error_gci: np.ndarray  # absolute
-    levels: np.ndarray  # bisection levels used per design (int64)
+    levels: np.ndarray  # refinement levels used per design (int64)
     evaluations: np.ndarray  # field-kernel calls per design
-
-
-def _errors(mech: Mechanism, fine: np.ndarray, coarse: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Relative measure and absolute GCI differences of two statistics arrays (0 for empty workspaces)."""
-    c_f, c_c = fine[:, _grid.COL_COUNT], coarse[:, _grid.COL_COUNT]
-    ev = np.where(c_f > 0, np.abs(c_f - c_c) / np.where(c_f > 0, c_f, 1.0), 0.0)
-    g_f = np.where(c_f > 0, fine[:, _grid.COL_SUM] / np.where(c_f > 0, c_f, 1.0), 0.0)
-    g_c = np.where(c_c > 0, coarse[:, _grid.COL_SUM] / np.where(c_c > 0, c_c, 1.0), 0.0)
-    return ev, np.abs(g_f - g_c)
+    coarse_cells: int  # cells of the coarse grid (coverage = count / coarse_cells)
 
 
 def adaptive_population_stats(
@@ -126,41 +140,27 @@ def adaptive_population_stats(
     edges: np.ndarray,
     region: Mapping[str, Sequence[float]] | None = None,
     boxes: Grid | None = None,
+    plan: ColumnPlan | None = None,
 ) -> AdaptiveResult:
-    """Statistics of every design by the adaptive evaluator (kernels.adaptive), deepening per design until its
-    error estimate meets ``tolerance`` or the last level is reached. ``boxes``: one fixed coarse grid for every
-    design (the task box) instead of each design's bounding box."""
-    from scalesynth.kernels.adaptive import adaptive_stats
+    """Statistics of every design by the adaptive column evaluator (kernels.adaptive), refined per design until
+    its error estimate (change from the previous level) meets ``tolerance`` or the plan's last level is reached.
+    ``boxes``: one fixed box for every design (the task box) instead of each design's bounding box."""
+    from scalesynth.kernels.adaptive import column_stats
 
     n = len(designs)
     ndim = len(mech.task_axes)
-    n0 = ADAPTIVE_COARSE[ndim]
+    plan = plan or adaptive_plan(mech)
     if boxes is None:
-        grids = [make_grid(mech, d, options, n0, region) for d in designs]  # its lo + i step: cell corners
+        grids = [make_grid(mech, d, options, 1, region) for d in designs]
     else:
-        step = boxes.step * boxes.shape / np.where(np.arange(3) < ndim, n0, 1)
-        grids = [Grid(lo=boxes.lo, step=step, shape=np.array([n0] * ndim + [1] * (3 - ndim)), ndim=ndim)] * n
-    lo = np.stack([g.lo for g in grids])
-    step = np.stack([g.step for g in grids])
-    shape = grids[0].shape
-    cell = np.array([g.cell_measure for g in grids])
-    stats = np.zeros((n, _grid.stat_columns(mech.n_fields, len(edges) - 1)))
-    err_v = np.zeros(n)
-    err_g = np.zeros(n)
-    used = np.zeros(n, dtype=np.int64)
-    evals = np.zeros(n)
-    todo = np.arange(n)
-    first, last = ADAPTIVE_LEVELS
-    for levels in range(first, last + 1):
-        if todo.size == 0:
-            break
-        s, s2, e = adaptive_stats(mech.field_kernel, mech.n_fields, packed[todo], lo[todo], step[todo], shape,
-                                  edges, ndim, levels, ADAPTIVE_TAU)
-        ev, eg = _errors(mech, s, s2)
-        stats[todo], err_v[todo], err_g[todo], used[todo] = s, ev, eg, levels
-        evals[todo] += e
-        todo = todo[(ev > tolerance.volume) | (eg > tolerance.gci)]
-    return AdaptiveResult(stats, cell, err_v, err_g, used, evals)
+        grids = [boxes] * n
+    lo = np.stack([g.lo for g in grids]) if n else np.zeros((0, 3))
+    hi = np.stack([g.lo + g.step * g.shape for g in grids]) if n else np.zeros((0, 3))
+    cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
+    stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
+                                                      plan.columns, plan.cells, plan.bisections, plan.levels,
+                                                      tolerance.volume, tolerance.gci, edges, plan.beta)
+    return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 
 def stats_to_metrics(
@@ -217,10 +217,9 @@ def _metrics_of(
     unit: str,
     task: Any,
     cycle: Any = None,
-    tolerance: Tolerance | None = None,
 ) -> dict[str, np.ndarray]:
-    """Every catalogue metric of the designs: workspace statistics given, task statistics and the computed
-    families (design, path) evaluated here (task box: adaptive evaluator when ``tolerance`` is given)."""
+    """Every catalogue metric of the designs: workspace statistics given, task statistics (on the uniform task
+    grid) and the computed families (design, path) evaluated here."""
     has_path = task is not None and task.path is not None
     entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
     n_bands = len(band_edges) - 1
@@ -230,13 +229,11 @@ def _metrics_of(
     if task is not None:
         tg = task_grid(mech, task, resolution)
         edges = np.asarray(band_edges, dtype=float)
-        if tolerance is not None and task.resolution is None:
-            ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, boxes=tg)
-            ndim = len(mech.task_axes)
-            tstats, tcell, tcells = ad.stats, ad.cell, float(ADAPTIVE_COARSE[ndim] ** ndim)  # coarse-cell units
-        else:
-            tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
-            tcell, tcells = np.full(n, tg.cell_measure), float(tg.n_cells)
+        # the task box always on the uniform grid (task.resolution, else grid.resolution): the column evaluator's
+        # task-box statistics are not accurate yet (fivebar_packing, 20 random designs: task_gci up to 0.046 off
+        # a 768^2 grid, against 0.002 for the uniform 256^2 grid)
+        tstats = mech.grid_stats(packed, np.tile(tg.lo, (n, 1)), np.tile(tg.step, (n, 1)), tg.shape, edges)
+        tcell, tcells = np.full(n, tg.cell_measure), float(tg.n_cells)
         out.update(stats_to_metrics(mech, tstats, tcell, tcells,
                                     [m for m in entries if m.family == "task" and m.compute is None], n_bands))
     ctx = _metrics.EvalContext(mech, resolved, options, packed, task, resolution, band_edges, unit, cycle)
@@ -339,7 +336,7 @@ def evaluate(
         ad = adaptive_population_stats(mech, [design], options, packed, tolerance, edges, region)
         seconds = time.perf_counter() - t0
         values = _metrics_of(mech, [design], options, packed, ad.stats, ad.cell, resolution, band_edges, unit, task,
-                             cycle, tolerance)
+                             cycle)
         values.update(error_volume=ad.error_volume, error_gci=ad.error_gci)
         n_cells = int(ad.evaluations[0])
     else:
@@ -414,7 +411,7 @@ def evaluate_population(
     if tolerance is not None:
         ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, region)
         out = _metrics_of(mech, resolved, options, packed, ad.stats, ad.cell, resolution, band_edges, unit, task,
-                          cycle, tolerance)
+                          cycle)
         out["error_volume"] = ad.error_volume
         out["error_gci"] = ad.error_gci
         return out

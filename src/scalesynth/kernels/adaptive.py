@@ -1,263 +1,320 @@
-"""Accuracy-targeted (adaptive) grid evaluator: a coarse vertex lattice, cells refined by octree bisection only
-where they matter.
+"""Accuracy-targeted (adaptive) evaluator: reachable intervals along columns, found by bisection, integrated by
+Gauss rules; the columns refined (ternary) only where the column measures curve.
 
-Algorithm (per design; ``tests/naive.py::adaptive_stats`` is its NumPy twin):
+Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
 
-1. Evaluate every field at the (n0x + 1) x (n0y + 1) x (n0z + 1) corners of the coarse cells (``lo + i * step``;
-   planar: ``ndim = 2``, z fixed at lo[2]).
-2. Visit the coarse cells in (i, j, k) order. A cell of level l (edge step / 2^l) is refined when l < ``levels``
-   and its corners disagree on reachability (the workspace boundary crosses it), or it lies next to such a cell
-   (a coarse neighbour or a sibling: bulges of the workspace hide in cells whose corners are all outside), or,
-   all reachable, their LCI range exceeds ``tau`` (the field varies fast). Refining evaluates the 3^ndim points
-   of its bisection (the corners are reused) and visits its 2^ndim children depth first, in a fixed order.
-3. A cell that is not refined is a leaf: each of its 2^ndim corners enters the statistics row with weight
-   (cell measure / coarse cell measure) / 2^ndim (trapezoid rule; a boundary cell counts its reachable corners'
-   share), so weights are binary fractions, exact in floating point, and every field's statistics use the same
-   weights. Counts are in coarse-cell units: measure = count x coarse cell measure.
+1. Columns run along the last task axis ("z"; planar mechanisms: y) over a cell-centred grid of the other axes
+   (n x n columns; planar: n). Along a column the fields are evaluated at the m + 1 nodes ``zlo + k hz``; where
+   reachability changes between two nodes, ``nbis`` bisection steps locate the boundary (estimate: the midpoint of
+   the last bracket, error <= hz / 2^(nbis+1)). So the column's reachable length is exact to that precision, not
+   a voxel count.
+2. Each reachable piece of a z-cell (between two reachable nodes, or between a node and the boundary) is integrated
+   by the 2-point Gauss-Legendre rule: every field at its two points, each with half the piece's length (a point
+   that turns out unreachable gives its weight to the other; a piece with neither reachable is dropped). The
+   points' fields and weights feed the shared statistics accumulator (kernels.grid), so every statistic of the
+   row layout (count, sum, sum of squares, min, max per field, band measures) exists as for uniform grids.
+3. Level 0 integrates the column measures L and LCI sums S over the cross grid by the midpoint rule. Its local
+   error indicator is the second difference of L (and of S) over the neighbouring columns (the midpoint rule is
+   exact for linear variation; walls and silhouettes give large second differences). A column whose indicator
+   x cell area / 24 exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3
+   (planar: 3) cells, each with its own column (the centre one recomputed). The next level repeats steps 1-3 on
+   the new columns, with the others held at their coarser values.
+4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
+   (absolute) from level l-1; the design stops at the first level whose estimate meets the tolerance, or at
+   ``maxlev``, or when no column is flagged for refinement (the estimate is then the last change, reported as
+   it is even when above the tolerance; 0 if that happens at level 0: the midpoint rule sees no curvature).
 
-A second row is accumulated as if ``levels - 1`` were the deepest level; the difference of the two is the error
-estimate of the result (Richardson with first-order convergence, which is conservative for these sums).
-Parallel over (design, coarse x-slab) with a fixed reduction order: deterministic whatever the thread count.
+Counts are in units of the coarse cell (cross cell x hz): measure = count x hx hy hz. Parallel over designs, each
+design serial with a fixed order of columns: deterministic whatever the thread count.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit, prange
 
 from scalesynth.kernels.bind import bind
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.kernels.grid import accumulate_cells, gather_column, init_row, reduce_partials
+from scalesynth.kernels.grid import accumulate_cells, init_row
 
 # placeholders: kernels.bind gives each bound copy one mechanism's field kernel and field count
 FIELD_KERNEL = None
 N_FIELDS = 0
 
+GAUSS_X = 1.0 / math.sqrt(3.0)  # 2-point Gauss-Legendre abscissa on [-1, 1] (weights 1)
+# the end nodes of a column are evaluated this fraction of hz inside the box: a box is often made of the limits
+# themselves, and reachability exactly on a limit depends on rounding (fused multiply-adds differ between two
+# compilations of the same field kernel)
+END_NUDGE = 2.0**-20
 
-def _lattice(params, lo, step, shape, ndim):
-    """Template: fields at the coarse corners, (n_designs, n0x + 1, n0y + 1, n0z + 1, n_fields)."""
-    n_fields = N_FIELDS
-    n_designs = params.shape[0]
-    mx = shape[0] + 1
-    my = shape[1] + 1
-    mz = shape[2] + 1 if ndim == 3 else 1
-    out = np.empty((n_designs, mx, my, mz, n_fields))
-    for task in prange(n_designs * mx):
-        d = task // mx
-        i = task - d * mx
-        p = params[d]
-        cell = np.empty(n_fields)
-        x = lo[d, 0] + i * step[d, 0]
-        for j in range(my):
-            y = lo[d, 1] + j * step[d, 1]
-            for k in range(mz):
-                FIELD_KERNEL(p, x, y, lo[d, 2] + k * step[d, 2], cell)
-                for f in range(n_fields):
-                    out[d, i, j, k, f] = cell[f]
+
+@njit(cache=True)
+def _add_product(a, b, c):
+    """a + b c without fastmath (no fused multiply-add): sample coordinates are computed exactly as the NumPy
+    twin computes them, so a point on the box face (where reachability may flip) is the same point in both."""
+    return a + b * c
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def add_row(acc, row, n_fields):
+    """Fold statistics row ``row`` into ``acc`` (sums added, min/max combined)."""
+    acc[0] += row[0]
+    for f in range(n_fields):
+        c = 1 + 4 * f
+        acc[c] += row[c]
+        acc[c + 1] += row[c + 1]
+        acc[c + 2] = min(acc[c + 2], row[c + 2])
+        acc[c + 3] = max(acc[c + 3], row[c + 3])
+    for b in range(1 + 4 * n_fields, acc.shape[0]):
+        acc[b] += row[b]
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def level_sums(lg, sg, area):
+    """(measure, LCI sum) of a level's piecewise-constant column grids, in coarse-cell units."""
+    v = 0.0
+    s = 0.0
+    for i in range(lg.shape[0]):
+        for j in range(lg.shape[1]):
+            v += lg[i, j]
+            s += sg[i, j]
+    return v * area, s * area
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, flags):
+    """flags[a] = whether active column a (cell ci[a], cj[a]) is refined: a second difference of the column
+    measure (or LCI sum) along a cross axis, x area / 24, above its budget (neighbours clamped at the box)."""
+    nl = lg.shape[0]
+    nyl = lg.shape[1]
+    for a in range(n_active):
+        i = ci[a]
+        j = cj[a]
+        f = False
+        for axis in range(ndim - 1):
+            if axis == 0:
+                i0, j0, i1, j1 = max(i - 1, 0), j, min(i + 1, nl - 1), j
+            else:
+                i0, j0, i1, j1 = i, max(j - 1, 0), i, min(j + 1, nyl - 1)
+            d2 = abs(lg[i1, j1] + lg[i0, j0] - 2.0 * lg[i, j])
+            if d2 * area / 24.0 > budget_v:
+                f = True
+            d2 = abs(sg[i1, j1] + sg[i0, j0] - 2.0 * sg[i, j])
+            if d2 * area / 24.0 > budget_g:
+                f = True
+        flags[a] = f
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def refine_grid(g, ndim):
+    """A level's column grid at the next level: every value repeated over its 3 x 3 (planar: 3) children."""
+    ry = 3 if ndim == 3 else 1
+    out = np.empty((g.shape[0] * 3, g.shape[1] * ry))
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            out[i, j] = g[i // 3, j // ry]
     return out
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def _mixed(corners, n_corners):
-    """Whether the corners (n_corners, n_fields) disagree on reachability."""
-    n_in = 0
-    for c in range(n_corners):
-        if corners[c, 0] >= 0.0:
-            n_in += 1
-    return 0 < n_in < n_corners
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def _coarse_mixed(lattice, d, i, j, k, ndim):
-    """Whether coarse cell (i, j, k) of design d, or one of its neighbours, has corners that disagree on
-    reachability (cells outside the grid do not count)."""
-    nx = lattice.shape[1] - 1
-    ny = lattice.shape[2] - 1
-    nz = lattice.shape[3] - 1 if ndim == 3 else 1
-    kr = 1 if ndim == 3 else 0
-    for a in range(max(i - 1, 0), min(i + 1, nx - 1) + 1):
-        for b in range(max(j - 1, 0), min(j + 1, ny - 1) + 1):
-            for c in range(max(k - kr, 0), min(k + kr, nz - 1) + 1):
-                n_in = 0
-                n_all = 0
-                for da in range(2):
-                    for db in range(2):
-                        for dc in range(kr + 1):
-                            n_all += 1
-                            if lattice[d, a + da, b + db, c + dc, 0] >= 0.0:
-                                n_in += 1
-                if 0 < n_in < n_all:
-                    return True
-    return False
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def _refine(corners, n_corners, level, levels, tau, forced):
-    """Whether a cell with these corner fields (n_corners, n_fields) is bisected: below the last level, and
-    ``forced`` (next to the workspace boundary), or its corners disagree on reachability, or their LCI range
-    exceeds tau."""
-    if level >= levels:
-        return False
-    if forced:
-        return True
-    n_in = 0
-    lmin = 2.0
-    lmax = -2.0
-    for c in range(n_corners):
-        v = corners[c, 0]
-        if v >= 0.0:
-            n_in += 1
-        lmin = min(lmin, v)
-        lmax = max(lmax, v)
-    if n_in == 0:
-        return False
-    if n_in < n_corners:
-        return True
-    return lmax - lmin > tau
-
-
-_BUFFER = 4096  # cells buffered per statistics row before they are reduced into it (kernels.grid accumulator)
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def _add_leaf(row, corners, n_corners, w, edges, vals, buf, wbuf, m):
-    """Buffer a leaf's corners, each with weight w / n_corners; reduce the buffer into the row when full.
-    Returns the new fill."""
-    for c in range(n_corners):
-        for f in range(vals.shape[0]):
-            vals[f, c] = corners[c, f]
-    if m + n_corners > buf.shape[1]:
-        accumulate_cells(row, buf, wbuf, m, edges)
-        m = 0
-    return gather_column(buf, wbuf, m, vals, 0, n_corners - 1, w / n_corners)
-
-
-def _adaptive_stats(params, lo, step, shape, edges, ndim, levels, tau, lattice):
-    """Template: (stats, stats_one_level_coarser, evaluations) per design; see the module docstring."""
+def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges, row, info):
+    """Template (serial): statistics row of one design into ``row``; info: error_volume, error_gci, level,
+    evaluations."""
     n_fields = N_FIELDS
-    n_designs = params.shape[0]
-    nx, ny = shape[0], shape[1]
-    nz = shape[2] if ndim == 3 else 1
     nb = edges.shape[0] - 1
     ncol = 1 + 4 * n_fields + nb
-    nc = 1 << ndim
-    n_sub = 27 if ndim == 3 else 9
-    partial = np.zeros((n_designs * nx, ncol))
-    partial2 = np.zeros((n_designs * nx, ncol))
-    evals = np.zeros(n_designs * nx)
-    cap = 8 * (levels + 1) + 1
-    for task in prange(n_designs * nx):
-        d = task // nx
-        i = task - d * nx
-        p = params[d]
-        row = partial[task]
-        row2 = partial2[task]
-        init_row(row, n_fields)
-        init_row(row2, n_fields)
-        vals = np.empty((n_fields, 8))
-        cell = np.empty(n_fields)
-        sub = np.empty((27, n_fields))
-        st_o = np.empty((cap, 3))
-        st_l = np.empty(cap, dtype=np.int64)
-        st_c = np.empty((cap, 8, n_fields))
-        st_f = np.empty(cap, dtype=np.bool_)
-        buf = np.empty((n_fields, _BUFFER))
-        wbuf = np.empty(_BUFFER)
-        buf2 = np.empty((n_fields, _BUFFER))
-        wbuf2 = np.empty(_BUFFER)
-        m = 0
-        m2 = 0
-        n_eval = 0.0
-        for j in range(ny):
-            for k in range(nz):
-                # the coarse cell (i, j, k) on the stack
-                for c in range(nc):
-                    ci = i + (c & 1)
-                    cj = j + ((c >> 1) & 1)
-                    ck = k + ((c >> 2) & 1) if ndim == 3 else 0
-                    for f in range(n_fields):
-                        st_c[0, c, f] = lattice[d, ci, cj, ck, f]
-                st_o[0, 0] = lo[d, 0] + i * step[d, 0]
-                st_o[0, 1] = lo[d, 1] + j * step[d, 1]
-                st_o[0, 2] = lo[d, 2] + k * step[d, 2]
-                st_l[0] = 0
-                st_f[0] = _coarse_mixed(lattice, d, i, j, k, ndim)
-                top = 1
-                while top > 0:
-                    top -= 1
-                    level = st_l[top]
-                    corners = st_c[top]
-                    w = 1.0 / (1 << (ndim * level))
-                    if not _refine(corners, nc, level, levels, tau, st_f[top]):
-                        m = _add_leaf(row, corners, nc, w, edges, vals, buf, wbuf, m)
-                        if level <= levels - 1 or levels == 0:
-                            m2 = _add_leaf(row2, corners, nc, w, edges, vals, buf2, wbuf2, m2)
-                        continue
-                    if level == levels - 1:
-                        m2 = _add_leaf(row2, corners, nc, w, edges, vals, buf2, wbuf2, m2)
-                    h = 0.5 / (1 << level)
-                    hx = h * step[d, 0]
-                    hy = h * step[d, 1]
-                    hz = h * step[d, 2]
-                    ox = st_o[top, 0]
-                    oy = st_o[top, 1]
-                    oz = st_o[top, 2]
-                    # the 3^ndim bisection points, index a + 3 b + 9 c; corners (even a, b, c) reused
-                    for s in range(n_sub):
-                        a = s % 3
-                        b = (s // 3) % 3
-                        cc = s // 9
-                        if a != 1 and b != 1 and cc != 1:
-                            src = (a >> 1) | ((b >> 1) << 1) | ((cc >> 1) << 2)
-                            for f in range(n_fields):
-                                sub[s, f] = corners[src, f]
+    ny = n if ndim == 3 else 1
+    ca = ndim - 1
+    init_row(row, n_fields)
+    zlo = lo_d[ca]
+    hz = (hi_d[ca] - zlo) / m
+    hx = (hi_d[0] - lo_d[0]) / n
+    hy = (hi_d[1] - lo_d[1]) / n if ndim == 3 else 1.0
+    zfix = lo_d[2]
+    info[:] = 0.0
+    if not (hz > 0.0 and hx > 0.0 and hy > 0.0):
+        return  # an empty box (a degenerate design's bounding box): nothing reachable
+    cell = np.empty(n_fields)
+    nodes = np.empty((m + 1, n_fields))
+    buf = np.empty((n_fields, 2 * m))
+    wbuf = np.empty(2 * m)
+    q0 = np.empty(n_fields)
+    q1 = np.empty(n_fields)
+    colrow = np.empty(ncol)
+    evals = 0.0
+    # level 0: every cell of the cross grid is active, in (i, j) order
+    n_active = n * ny
+    ci = np.empty(n_active, dtype=np.int64)
+    cj = np.empty(n_active, dtype=np.int64)
+    for a in range(n_active):
+        ci[a] = a // ny
+        cj[a] = a - (a // ny) * ny
+    lg = np.zeros((n, ny))
+    sg = np.zeros((n, ny))
+    prev_v = 0.0
+    prev_g = 0.0
+    err_v = 0.0
+    err_g = 0.0
+    level = 0
+    while True:
+        scale = 1.0
+        for _ in range(level):
+            scale *= 3.0
+        area = 1.0 / (scale * scale) if ndim == 3 else 1.0 / scale
+        rows = np.empty((n_active, ncol))
+        for a in range(n_active):
+            x = lo_d[0] + (ci[a] + 0.5) * hx / scale
+            y = lo_d[1] + (cj[a] + 0.5) * hy / scale
+            # 1. nodes
+            for k in range(m + 1):
+                zk = _add_product(zlo, END_NUDGE if k == 0 else (m - END_NUDGE if k == m else k), hz)
+                if ndim == 3:
+                    FIELD_KERNEL(p, x, y, zk, cell)
+                else:
+                    FIELD_KERNEL(p, x, zk, zfix, cell)
+                for f in range(n_fields):
+                    nodes[k, f] = cell[f]
+            evals += m + 1
+            npts = 0
+            col_l = 0.0
+            col_s = 0.0
+            for k in range(m):
+                r0 = nodes[k, 0] >= 0.0
+                r1 = nodes[k + 1, 0] >= 0.0
+                if not r0 and not r1:
+                    continue
+                za = _add_product(zlo, k, hz)
+                zb = _add_product(zlo, k + 1, hz)
+                if r0 != r1:
+                    # bisection: [a, b] keeps node k's reachability at a
+                    ba = za
+                    bb = zb
+                    for _ in range(nbis):
+                        mid = 0.5 * (ba + bb)
+                        if ndim == 3:
+                            FIELD_KERNEL(p, x, y, mid, cell)
                         else:
-                            FIELD_KERNEL(p, ox + a * hx, oy + b * hy, oz + cc * hz, cell)
-                            n_eval += 1.0
-                            for f in range(n_fields):
-                                sub[s, f] = cell[f]
-                    # children pushed in reverse so that child 0 is visited first; all of them are refined further
-                    # when one is crossed by the boundary (a bulge of the workspace may hide in a child whose
-                    # corners are all outside)
-                    base = top
-                    any_mixed = False
-                    for child in range(nc - 1, -1, -1):
-                        ca = child & 1
-                        cb = (child >> 1) & 1
-                        cz = (child >> 2) & 1
-                        for c in range(nc):
-                            s = (ca + (c & 1)) + 3 * (cb + ((c >> 1) & 1)) + 9 * (cz + ((c >> 2) & 1))
-                            for f in range(n_fields):
-                                st_c[top, c, f] = sub[s, f]
-                        st_o[top, 0] = ox + ca * hx
-                        st_o[top, 1] = oy + cb * hy
-                        st_o[top, 2] = oz + cz * hz
-                        st_l[top] = level + 1
-                        any_mixed = any_mixed or _mixed(st_c[top], nc)
-                        top += 1
-                    for t in range(base, top):
-                        st_f[t] = any_mixed
-        accumulate_cells(row, buf, wbuf, m, edges)
-        accumulate_cells(row2, buf2, wbuf2, m2, edges)
-        evals[task] = n_eval
-    out_evals = np.zeros(n_designs)
-    for d in range(n_designs):
-        for i in range(nx):
-            out_evals[d] += evals[d * nx + i]
-    return (reduce_partials(partial, n_designs, nx, n_fields), reduce_partials(partial2, n_designs, nx, n_fields),
-            out_evals)
+                            FIELD_KERNEL(p, x, mid, zfix, cell)
+                        if (cell[0] >= 0.0) == r0:
+                            ba = mid
+                        else:
+                            bb = mid
+                    evals += nbis
+                    cross = 0.5 * (ba + bb)
+                    if r0:
+                        zb = cross
+                    else:
+                        za = cross
+                # 2. 2-point Gauss rule on the piece [za, zb]
+                half = 0.5 * (zb - za)
+                zm = 0.5 * (za + zb)
+                if ndim == 3:
+                    FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
+                    FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
+                else:
+                    FIELD_KERNEL(p, x, _add_product(zm, -half, GAUSS_X), zfix, q0)
+                    FIELD_KERNEL(p, x, _add_product(zm, half, GAUSS_X), zfix, q1)
+                evals += 2
+                ok0 = q0[0] >= 0.0
+                ok1 = q1[0] >= 0.0
+                if not ok0 and not ok1:
+                    continue
+                w = half / hz if ok0 and ok1 else 2.0 * half / hz
+                if ok0:
+                    for f in range(n_fields):
+                        buf[f, npts] = q0[f]
+                    wbuf[npts] = w * area
+                    npts += 1
+                    col_l += w
+                    col_s += w * q0[0]
+                if ok1:
+                    for f in range(n_fields):
+                        buf[f, npts] = q1[f]
+                    wbuf[npts] = w * area
+                    npts += 1
+                    col_l += w
+                    col_s += w * q1[0]
+            init_row(colrow, n_fields)
+            accumulate_cells(colrow, buf, wbuf, npts, edges)
+            for c in range(ncol):
+                rows[a, c] = colrow[c]
+            lg[ci[a], cj[a]] = col_l
+            sg[ci[a], cj[a]] = col_s
+        # 4. error estimate against the previous level
+        vol, ssum = level_sums(lg, sg, area)
+        gci = ssum / vol if vol > 0.0 else 0.0
+        if level > 0:
+            if vol > 0.0:
+                err_v = abs(vol - prev_v) / vol
+            else:
+                err_v = 0.0 if prev_v == 0.0 else 1.0
+            err_g = abs(gci - prev_g)
+        prev_v = vol
+        prev_g = gci
+        stop = level >= maxlev or (level >= 1 and err_v <= tol_v and err_g <= tol_g)
+        flags = np.zeros(n_active, dtype=np.bool_)
+        if not stop:
+            ncell0 = n * ny
+            flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
+                         tol_g * vol * beta / ncell0, flags)
+        n_flag = 0
+        for a in range(n_active):
+            if flags[a]:
+                n_flag += 1
+            else:
+                add_row(row, rows[a], n_fields)
+        if stop or n_flag == 0:
+            break
+        # 3. children of the flagged cells, in (parent, a, b) order
+        nk = 9 if ndim == 3 else 3
+        ni = np.empty(n_flag * nk, dtype=np.int64)
+        nj = np.empty(n_flag * nk, dtype=np.int64)
+        t = 0
+        for a in range(n_active):
+            if flags[a]:
+                for da in range(3):
+                    for db in range(3 if ndim == 3 else 1):
+                        ni[t] = 3 * ci[a] + da
+                        nj[t] = 3 * cj[a] + db if ndim == 3 else 0
+                        t += 1
+        ci = ni
+        cj = nj
+        n_active = t
+        lg = refine_grid(lg, ndim)
+        sg = refine_grid(sg, ndim)
+        level += 1
+    info[0] = err_v
+    info[1] = err_g
+    info[2] = level
+    info[3] = evals
 
 
-def adaptive_stats(field_kernel, n_fields, params, lo, step, shape, edges, ndim, levels, tau):
-    """Statistics rows of every design by the adaptive algorithm (module docstring).
+def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges):
+    """Template (parallel over designs): FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel."""
+    n_designs = params.shape[0]
+    stats = np.zeros((n_designs, 1 + 4 * N_FIELDS + edges.shape[0] - 1))
+    info = np.zeros((n_designs, 4))
+    for d in prange(n_designs):
+        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges, stats[d],
+                     info[d])
+    return stats, info
 
-    params (n, k); lo, step (n, 3): origin and edge of the coarse cells; shape int64[3]: coarse cells per axis
-    (planar: shape[2] = 1 and ndim = 2); levels: bisection levels; tau: LCI range that triggers refinement.
-    Returns (stats, stats_coarser, evaluations): two (n, stat_columns) arrays with counts in coarse-cell units
-    (the second as if levels - 1 were the deepest) and the field-kernel calls per design (float64 (n,)).
+
+def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
+                 beta=1.0):
+    """Statistics rows of every design by the column algorithm (module docstring).
+
+    params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
+    per cross axis; m: z-cells per column; nbis: bisection steps per boundary crossing; maxlev: most refinement
+    levels; tol_v, tol_g: relative measure and absolute GCI tolerance; edges: band edges; beta: share of the
+    tolerance one coarse column's error indicator may take before it is refined. Returns (stats (d,
+    stat_columns), error_volume (d,), error_gci (d,), levels (d,) int64, evaluations (d,)): counts in units of the
+    coarse cell (hx hy hz with hx = (hi - lo)[0] / n, ...; planar hx hz).
     """
-    lattice = bind(_lattice, field_kernel, n_fields, parallel=True, fastmath=FASTMATH)(params, lo, step, shape,
-                                                                                        ndim)
-    run = bind(_adaptive_stats, field_kernel, n_fields, parallel=True, fastmath=FASTMATH)
-    stats, coarser, evals = run(params, lo, step, shape, edges, ndim, levels, tau, lattice)
-    return stats, coarser, evals + lattice.shape[1] * lattice.shape[2] * lattice.shape[3]
+    one = bind(_design_stats, field_kernel, n_fields, fastmath=FASTMATH)
+    run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
+    stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),
+                      np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), int(m), int(nbis), int(maxlev),
+                      float(tol_v), float(tol_g), float(beta), np.ascontiguousarray(edges, dtype=float))
+    return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()
