@@ -33,6 +33,7 @@ from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -43,6 +44,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     wrap_angle,
 )
+from scalesynth.stiffness import legs as _legs_k
 from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
@@ -58,7 +60,11 @@ IK_LABEL = "Z+"  # the only IK branch: leg lengths are positive square roots, th
 _C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
 _L1LO, _L1HI, _L2LO, _L2HI, _L3LO, _L3HI = 6, 7, 8, 9, 10, 11
 _ALO, _AHI, _BLO, _BHI, _YLO, _YHI = 12, 13, 14, 15, 16, 17
-N_PACKED = 18
+# stiffness (point_fields slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N mm^2), GJ (N mm^2) of the 'leg' and
+# 'link' groups, actuator stiffness (N/mm), load (N)
+_EA_LEG, _EI_LEG, _GJ_LEG, _EA_LINK, _EI_LINK, _GJ_LINK, _KACT, _FX, _FY, _FZ = 18, 19, 20, 21, 22, 23, 24, 25, 26, 27
+N_PACKED = 28
+_F_STIFFNESS_MIN, _F_DEFLECTION = 3, 4  # slots of the stiffness fields in the field kernel's out
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -87,29 +93,30 @@ def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
     return ln, ja, jb, jy
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def point_fields(p, alpha, beta, yy, out):
-    """LCI at task point (alpha [rad], beta [rad], Y [mm]) if it lies in the workspace box with every actuator
-    length within its limits, else -1. LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the angle columns divided by
-    the characteristic length. Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq,
-    x = (L alpha, L beta, Y) (dimensionless)."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _kinematics(p, alpha, beta, yy, out):
+    """Slots 0-2 at task point (alpha [rad], beta [rad], Y [mm]): LCI if it lies in the workspace box with every
+    actuator length within its limits, else -1 (write_unreachable). LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the
+    angle columns divided by the characteristic length; sigma_min, sigma_max of J = dx/dq, x = (L alpha, L beta, Y)
+    (dimensionless). Returns (ok, sin alpha, cos alpha, sin beta, cos beta, P_x, P_z, longest leg); ok False where
+    slots 0-2 say unreachable or singular (the other slots are then written too)."""
     if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if yy < p[_YLO] or yy > p[_YHI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     c = p[_C]
     rho2 = c * c - yy * yy
     if not rho2 > 0.0:
         _grid.write_unreachable(out)  # |Y| >= c: no Z > 0 assembly
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     am = p[_AM]
     # spec §3.3: l1 = |(2/3) P - M| depends on Y only; > 0 whenever |Y| < c
     l1 = math.sqrt(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy)
     if l1 < p[_L1LO] or l1 > p[_L1HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     rho = math.sqrt(rho2)
     sa = math.sin(alpha)
     ca = math.cos(alpha)
@@ -124,18 +131,130 @@ def point_fields(p, alpha, beta, yy, out):
     l2, j2a, j2b, j2y = _ups_row(-ax, ay, -bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l2 < p[_L2LO] or l2 > p[_L2HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     l3, j3a, j3b, j3y = _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l3 < p[_L3LO] or l3 > p[_L3HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if l2 <= 0.0 or l3 <= 0.0:
-        _grid.write_singular(out)  # zero-length leg: inverse singularity
-        return
+        _grid.write_singular(out)  # zero-length leg: inverse singularity (stiffness fields 0)
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     s = p[_INV_L]
     lci, smin, smax = sv_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    return True, sa, ca, sb, cb, px, pz, max(l1, l2, l3)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, alpha, beta, yy, out):
+    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
+    the LCI alone) and the stiffness twin tests."""
+    _kinematics(p, alpha, beta, yy, out)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_fields(p, alpha, beta, yy, out):
+    """Fields at task point (alpha [rad], beta [rad], Y [mm]) (kernels.grid contract): slots 0-2 LCI, sigma_min,
+    sigma_max of J = dx/dq, x = (L alpha, L beta, Y) (dimensionless); _F_STIFFNESS_MIN (N/mm) and _F_DEFLECTION
+    (mm) under the packed load (ideal joints, docs/stiffness.md); LCI -1 (and zeros) outside the workspace box or
+    the actuator limits."""
+    ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
+    if ok:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+    elif out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
+        out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _up(dx, dy, dz):
+    """The section's ``up`` vector of a link along (dx, dy, dz), as stiffness_model: z unless the link is steep."""
+    if abs(dz) < 0.9 * math.sqrt(dx * dx + dy * dy + dz * dz):
+        return 0.0, 0.0, 1.0
+    return 1.0, 0.0, 0.0
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _beam(C, p, group, ax, ay, az, bx, by, bz, rx, ry, rz):
+    """C += the compliance at ref of the link a -> b of group 0 ('leg') or 1 ('link')."""
+    ux, uy, uz = _up(bx - ax, by - ay, bz - az)
+    o = _EA_LEG if group == 0 else _EA_LINK
+    _legs_k.add_beam_compliance(C, ax, ay, az, bx, by, bz, ux, uy, uz, p[o], p[o + 1], p[o + 1], p[o + 2], rx, ry, rz)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _actuated_leg(C, p, ax, ay, az, bx, by, bz, rx, ry, rz):
+    """C = compliance at ref of a prismatic leg a -> b: cylinder and rod (each half, group 'leg') with the actuator
+    spring between them. Returns the leg's unit vector and length."""
+    C[:, :] = 0.0
+    mx, my, mz = 0.5 * (ax + bx), 0.5 * (ay + by), 0.5 * (az + bz)
+    _beam(C, p, 0, ax, ay, az, mx, my, mz, rx, ry, rz)
+    _beam(C, p, 0, mx, my, mz, bx, by, bz, rx, ry, rz)
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    ln = math.sqrt(dx * dx + dy * dy + dz * dz)
+    _legs_k.add_prismatic_spring(C, dx / ln, dy / ln, dz / ln, p[_KACT])
+    return dx / ln, dy / ln, dz / ln, ln
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
+    """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model (per-leg
+    condensation, scalesynth.stiffness.legs): each UPS leg (U at A_i with both axes normal to the leg, cylinder,
+    actuator spring, rod, S at B_i) one leg; the (S+SPR)R chain as the link's node B0 (the lower link with its S at
+    A0 and the SPR leg, S at M, revolute about x_link at B0, in parallel) in series with the upper link and the
+    revolute at B1 = P. Stiffness at the reference point P, summed over the chains."""
+    w = _legs_k.scratch()
+    C, J, N, K, Ka, Kb, work, K1 = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]
+    c = p[_C]
+    am = p[_AM]
+    K[:, :] = 0.0
+    for sx in (-1.0, 1.0):  # UPS legs 2 (x < 0) and 3
+        ax = sx * p[_AX]
+        ay = -am
+        bx0 = sx * p[_BX]
+        by0 = p[_BY]
+        bx = px + cb * bx0 + sb * sa * by0
+        by = py + ca * by0
+        bz = pz - sb * bx0 + cb * sa * by0
+        ux, uy, uz, ln = _actuated_leg(C, p, ax, ay, 0.0, bx, by, bz, px, py, pz)
+        # U axes: n1 = (z x A) x (B - A), n2 = (B - A) x n1
+        tx, ty = -ay, ax  # z x A
+        n1x, n1y, n1z = ty * uz, -tx * uz, tx * uy - ty * ux
+        nn = math.sqrt(n1x * n1x + n1y * n1y + n1z * n1z)
+        n1x, n1y, n1z = n1x / nn, n1y / nn, n1z / nn
+        n2x, n2y, n2z = uy * n1z - uz * n1y, uz * n1x - ux * n1z, ux * n1y - uy * n1x
+        _legs_k.set_rotation_twist(J, 0, ax, ay, 0.0, n1x, n1y, n1z, px, py, pz)
+        _legs_k.set_rotation_twist(J, 1, ax, ay, 0.0, n2x, n2y, n2z, px, py, pz)
+        _legs_k.set_spherical_twists(J, 2, bx, by, bz, px, py, pz)
+        n = _legs_k.constraint_wrenches(J, 5, c, N)
+        _legs_k.add_leg_stiffness(C, N, n, K, work)
+    # (S+SPR)R: the link's node B0 = K0 P, revolute axes x_link = Ry(beta) x
+    xlx, xlz = cb, -sb
+    b0x, b0y, b0z = K0 * px, K0 * py, K0 * pz
+    Ka[:, :] = 0.0
+    C[:, :] = 0.0
+    _beam(C, p, 1, 0.0, 0.0, 0.0, b0x, b0y, b0z, px, py, pz)  # lower link, S at A0
+    _legs_k.set_spherical_twists(J, 0, 0.0, 0.0, 0.0, px, py, pz)
+    n = _legs_k.constraint_wrenches(J, 3, c, N)
+    _legs_k.add_leg_stiffness(C, N, n, Ka, work)
+    _actuated_leg(C, p, 0.0, -am, 0.0, b0x, b0y, b0z, px, py, pz)  # SPR leg: S at M, revolute at B0
+    _legs_k.set_spherical_twists(J, 0, 0.0, -am, 0.0, px, py, pz)
+    _legs_k.set_rotation_twist(J, 3, b0x, b0y, b0z, xlx, 0.0, xlz, px, py, pz)
+    n = _legs_k.constraint_wrenches(J, 4, c, N)
+    _legs_k.add_leg_stiffness(C, N, n, Ka, work)
+    Kb[:, :] = 0.0
+    C[:, :] = 0.0
+    _beam(C, p, 1, b0x, b0y, b0z, px, py, pz, px, py, pz)  # upper link B0 -> B1, revolute at B1
+    _legs_k.set_rotation_twist(J, 0, px, py, pz, xlx, 0.0, xlz, px, py, pz)
+    n = _legs_k.constraint_wrenches(J, 1, c, N)
+    _legs_k.add_leg_stiffness(C, N, n, Kb, work)
+    _legs_k.series_stiffness(Ka, Kb, K1, work)
+    for i in range(6):
+        for j in range(6):
+            K[i, j] += K1[i, j]
+    # the reference solver's characteristic length: its longest link (the halves of the legs, the lower link)
+    length = max(0.5 * lmax, K0 * c)
+    return _legs_k.platform_response(K, p[_FX], p[_FY], p[_FZ], length, work)
 
 
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
@@ -226,13 +345,20 @@ class UpsSspr(Mechanism):
         p[_ALO], p[_AHI] = options["alpha_range"]
         p[_BLO], p[_BHI] = options["beta_range"]
         p[_YLO], p[_YHI] = self.y_box(design, options)
+        from scalesynth.stiffness.sections import tube_section
+
+        for o, group in ((_EA_LEG, "leg"), (_EA_LINK, "link")):
+            sec = tube_section(options, group, "mm")
+            p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
+        p[_KACT] = options["actuator_stiffness"]
+        p[_FX], p[_FY], p[_FZ] = options["load"]
         return p
 
     @property
     def field_kernel(self):
         return point_fields
 
-    # ----- stiffness (scalesynth.stiffness; pose level only, no per-voxel fields yet) ------------------
+    # ----- stiffness (scalesynth.stiffness; per voxel: point_fields slots 3, 4, the same frame) ---------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
         """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at pose (alpha, beta, Y); raises InvalidPose
         outside the workspace box or the actuator limits. Joints as in joint_screws: UPS legs (U at A_i with both
@@ -559,7 +685,13 @@ MECHANISM = UpsSspr(
                            [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
     default_length_unit="mm",
-    fields=base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+    fields=(
+        *base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+        Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at B1 "
+              "under a pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
+        Field("deflection", "{length}", "magnitude of the deflection of B1 under options.load (default 150 N along "
+              "-z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP)),
+    ),
     design_metrics=(
         DesignMetric(
             "link_length_sum", "{length}",
