@@ -167,94 +167,109 @@ def point_fields(p, alpha, beta, yy, out):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _up(dx, dy, dz):
-    """The section's ``up`` vector of a link along (dx, dy, dz), as stiffness_model: z unless the link is steep."""
-    if abs(dz) < 0.9 * math.sqrt(dx * dx + dy * dy + dz * dz):
-        return 0.0, 0.0, 1.0
-    return 1.0, 0.0, 0.0
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def _beam(C, p, group, ax, ay, az, bx, by, bz, rx, ry, rz):
-    """C += the compliance at ref of the link a -> b of group 0 ('leg') or 1 ('link')."""
-    ux, uy, uz = _up(bx - ax, by - ay, bz - az)
-    o = _EA_LEG if group == 0 else _EA_LINK
-    _legs_k.add_beam_compliance(C, ax, ay, az, bx, by, bz, ux, uy, uz, p[o], p[o + 1], p[o + 1], p[o + 2], rx, ry, rz)
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def _actuated_leg(C, p, ax, ay, az, bx, by, bz, rx, ry, rz):
-    """C = compliance at ref of a prismatic leg a -> b: cylinder and rod (each half, group 'leg') with the actuator
-    spring between them. Returns the leg's unit vector and length."""
-    C[:, :] = 0.0
-    mx, my, mz = 0.5 * (ax + bx), 0.5 * (ay + by), 0.5 * (az + bz)
-    _beam(C, p, 0, ax, ay, az, mx, my, mz, rx, ry, rz)
-    _beam(C, p, 0, mx, my, mz, bx, by, bz, rx, ry, rz)
-    dx, dy, dz = bx - ax, by - ay, bz - az
-    ln = math.sqrt(dx * dx + dy * dy + dz * dz)
-    _legs_k.add_prismatic_spring(C, dx / ln, dy / ln, dz / ln, p[_KACT])
-    return dx / ln, dy / ln, dz / ln, ln
+def _bilinear(up_a, up_b, up_t, up_r, up_k, ex, ey, ez, f, g):
+    """f^T C_up g for two wrenches f, g (6-vectors at P) and C_up the tip compliance at P of the upper link (axis e,
+    round section) clamped at B0: translations a e e^T + b (I - e e^T), rotations t e e^T + r (I - e e^T), coupling
+    k e . (F_f x M_g + F_g x M_f)."""
+    fe = f[0] * ex + f[1] * ey + f[2] * ez
+    ge = g[0] * ex + g[1] * ey + g[2] * ez
+    fme = f[3] * ex + f[4] * ey + f[5] * ez
+    gme = g[3] * ex + g[4] * ey + g[5] * ez
+    ff = f[0] * g[0] + f[1] * g[1] + f[2] * g[2]
+    mm = f[3] * g[3] + f[4] * g[4] + f[5] * g[5]
+    # e . (F_f x M_g) + e . (F_g x M_f)
+    c1 = ex * (f[1] * g[5] - f[2] * g[4]) + ey * (f[2] * g[3] - f[0] * g[5]) + ez * (f[0] * g[4] - f[1] * g[3])
+    c2 = ex * (g[1] * f[5] - g[2] * f[4]) + ey * (g[2] * f[3] - g[0] * f[5]) + ez * (g[0] * f[4] - g[1] * f[3])
+    return up_b * ff + (up_a - up_b) * fe * ge + up_r * mm + (up_t - up_r) * fme * gme + up_k * (c1 + c2)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
-    """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model (per-leg
-    condensation, scalesynth.stiffness.legs): each UPS leg (U at A_i with both axes normal to the leg, cylinder,
-    actuator spring, rod, S at B_i) one leg; the (S+SPR)R chain as the link's node B0 (the lower link with its S at
-    A0 and the SPR leg, S at M, revolute about x_link at B0, in parallel) in series with the upper link and the
-    revolute at B1 = P. Stiffness at the reference point P, summed over the chains."""
-    w = _legs_k.scratch()
-    C, J, N, K, Ka, Kb, work, K1 = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]
+    """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model, by
+    per-chain condensation (scalesynth.stiffness.legs' wrench form K = sum_i W_i Phi_i^-1 W_i^T = A A^T):
+
+    * UPS leg i (U at A_i, S at B_i): a two-force member; wrench W = (u, (B_i - P) x u), flexibility
+      Phi = l_i / EA + 1 / k (cylinder and rod in series with the actuator spring).
+    * (S+SPR)R: with ideal joints the link A0-B0-B1 is statically determinate under the wrenches it can take from
+      the platform: the revolute at B1 passes no moment about x_link, the S at A0 a force R, the SPR leg (S at M,
+      revolute about x_link at B0) a force Q = alpha d + beta x_link through M (d along M -> B0). The link is in
+      equilibrium under the platform's wrench f = (R + Q, -P x R + (M - P) x Q) (at P; A0 is the origin), and
+      x_link . moment = 0 ties R . h to alpha (h = x_link x e, e = P / c): a 4-dimensional wrench space with basis
+      (R = e), (R = x_link), (beta = 1), (alpha = 1, R = (K0 - 1)(d . h) h). Its flexibility Phi (4x4) is the
+      complementary energy: the upper link (B0 -> B1) as a cantilever clamped at B0 loaded by f, the lower link
+      (A0 -> B0) as one loaded by R at A0, the SPR leg (length l1) as one loaded by Q at M (axial
+      l1 / EA + 1 / k, lateral l1^3 / 3 EI). Round sections (EIy = EIz), as the tube options give.
+
+    The six wrench columns W L^-T (L L^T = Phi) form A; platform_response_wrenches gives the fields. The generic
+    per-leg routine on the same frame (tests/test_stiffness_legs.py) and the reference solver agree with it.
+    Characteristic length for the singularity test: the reference solver's longest link (halves of the legs, the
+    lower link)."""
+    w = np.empty((3, 6, 6))
+    A, work, fw = w[0], w[1], w[2]
     c = p[_C]
     am = p[_AM]
-    K[:, :] = 0.0
-    for sx in (-1.0, 1.0):  # UPS legs 2 (x < 0) and 3
-        ax = sx * p[_AX]
-        ay = -am
+    k = p[_KACT]
+    ea_leg, ei_leg = p[_EA_LEG], p[_EI_LEG]
+    for col in range(2):  # UPS legs 2 (x < 0) and 3: columns 4, 5
+        sx = -1.0 if col == 0 else 1.0
         bx0 = sx * p[_BX]
         by0 = p[_BY]
-        bx = px + cb * bx0 + sb * sa * by0
-        by = py + ca * by0
-        bz = pz - sb * bx0 + cb * sa * by0
-        ux, uy, uz, ln = _actuated_leg(C, p, ax, ay, 0.0, bx, by, bz, px, py, pz)
-        # U axes: n1 = (z x A) x (B - A), n2 = (B - A) x n1
-        tx, ty = -ay, ax  # z x A
-        n1x, n1y, n1z = ty * uz, -tx * uz, tx * uy - ty * ux
-        nn = math.sqrt(n1x * n1x + n1y * n1y + n1z * n1z)
-        n1x, n1y, n1z = n1x / nn, n1y / nn, n1z / nn
-        n2x, n2y, n2z = uy * n1z - uz * n1y, uz * n1x - ux * n1z, ux * n1y - uy * n1x
-        _legs_k.set_rotation_twist(J, 0, ax, ay, 0.0, n1x, n1y, n1z, px, py, pz)
-        _legs_k.set_rotation_twist(J, 1, ax, ay, 0.0, n2x, n2y, n2z, px, py, pz)
-        _legs_k.set_spherical_twists(J, 2, bx, by, bz, px, py, pz)
-        n = _legs_k.constraint_wrenches(J, 5, c, N)
-        _legs_k.add_leg_stiffness(C, N, n, K, work)
-    # (S+SPR)R: the link's node B0 = K0 P, revolute axes x_link = Ry(beta) x
-    xlx, xlz = cb, -sb
-    b0x, b0y, b0z = K0 * px, K0 * py, K0 * pz
-    Ka[:, :] = 0.0
-    C[:, :] = 0.0
-    _beam(C, p, 1, 0.0, 0.0, 0.0, b0x, b0y, b0z, px, py, pz)  # lower link, S at A0
-    _legs_k.set_spherical_twists(J, 0, 0.0, 0.0, 0.0, px, py, pz)
-    n = _legs_k.constraint_wrenches(J, 3, c, N)
-    _legs_k.add_leg_stiffness(C, N, n, Ka, work)
-    _actuated_leg(C, p, 0.0, -am, 0.0, b0x, b0y, b0z, px, py, pz)  # SPR leg: S at M, revolute at B0
-    _legs_k.set_spherical_twists(J, 0, 0.0, -am, 0.0, px, py, pz)
-    _legs_k.set_rotation_twist(J, 3, b0x, b0y, b0z, xlx, 0.0, xlz, px, py, pz)
-    n = _legs_k.constraint_wrenches(J, 4, c, N)
-    _legs_k.add_leg_stiffness(C, N, n, Ka, work)
-    Kb[:, :] = 0.0
-    C[:, :] = 0.0
-    _beam(C, p, 1, b0x, b0y, b0z, px, py, pz, px, py, pz)  # upper link B0 -> B1, revolute at B1
-    _legs_k.set_rotation_twist(J, 0, px, py, pz, xlx, 0.0, xlz, px, py, pz)
-    n = _legs_k.constraint_wrenches(J, 1, c, N)
-    _legs_k.add_leg_stiffness(C, N, n, Kb, work)
-    _legs_k.series_stiffness(Ka, Kb, K1, work)
-    for i in range(6):
-        for j in range(6):
-            K[i, j] += K1[i, j]
-    # the reference solver's characteristic length: its longest link (the halves of the legs, the lower link)
+        rbx = cb * bx0 + sb * sa * by0  # B - P = R B'
+        rby = ca * by0
+        rbz = -sb * bx0 + cb * sa * by0
+        dx = px + rbx - sx * p[_AX]
+        dy = py + rby + am
+        dz = pz + rbz
+        ln = math.sqrt(dx * dx + dy * dy + dz * dz)
+        ux, uy, uz = dx / ln, dy / ln, dz / ln
+        s = 1.0 / math.sqrt(ln / ea_leg + 1.0 / k)
+        j = 4 + col
+        A[0, j], A[1, j], A[2, j] = ux * s, uy * s, uz * s
+        A[3, j] = (rby * uz - rbz * uy) * s
+        A[4, j] = (rbz * ux - rbx * uz) * s
+        A[5, j] = (rbx * uy - rby * ux) * s
+    # (S+SPR)R chain: frame e (link axis), x (revolute axes), h = x cross e
+    ex, ey, ez = px / c, py / c, pz / c
+    xx, xz = cb, -sb  # x_link = (cb, 0, -sb)
+    hx, hy, hz = -xz * ey, xz * ex - xx * ez, xx * ey
+    dx, dy, dz = K0 * px, K0 * py + am, K0 * pz  # B0 - M
+    l1 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    dx, dy, dz = dx / l1, dy / l1, dz / l1
+    g = (K0 - 1.0) * (dx * hx + dy * hy + dz * hz)
+    mpx, mpy, mpz = -px, -am - py, -pz  # M - P
+    # wrench basis f_j = (R + Q, -P x R + (M - P) x Q): -P x e = 0, -P x x_link = c h, -P x h = -c x_link
+    fw[:, :] = 0.0
+    fw[0, 0], fw[1, 0], fw[2, 0] = ex, ey, ez  # R = e
+    fw[0, 1], fw[1, 1], fw[2, 1] = xx, 0.0, xz  # R = x_link
+    fw[3, 1], fw[4, 1], fw[5, 1] = c * hx, c * hy, c * hz
+    fw[0, 2], fw[1, 2], fw[2, 2] = xx, 0.0, xz  # Q = x_link through M
+    fw[3, 2], fw[4, 2], fw[5, 2] = mpy * xz, mpz * xx - mpx * xz, -mpy * xx
+    fw[0, 3], fw[1, 3], fw[2, 3] = dx + g * hx, dy + g * hy, dz + g * hz  # Q = d through M, R = g h
+    fw[3, 3] = mpy * dz - mpz * dy - g * c * xx
+    fw[4, 3] = mpz * dx - mpx * dz
+    fw[5, 3] = mpx * dy - mpy * dx - g * c * xz
+    ea, ei, gj = p[_EA_LINK], p[_EI_LINK], p[_GJ_LINK]
+    lu = (1.0 - K0) * c
+    up_a, up_b, up_t, up_r, up_k = lu / ea, lu * lu * lu / (3.0 * ei), lu / gj, lu / ei, lu * lu / (2.0 * ei)
+    lo = K0 * c
+    lo_ax, lo_lat = lo / ea, lo * lo * lo / (3.0 * ei)
+    spr_ax, spr_lat = l1 / ea_leg + 1.0 / k, l1 * l1 * l1 / (3.0 * ei_leg)
+    phi = work
+    for a in range(4):
+        for b in range(a, 4):
+            phi[a, b] = _bilinear(up_a, up_b, up_t, up_r, up_k, ex, ey, ez, fw[:, a], fw[:, b])
+    phi[0, 0] += lo_ax
+    phi[1, 1] += lo_lat
+    phi[2, 2] += spr_lat
+    phi[3, 3] += g * g * lo_lat + spr_ax
+    for a in range(4):
+        for b in range(a):
+            phi[a, b] = phi[b, a]
+    if not _legs_k.cholesky(phi, 4):
+        return 0.0, _legs_k.DEFLECTION_CAP
+    _legs_k.wrench_columns(phi, fw, 4, A, 0)
     length = max(0.5 * lmax, K0 * c)
-    return _legs_k.platform_response(K, p[_FX], p[_FY], p[_FZ], length, work)
+    return _legs_k.platform_response_wrenches(A, p[_FX], p[_FY], p[_FZ], length, work)
 
 
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):

@@ -264,7 +264,7 @@ def constraint_wrenches(J, m, length, N):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _cholesky(A, n):
+def cholesky(A, n):
     """In-place lower Cholesky factor of the leading n x n block of the symmetric A; False if not positive
     definite (a pivot <= 0 or not finite)."""
     for j in range(n):
@@ -323,7 +323,7 @@ def add_leg_stiffness(C, N, n, K, work):
                 s += N[i, a] * ci
             m[a, b] = s
             m[b, a] = s
-    if not _cholesky(m, n):
+    if not cholesky(m, n):
         return False
     y = np.empty((6, 6))  # rows 0..n-1: L^-1 N^T
     for a in range(n):
@@ -350,7 +350,7 @@ def series_stiffness(Ka, Kb, out, work):
     for i in range(6):
         for j in range(6):
             s[i, j] = Ka[i, j] + Kb[i, j]
-    if not _cholesky(s, 6):
+    if not cholesky(s, 6):
         out[:, :] = 0.0
         return False
     x = np.empty((6, 6))
@@ -390,7 +390,7 @@ def platform_response(K, fx, fy, fz, length, work):
     for i in range(6):
         tr += s[i, i]
     scaled = s.copy()
-    if not tr > 0.0 or not _cholesky(s, 6):
+    if not tr > 0.0 or not cholesky(s, 6):
         return 0.0, zero
     x = np.zeros((6, 6))
     for i in range(6):
@@ -414,4 +414,133 @@ def platform_response(K, fx, fy, fz, length, work):
     dx = x[0, 0] * fx + x[0, 1] * fy + x[0, 2] * fz
     dy = x[1, 0] * fx + x[1, 1] * fy + x[1, 2] * fz
     dz = x[2, 0] * fx + x[2, 1] * fy + x[2, 2] * fz
+    return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def leg_wrench_columns(C, N, n, A, col, work):
+    """The leg of compliance C (6x6 at ref) and constraint wrenches N[:, :n] as columns col..col+n-1 of A:
+    N L^-T with L L^T = N^T C N, so that the leg's stiffness is their outer-product sum (K_leg = N (N^T C N)^-1
+    N^T). Stacking every leg's columns gives the platform stiffness K = A A^T (platform_response_wrenches).
+    Returns the next free column, or -1 if N^T C N is not positive definite."""
+    m = work
+    for a in range(n):
+        for b in range(a, n):
+            s = 0.0
+            for i in range(6):
+                ci = 0.0
+                for j in range(6):
+                    ci += C[i, j] * N[j, b]
+                s += N[i, a] * ci
+            m[a, b] = s
+            m[b, a] = s
+    if not cholesky(m, n):
+        return -1
+    wrench_columns(m, N, n, A, col)
+    return col + n
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def wrench_columns(L, W, n, A, col):
+    """A[:, col:col+n] = W L^-T (L the lower Cholesky factor of a leg's flexibility on its wrench basis W[:, :n])."""
+    for i in range(6):
+        for a in range(n):
+            t = W[i, a]
+            for k in range(a):
+                t -= L[a, k] * A[i, col + k]
+            A[i, col + a] = t / L[a, a]
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def platform_response_wrenches(A, fx, fy, fz, length, work):
+    """(stiffness_min, deflection) as :func:`platform_response` for the platform stiffness K = A A^T, A (6x6) the
+    stacked wrench columns of the legs (a non-redundant mechanism: six in all), without forming K: with rotations
+    as arc lengths at ``length`` (A~ = S A, S = diag(1, 1, 1, 1/length, ...)), X = A~^-1 by LU with partial
+    pivoting, K~^-1 = X^T X and C_t = X[:, :3]^T X[:, :3]. Singular as in the reference solver (eigenvalue ratio of
+    K~ at most SINGULAR_RTOL; decided from tr(K~) tr(K~^-1), which bounds the ratio within a factor 36, and from
+    the eigenvalues where that bound cannot decide); ``work``: a 6x6 scratch. A is overwritten."""
+    zero = 0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else DEFLECTION_CAP
+    inv = 1.0 / length
+    tr = 0.0
+    for i in range(6):
+        for j in range(6):
+            if i >= 3:
+                A[i, j] *= inv
+            tr += A[i, j] * A[i, j]
+    if not tr > 0.0 or not math.isfinite(tr):
+        return 0.0, zero
+    piv = np.empty(6, dtype=np.int64)
+    for j in range(6):  # LU, partial pivoting, in place
+        p = j
+        big = abs(A[j, j])
+        for i in range(j + 1, 6):
+            if abs(A[i, j]) > big:
+                big = abs(A[i, j])
+                p = i
+        piv[j] = p
+        if not big > 0.0:
+            return 0.0, zero
+        if p != j:
+            for k in range(6):
+                A[j, k], A[p, k] = A[p, k], A[j, k]
+        d = 1.0 / A[j, j]
+        for i in range(j + 1, 6):
+            A[i, j] *= d
+            f = A[i, j]
+            for k in range(j + 1, 6):
+                A[i, k] -= f * A[j, k]
+    x = work  # X = A~^-1: solve A~ X = I
+    for c in range(6):
+        for i in range(6):
+            x[i, c] = 0.0
+        x[c, c] = 1.0
+    for j in range(6):  # apply the row swaps to I
+        p = piv[j]
+        if p != j:
+            for c in range(6):
+                x[j, c], x[p, c] = x[p, c], x[j, c]
+    for c in range(6):
+        for i in range(6):
+            t = x[i, c]
+            for k in range(i):
+                t -= A[i, k] * x[k, c]
+            x[i, c] = t
+        for i in range(5, -1, -1):
+            t = x[i, c]
+            for k in range(i + 1, 6):
+                t -= A[i, k] * x[k, c]
+            x[i, c] = t / A[i, i]
+    tri = 0.0
+    for i in range(6):
+        for j in range(6):
+            tri += x[i, j] * x[i, j]
+    if not tr * tri * SINGULAR_RTOL < 1.0:
+        if not math.isfinite(tri):
+            return 0.0, zero
+        # P A~ = L U, so K~ = A~ A~^T has the eigenvalues of (L U)(L U)^T
+        lu = np.zeros((6, 6))
+        for i in range(6):
+            for j in range(6):
+                t = A[i, j] if i <= j else 0.0
+                for k in range(min(i, j + 1)):
+                    t += A[i, k] * A[k, j]
+                lu[i, j] = t
+        w = np.linalg.eigvalsh(lu @ lu.T)
+        if not w[0] > SINGULAR_RTOL * w[5]:
+            return 0.0, zero
+    c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+    for k in range(6):
+        a0, a1, a2 = x[k, 0], x[k, 1], x[k, 2]
+        c00 += a0 * a0
+        c01 += a0 * a1
+        c02 += a0 * a2
+        c11 += a1 * a1
+        c12 += a1 * a2
+        c22 += a2 * a2
+    lci, cmin, cmax = sv_3x3(c00, c01, c02, c01, c11, c12, c02, c12, c22)
+    if not cmax > 0.0:
+        return 0.0, zero
+    dx = c00 * fx + c01 * fy + c02 * fz
+    dy = c01 * fx + c11 * fy + c12 * fz
+    dz = c02 * fx + c12 * fy + c22 * fz
     return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
