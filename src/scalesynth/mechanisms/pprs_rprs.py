@@ -48,6 +48,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     wrap_angle,
 )
+from scalesynth.stiffness.sections import check_positive_option, check_stiffness_options, stiffness_options
 
 SQRT3_2 = math.sqrt(3.0) / 2.0
 # spec §1.8 search box (mm); bounding_box never extends beyond it
@@ -70,6 +71,14 @@ _RAD = 27  # capsule radii of the 8 bodies, in LINK_RADII order
 _FREE_ONLY = 35  # 1: poses whose capsules overlap are unreachable
 _F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
 N_PACKED = 36
+
+# stiffness (scalesynth.stiffness, docs/stiffness.md): link groups, the columns B_i D_i (the vertical sliders and
+# chain 3's tilting prismatic) and the links D_i C_i; actuator stiffness defaults (assumptions, the paper gives none):
+# 2e4 N/mm for the five linear actuators (a small ball-screw axis), 1e8 N mm/rad (1e5 N m/rad, a servo with a stiff
+# precision reducer) for chain 3's revolute input beta
+LINK_GROUPS = ("column", "link")
+ACTUATOR_STIFFNESS = 2e4
+BETA_STIFFNESS = 1e8
 
 # capsules of the clearance field, in link_geometry's order, with their body (index into LINK_RADII)
 _SEGMENT_BODY = np.array([0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7], dtype=np.int64)
@@ -587,6 +596,8 @@ class PprsRprs(Mechanism):
                 options[name] = value
         links.check_radius_option(options, LINK_RADII)
         links.check_flag_option(options, "interference_free")
+        check_stiffness_options(options, 3, LINK_GROUPS)
+        check_positive_option(options, "beta_stiffness")
 
     # ----- kernel side -------------------------------------------------------------------------------
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
@@ -787,6 +798,85 @@ class PprsRprs(Mechanism):
         q = np.asarray(q, dtype=float)
         return [n for n, v, (lo, hi) in zip(JOINTS, q, self.joint_limits(options), strict=True) if not lo <= v <= hi]
 
+    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at O1 = (x, y, z) with the options'
+        orientation, working mode ``options.sigma``; raises InvalidPose outside the workspace (out of reach or an
+        actuator outside its limits). Joints as in joint_screws. Chains 1, 2: a rigid carriage at B_i = (u_i.C_i) u_i
+        on the rail (prismatic actuator w_i along u_i to the base), the column slider_i B_i -> D_i = B_i + s_i z
+        (prismatic actuator s_i along z between column and carriage at B_i), the link D_i C_i (revolute about u_i at
+        D_i, spherical at C_i). Chain 3: a rigid rocker at B3 = R u3 (revolute actuator beta about e3 to the base),
+        the column leg3 B3 -> D3 = B3 + s3 d3 (prismatic actuator s3 along d3 at B3), the link D3 C3 (revolute about
+        n3 = e3 x d3 at D3, spherical at C3). The platform C1 C2 C3 is rigid with reference point O1 (6 DOFs: x, y,
+        z and the small rotations rx, ry, rz about the fixed axes); the load is a force at O1. ``joints`` 'bonded'
+        welds the passive joints."""
+        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.sections import tube_section
+
+        x, y, z = self.check_vector("pose", pose, 3)
+        if self.point_kernel(self.pack(design, options), x, y, z) < 0.0:
+            raise InvalidPose(f"pose: ({x:g}, {y:g}, {z:g}) is outside the workspace (mode {options['sigma']}, "
+                              "actuator limits included)")
+        geo = Geometry.of(design, options)
+        X = self.full_pose(options, (x, y, z))
+        st = chain_state(geo, X, sigma_vector(options["sigma"]))
+        q = st.q
+        zhat = np.array([0.0, 0.0, 1.0])
+        k, k_beta = options["actuator_stiffness"], options["beta_stiffness"]
+        sec = {g: tube_section(options, g, "mm") for g in LINK_GROUPS}
+        links_, js = [], []
+
+        def unit(v):
+            v = np.asarray(v, dtype=float)
+            return v / np.linalg.norm(v)
+
+        def link(name, group, start, end):
+            s = sec[group]
+            d = unit(end - start)
+            up = zhat if abs(d[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+            links_.append(Link(name, group, np.array(start, float), np.array(end, float), s.EA, s.EI, s.EI, s.GJ, up))
+
+        def joint(name, kind, at, part_a, part_b, axes=(), stiffness=None):
+            if joints == "bonded" and stiffness is None:
+                kind, axes = "fixed", ()
+            js.append(Joint(name, kind, np.array(at, float), (part_a, part_b), tuple(unit(a) for a in axes),
+                            stiffness))
+
+        bodies = [Body("base", np.zeros(3))]
+        for i in (0, 1):
+            n = i + 1
+            u, c = geo.u[i], st.centres[i]
+            b = (u @ c) * u
+            d = b + q[3 + i] * zhat
+            bodies.append(Body(f"carriage{n}", b.copy()))
+            link(f"slider{n}", "column", b, d)
+            link(f"link{n}", "link", d, c)
+            joint(f"P_w{n}", "prismatic", b, f"carriage{n}", "base", (u,), k)
+            joint(f"P_s{n}", "prismatic", b, f"slider{n}.a", f"carriage{n}", (zhat,), k)
+            joint(f"R{n}", "revolute", d, f"slider{n}.b", f"link{n}.a", (u,))
+            joint(f"S{n}", "spherical", c, f"link{n}.b", "platform")
+        u3, e3, beta = geo.u[2], geo.e[2], q[2]
+        d3 = -math.cos(beta) * u3 + math.sin(beta) * zhat
+        b3 = geo.rail * u3
+        top = b3 + q[5] * d3
+        c3 = st.centres[2]
+        bodies.append(Body("rocker3", b3.copy()))
+        link("leg3", "column", b3, top)
+        link("link3", "link", top, c3)
+        joint("R_beta", "revolute", b3, "rocker3", "base", (e3,), k_beta)
+        joint("P_s3", "prismatic", b3, "leg3.a", "rocker3", (d3,), k)
+        joint("R3", "revolute", top, "leg3.b", "link3.a", (np.cross(e3, d3),))
+        joint("S3", "spherical", c3, "link3.b", "platform")
+        bodies.append(Body("platform", X[:3].copy()))
+        notes = ["spatial frame O-xyz of the paper (z up, mm); rigid platform C1C2C3 with reference point O1, "
+                 "DOFs x, y, z, rx, ry, rz (small rotations about the fixed axes); the load is a force at O1",
+                 f"orientation (phi, theta, psi) = {tuple(float(v) for v in X[3:])} rad, "
+                 f"working mode {options['sigma']}"]
+        if joints == "bonded":
+            notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
+        return FrameModel(3, "mm", tuple(links_), tuple(js), tuple(bodies), "platform",
+                          np.asarray(options["load"], float), tuple(notes))
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §1.2: chains PPRS, PPRS, RPRS; n = 11 (base, platform, three links per chain),
@@ -951,6 +1041,11 @@ MECHANISM = PprsRprs(
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 5, "
                "slider1/slider2/leg3 8, link1/link2/link3 5, platform 5 (illustrative)"),
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
+        *stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator (w1, w2, s1, s2, s3), "
+                           "N/mm (an assumption)", [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction "
+                           "(z up), at O1"),
+        Option("beta_stiffness", BETA_STIFFNESS, "stiffness: torsional stiffness of chain 3's revolute actuator beta, "
+               "N mm/rad (1e5 N m/rad, an assumption)"),
     ),
     default_length_unit="mm",
     fields=(*base_fields("1", "J = dx/dq, the twist of O1 with its angular part times angle_length and the beta "
