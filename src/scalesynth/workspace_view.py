@@ -69,15 +69,18 @@ def sample_fields(cfg, design: Mapping[str, float], resolution: int) -> FieldGri
     return FieldGrid(grid=g, lci=np.ascontiguousarray(lci), fields=fields)
 
 
-def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, resolution: int):
-    """LCI on the plane ``task axis normal = value`` only (the other axes at ``resolution`` cells over the grid box):
-    returns (2-D array indexed by the two remaining axes in order, their extent (a0, a1, b0, b1))."""
+def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, resolution: int, field: str = "lci"):
+    """A per-voxel field (default LCI) on the plane ``task axis normal = value`` only (the other axes at
+    ``resolution`` cells over the grid box): returns (2-D array indexed by the two remaining axes in order, their
+    extent (a0, a1, b0, b1)). Unreachable cells: LCI -1, any other field NaN."""
     mech = cfg.mech
+    slot = mech.field_names.index(check_field(mech, field))
     g = make_grid(mech, mech.resolve_design(design), cfg.resolved_options(), resolution, cfg.grid.region)
     lo, step, shape = g.lo.copy(), g.step.copy(), g.shape.copy()
     lo[normal] = value - 0.5 * step[normal]
     shape[normal] = 1
-    plane = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), lo, step, shape)[..., 0]
+    cells = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), lo, step, shape)
+    plane = cells[..., 0] if slot == 0 else np.where(cells[..., 0] >= 0, cells[..., slot], np.nan)
     others = [a for a in range(3) if a != normal]
     values = np.take(plane, 0, axis=normal)
     ext = []
