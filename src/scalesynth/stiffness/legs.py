@@ -471,3 +471,27 @@ def sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22):
     if r <= -1.0:
         return q + p
     return q + 2.0 * p * math.cos(math.acos(r) / 3.0)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def tip_bilinear(length, ea, ei, gj, ex, ey, ez, f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z):
+    """w1^T C w2 for two wrenches w = (F, M) at the tip of a round-section cantilever (length, unit axis e from
+    the clamp to the tip; EA, EI, GJ): C's translations (L/EA) e e^T + (L^3/3EI)(I - e e^T), rotations
+    (L/GJ) e e^T + (L/EI)(I - e e^T), coupling (L^2/2EI) e . (F1 x M2 + F2 x M1) (the blocks of
+    add_beam_compliance with EIy = EIz). Zero for a beam of zero length."""
+    if not length > 0.0:
+        return 0.0
+    a = length / ea
+    b = length * length * length / (3.0 * ei)
+    r = length / ei
+    t = length / gj
+    k = length * length / (2.0 * ei)
+    fe1 = f1x * ex + f1y * ey + f1z * ez
+    fe2 = f2x * ex + f2y * ey + f2z * ez
+    me1 = m1x * ex + m1y * ey + m1z * ez
+    me2 = m2x * ex + m2y * ey + m2z * ez
+    ff = f1x * f2x + f1y * f2y + f1z * f2z
+    mm = m1x * m2x + m1y * m2y + m1z * m2z
+    c1 = ex * (f1y * m2z - f1z * m2y) + ey * (f1z * m2x - f1x * m2z) + ez * (f1x * m2y - f1y * m2x)
+    c2 = ex * (f2y * m1z - f2z * m1y) + ey * (f2z * m1x - f2x * m1z) + ez * (f2x * m1y - f2y * m1x)
+    return b * ff + (a - b) * fe1 * fe2 + r * mm + (t - r) * me1 * me2 + k * (c1 + c2)
