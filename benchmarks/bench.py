@@ -219,6 +219,7 @@ def bench_compile() -> dict:
 STIFFNESS_CASES = (  # (label, config, module of the field kernel, kinematic slots, grid N per axis, designs)
     ("planar-fivebar", "fivebar_stiffness.yaml", "planar_fivebar", 3, 256, 40),
     ("ups-sspr", "ups_sspr.yaml", "ups_sspr", 3, 40, 20),
+    ("pprs-rprs", "pprs_rprs.yaml", "pprs_rprs", 4, 40, 20),  # kinematic part: LCI, sigmas and clearance
 )
 
 
@@ -400,7 +401,8 @@ def write_results_md() -> None:
                   "sigma_min, sigma_max (the field kernel without stiffness); `with stiffness` adds stiffness_min and",
                   "deflection (five-bar: closed-form per-leg condensation, 2x2 platform stiffness; ups-sspr: closed-form",
                   "per-chain condensation in the wrench form of `scalesynth.stiffness.legs`, 6x6 platform stiffness,",
-                  "3x3 Schur complement).", "",
+                  "3x3 Schur complement; pprs-rprs: closed-form per-chain condensation, `kinematic` there includes the",
+                  "clearance field).", "",
                   f"Conditions: NUMBA_NUM_THREADS=1 on the shared 2-core machine, load average {_load_text(rows)}, so",
                   "the absolute times are several times an idle machine's; the ratios come from one run.", "",
                   "| mechanism | designs x grid | kinematic (s) | with stiffness (s) | ns per reachable voxel, kinematic | "

@@ -272,11 +272,24 @@ def _stiffness(p, ox, oy, oz, c1x, c1y, c1z, s1, c2x, c2y, c2z, p2x, p2y, s2, c3
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
+    """Every field at O1 = (x, y, z) (see _fields): LCI, sigma_min, sigma_max, clearance, stiffness_min, deflection."""
+    _fields(p, x, y, z, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, x, y, z, out):
+    """Slots 0-3 only (LCI, sigma_min, sigma_max, clearance), for benchmarks (the cost without stiffness)."""
+    _fields(p, x, y, z, out, False)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, x, y, z, out, stiffness):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
     IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
     Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq, x = (O1, angle_length x angular
     velocity), the beta input times beta_length (dimensionless); clearance (mm) of the link capsules (with
-    interference_free, overlapping capsules make the pose unreachable)."""
+    interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, stiffness_min (N/mm) and
+    deflection (mm) at O1 under the packed load (ideal joints, docs/stiffness.md; _stiffness)."""
     c1x = x + p[_R1]
     c1y = y + p[_R1 + 1]
     c1z = z + p[_R1 + 2]
@@ -388,13 +401,14 @@ def point_fields(p, x, y, z, out):
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
         _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
         out[_F_CLEARANCE] = gap
-        if p[_FX] != 0.0 or p[_FX + 1] != 0.0 or p[_FX + 2] != 0.0:
+        if stiffness and (p[_FX] != 0.0 or p[_FX + 1] != 0.0 or p[_FX + 2] != 0.0):
             out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # stiffness_min 0
         return
     out[_F_CLEARANCE] = gap
-    out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(
-        p, x, y, z, c1x, c1y, c1z, s1, c2x, c2y, c2z, p2x, p2y, s2, c3x, c3y, c3z, b3x, b3y, d3x, d3y, d3z, s3,
-        -rho3 * u3x / mu3, -rho3 * u3y / mu3, h3 / mu3, e3x, e3y)
+    if stiffness:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(
+            p, x, y, z, c1x, c1y, c1z, s1, c2x, c2y, c2z, p2x, p2y, s2, c3x, c3y, c3z, b3x, b3y, d3x, d3y, d3z, s3,
+            -rho3 * u3x / mu3, -rho3 * u3y / mu3, h3 / mu3, e3x, e3y)
     # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
     inv_alen = 1.0 / p[_ALEN]
     a = np.empty((6, 6))
