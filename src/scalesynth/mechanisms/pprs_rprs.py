@@ -219,20 +219,11 @@ def _chain_columns(p, kk, ox, oy, oz, cx, cy, cz, bx, by, bz, dx, dy, dz, ax, ay
     rx, ry, rz = cx - ox, cy - oy, cz - oz
     # column 1: f1 / l11; column 2: (f2 - l21 f1 / l11) / l22; wrench (f, (C - O) x f)
     ux, uy, uz = lx * i11, ly * i11, lz * i11
-    kk = _outer_add(kk, ux, uy, uz, ry * uz - rz * uy, rz * ux - rx * uz, rx * uy - ry * ux)
+    kk = _legs_k.outer_add(kk, ux, uy, uz, ry * uz - rz * uy, rz * ux - rx * uz, rx * uy - ry * ux)
     t = l21 * i11
     vx, vy, vz = (nx - t * lx) * i22, (ny - t * ly) * i22, (nz - t * lz) * i22
-    kk = _outer_add(kk, vx, vy, vz, ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx)
+    kk = _legs_k.outer_add(kk, vx, vy, vz, ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx)
     return True, kk
-
-
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _outer_add(k, a0, a1, a2, a3, a4, a5):
-    """k + a a^T for the 21 upper entries k of a symmetric 6x6 matrix (row-major: 00, 01, ..., 05, 11, ..., 55)."""
-    return (k[0] + a0 * a0, k[1] + a0 * a1, k[2] + a0 * a2, k[3] + a0 * a3, k[4] + a0 * a4, k[5] + a0 * a5,
-            k[6] + a1 * a1, k[7] + a1 * a2, k[8] + a1 * a3, k[9] + a1 * a4, k[10] + a1 * a5,
-            k[11] + a2 * a2, k[12] + a2 * a3, k[13] + a2 * a4, k[14] + a2 * a5,
-            k[15] + a3 * a3, k[16] + a3 * a4, k[17] + a3 * a5, k[18] + a4 * a4, k[19] + a4 * a5, k[20] + a5 * a5)
 
 
 @njit(cache=True, fastmath=FASTMATH)

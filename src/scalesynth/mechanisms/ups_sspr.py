@@ -166,15 +166,6 @@ def point_fields(p, alpha, beta, yy, out):
         out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _outer_add(k, a0, a1, a2, a3, a4, a5):
-    """k + a a^T for the 21 upper entries k of a symmetric 6x6 matrix (row-major: 00, 01, ..., 05, 11, ..., 55)."""
-    return (k[0] + a0 * a0, k[1] + a0 * a1, k[2] + a0 * a2, k[3] + a0 * a3, k[4] + a0 * a4, k[5] + a0 * a5,
-            k[6] + a1 * a1, k[7] + a1 * a2, k[8] + a1 * a3, k[9] + a1 * a4, k[10] + a1 * a5,
-            k[11] + a2 * a2, k[12] + a2 * a3, k[13] + a2 * a4, k[14] + a2 * a5,
-            k[15] + a3 * a3, k[16] + a3 * a4, k[17] + a3 * a5, k[18] + a4 * a4, k[19] + a4 * a5, k[20] + a5 * a5)
-
-
 @njit(cache=True, fastmath=FASTMATH)
 def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
     """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model, by
@@ -220,7 +211,7 @@ def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
         s *= w  # u / sqrt(flexibility)
         ux, ue, uh = (dx * xx + dz * xz) * s, (dx * ex + dy * ey + dz * ez) * s, (dx * hx + dy * hy + dz * hz) * s
         bx, be, bh = rbx * xx + rbz * xz, rbx * ex + rby * ey + rbz * ez, rbx * hx + rby * hy + rbz * hz
-        kk = _outer_add(kk, ux, ue, uh, be * uh - bh * ue, bh * ux - bx * uh, bx * ue - be * ux)
+        kk = _legs_k.outer_add(kk, ux, ue, uh, be * uh - bh * ue, bh * ux - bx * uh, bx * ue - be * ux)
     # the (S+SPR)R chain in the frame (x, e, h): d = (0, de, dh), M - P = (0, me, mh)
     dx, dy, dz = K0 * px, K0 * py + am, K0 * pz  # B0 - M
     l1 = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -258,11 +249,11 @@ def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
     i22 = 1.0 / l22
     i33 = 1.0 / math.sqrt(q33)
     # columns W L^-T: f1 / l11, (f4 - l41 f1 / l11) / l44; f2 / l22, (f3 - l32 f2 / l22) / l33
-    kk = _outer_add(kk, 0.0, i11, 0.0, 0.0, 0.0, 0.0)
-    kk = _outer_add(kk, 0.0, (de - l41 * i11) * i44, fh4 * i44, m4 * i44, 0.0, 0.0)
-    kk = _outer_add(kk, i22, 0.0, 0.0, 0.0, 0.0, c * i22)
+    kk = _legs_k.outer_add(kk, 0.0, i11, 0.0, 0.0, 0.0, 0.0)
+    kk = _legs_k.outer_add(kk, 0.0, (de - l41 * i11) * i44, fh4 * i44, m4 * i44, 0.0, 0.0)
+    kk = _legs_k.outer_add(kk, i22, 0.0, 0.0, 0.0, 0.0, c * i22)
     t = l32 * i22
-    kk = _outer_add(kk, (1.0 - t) * i33, 0.0, 0.0, 0.0, mh * i33, (-me - t * c) * i33)
+    kk = _legs_k.outer_add(kk, (1.0 - t) * i33, 0.0, 0.0, 0.0, mh * i33, (-me - t * c) * i33)
     fx, fy, fz = p[_FX], p[_FY], p[_FZ]
     fxx, fe, fh = fx * xx + fz * xz, fx * ex + fy * ey + fz * ez, fx * hx + fy * hy + fz * hz
     length = max(0.5 * lmax, K0 * c)

@@ -44,13 +44,6 @@ DEFLECTION_CAP = SIGMA_CAP  # length unit: the per-voxel deflection at a singula
 # a joint twist whose part outside the span of the previous ones is below this (relative, rotations as arc lengths
 # at the characteristic length) adds no free direction (a dependent joint axis, e.g. at a leg's own singularity)
 DEPENDENT_RTOL = 1e-9
-N_SCRATCH = 8  # 6x6 matrices a voxel needs: see scratch()
-
-
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def scratch():
-    """Work space of one voxel: N_SCRATCH 6x6 matrices (one allocation)."""
-    return np.empty((N_SCRATCH, 6, 6))
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -388,6 +381,16 @@ def platform_response(K, fx, fy, fz, length):
     return _response(K[0, 0], K[0, 1], K[0, 2], K[1, 1], K[1, 2], K[2, 2], K[0, 3], K[0, 4], K[0, 5], K[1, 3],
                      K[1, 4], K[1, 5], K[2, 3], K[2, 4], K[2, 5], K[3, 3], K[3, 4], K[3, 5], K[4, 4], K[4, 5],
                      K[5, 5], fx, fy, fz, length)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def outer_add(k, a0, a1, a2, a3, a4, a5):
+    """k + a a^T for the 21 upper entries k of a symmetric 6x6 matrix (a tuple, row-major: 00, 01, ..., 05, 11, ...,
+    55): a kernel sums its legs' wrench columns a into K in scalars and hands k to response_upper."""
+    return (k[0] + a0 * a0, k[1] + a0 * a1, k[2] + a0 * a2, k[3] + a0 * a3, k[4] + a0 * a4, k[5] + a0 * a5,
+            k[6] + a1 * a1, k[7] + a1 * a2, k[8] + a1 * a3, k[9] + a1 * a4, k[10] + a1 * a5,
+            k[11] + a2 * a2, k[12] + a2 * a3, k[13] + a2 * a4, k[14] + a2 * a5,
+            k[15] + a3 * a3, k[16] + a3 * a4, k[17] + a3 * a5, k[18] + a4 * a4, k[19] + a4 * a5, k[20] + a5 * a5)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
