@@ -83,6 +83,8 @@ def test_run_report_has_stiffness_maps_with_units(tmp_path):
         for field in STIFFNESS_MAP_FIELDS:
             path = out / "plots" / f"sections_{field}_{name.replace(' ', '_')}.png"
             assert path.stat().st_size > 0 and f"plots/{path.name}" in report
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert html.count("deflection [mm]") >= len(featured)  # report.html: a deflection heatmap per featured design
     design = cfg.resolved_design()
     for field, unit in (("deflection", "[mm]"), ("stiffness_min", "[N/mm]")):
         svg = field_sections(cfg, design, field, "t", tmp_path, "x", "svg")
@@ -95,6 +97,7 @@ def test_no_stiffness_maps_without_stiffness_fields(tmp_path):
     run(config_from_dict(SMALL), out)
     plots = [p.name for p in (out / "plots").glob("sections_*")]
     assert plots and not [p for p in plots if any(f in p for f in STIFFNESS_MAP_FIELDS)]
+    assert "deflection" not in (out / "report.html").read_text(encoding="utf-8")
 
 
 def test_show_colours_by_deflection(tmp_path):
