@@ -74,10 +74,8 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
                          "path": None if path is None else path[:, :2]}
                 blocks.append(figs.html(ia.heatmap_figure(panel, "LCI"), 520))
             if "deflection" in mech.field_names:  # the stiffness map: the report's sections coloured by deflection
-                from scalesynth.report import map_range, section_panels
-
-                panels = section_panels(cfg, design, "deflection")
-                vmin, vmax = map_range(panels)
+                panels = wv.section_panels(cfg, design, "deflection")
+                vmin, vmax = wv.map_range(panels)
                 flabel = lab.field_label(mech, "deflection", unit)
                 for panel in panels:
                     blocks.append(figs.html(ia.heatmap_figure(panel, flabel, f"{caption}: {flabel}, {panel['title']}",
