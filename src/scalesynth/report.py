@@ -21,7 +21,8 @@ from scalesynth.evaluate import evaluate_config
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
-from scalesynth.workspace_view import (
+from scalesynth.workspace_view import (  # SECTION_RESOLUTION, section_panels: also report's (memory, tests)
+    SECTION_RESOLUTION,  # noqa: F401
     STIFFNESS_MAP_FIELDS,
     band_labels,
     map_range,
