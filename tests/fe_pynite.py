@@ -102,10 +102,10 @@ def _fold_actuators(model: dict) -> tuple[dict[str, dict], list[dict]]:
     * a prismatic actuator between a link end and a body or the base, the link along the sliding axis: the link's
       axial compliance adds the spring's, L/EA_eff = L/EA + 1/k (the joint passes every other force and moment and
       the link's axial force is constant), and the joint becomes a weld;
-    * an actuator between a body and the base (prismatic or revolute): a spring member of length ell along the
-      axis from a base node at ``at - ell axis`` to the joint point, axially (prismatic, EA = k ell) or
-      torsionally (revolute, GJ = k ell) elastic and rigid in every other direction (its other rigidities are
-      marked None and set to the rigid penalty), welded to the body.
+    * an actuator between a body and the base (prismatic or revolute), or a revolute one between a link end and
+      the base: a spring member of length ell along the axis from a base node at ``at - ell axis`` to the joint
+      point, axially (prismatic, EA = k ell) or torsionally (revolute, GJ = k ell) elastic and rigid in every
+      other direction (its other rigidities are marked None and set to the rigid penalty), welded to the part.
 
     Returns the links by name and the joints."""
     links = {link["name"]: dict(link) for link in model["links"]}
@@ -119,8 +119,7 @@ def _fold_actuators(model: dict) -> tuple[dict[str, dict], list[dict]]:
             continue
         axis = np.asarray(j["axes"][0], dtype=float)
         k = stiffness[j["name"]]
-        if ends:
-            assert j["kind"] == "prismatic", "an actuated revolute on a link end: not needed yet"
+        if ends and j["kind"] == "prismatic":
             name, end = ends[0].split(".")
             link = links[name]
             d = np.subtract(link["to"], link["from"])
@@ -129,7 +128,7 @@ def _fold_actuators(model: dict) -> tuple[dict[str, dict], list[dict]]:
             link["EA"] = link["length"] / (link["length"] / link["EA"] + 1.0 / k)
             joints.append(dict(j, kind="fixed", axes=[]))
             continue
-        body = next(p for p in j["parts"] if p != "base")
+        body = next(p for p in j["parts"] if p != "base")  # a body or a link end
         assert "base" in j["parts"], "an actuator between two bodies: not needed yet"
         aux = f"act_{j['name']}"
         start = list(np.asarray(j["at"], dtype=float) - ell * axis)
@@ -140,6 +139,48 @@ def _fold_actuators(model: dict) -> tuple[dict[str, dict], list[dict]]:
                        "axes": []})
         joints.append({"name": j["name"], "kind": "fixed", "at": j["at"], "parts": [f"{aux}.b", body], "axes": []})
     return links, joints
+
+
+def _slide_stack(model: dict) -> tuple[dict, dict]:
+    """Rigid bodies joined to the base and the platform only by prismatic joints at the platform's reference point
+    (seed 000's PPaP chain): the platform's rotations are held rigidly, its translations along the passive slides are
+    free and along an actuated slide a spring. Returns the model without them and the platform node's supports
+    {"DX": True | False | stiffness, ..., "RX": True, ...}; the free, held and sprung directions must be global
+    axes (PyNite's supports and support springs are)."""
+    platform = model["platform"]["body"]
+    bodies = {b["name"] for b in model["bodies"]} - {"base", platform}
+    slides = [j for j in model["joints"] if j["kind"] == "prismatic" and all("." not in p for p in j["parts"])]
+    stack, frontier = [], [platform]
+    while frontier:  # the slides reachable from the platform through bodies
+        body = frontier.pop()
+        for j in slides:
+            if body in j["parts"] and j not in stack:
+                stack.append(j)
+                frontier += [p for p in j["parts"] if p not in ("base", platform, body)]
+    if not stack:
+        return model, {}
+    ref = np.asarray(model["platform"]["point"], dtype=float)
+    stiffness = {a["joint"]: a["stiffness"] for a in model["actuators"]}
+    used = {p for j in stack for p in j["parts"]} - {"base", platform}
+    assert used <= bodies and not any(p in used for j in model["joints"] if j not in stack for p in j["parts"])
+    assert all(np.allclose(j["at"], ref) for j in stack), "slides away from the platform's reference point"
+    free = np.array([j["axes"][0] for j in stack if j["name"] not in stiffness]).reshape(-1, 3)
+    supports = {"RX": True, "RY": True, "RZ": True}
+    for d, axis in zip(("DX", "DY", "DZ"), np.eye(3), strict=True):
+        sprung = [stiffness[j["name"]] for j in stack if j["name"] in stiffness and abs(abs(axis @ j["axes"][0]) - 1)
+                  < 1e-12]
+        in_free = free.size and np.linalg.matrix_rank(np.vstack([free, axis]), 1e-12) == np.linalg.matrix_rank(free)
+        if in_free:
+            supports[d] = False
+        elif sprung:
+            supports[d] = sprung[0]
+        else:
+            supports[d] = True
+    assert np.linalg.matrix_rank(free) == sum(v is False for v in supports.values()), "slides not on global axes"
+    rest = dict(model, joints=[j for j in model["joints"] if j not in stack],
+                actuators=[a for a in model["actuators"] if a["joint"] not in {j["name"] for j in stack}],
+                bodies=[b for b in model["bodies"] if b["name"] not in used])
+    return rest, supports
 
 
 def _merge_prismatic(model: dict) -> tuple[list[dict], list[dict]]:
@@ -174,11 +215,16 @@ def _distance(p, a, b) -> float:
 
 
 def _oriented(fe, member: str, axis) -> None:
-    """Rotate a member about its own axis so that its local z axis is ``axis`` (which must be normal to it)."""
+    """Rotate a member about its own axis so that its local z axis is ``axis`` (which must be normal to it). The
+    angle is measured from PyNite's default orientation, so a second call (a member with a revolute at each end)
+    must ask for the same axis."""
     m = fe.members[member]
-    dc = m.T()[:3, :3]  # rows: local x, y, z
     a = np.asarray(axis, dtype=float)
     a = a / np.linalg.norm(a)
+    if m.rotation != 0.0:
+        assert abs(abs(a @ m.T()[2, :3]) - 1.0) < 1e-9, "two revolute releases about different axes on one member"
+    m.rotation = 0.0
+    dc = m.T()[:3, :3]  # rows: local x, y, z of the default orientation
     assert abs(a @ dc[0]) < 1e-9, "a revolute axis along a member cannot be a member end release"
     m.rotation = float(np.degrees(np.arctan2(-(a @ dc[1]), a @ dc[2])))
 
@@ -194,7 +240,8 @@ def solve_model_3d(model: dict, rigid: float = RIGID) -> np.ndarray:
     PyNite would join it to a member it lies on) and back to a second node X' = X + 1e-6 ell a1
     (PyNite splits a member at every node on it, so X' must not coincide with X; the offset is normal to a2 and n so
     that both releases are about axes normal to their member): the first released about a1 at X, the second about
-    a2 at X', the member starting at X'."""
+    a2 at X', the member starting at X'. Slide stacks (_slide_stack) become supports of the platform's node."""
+    model, stack_supports = _slide_stack(model)
     links, joints = _merge_prismatic(model)
     fe = FEModel3D()
     nodes: dict[tuple, str] = {}
@@ -292,11 +339,16 @@ def solve_model_3d(model: dict, rigid: float = RIGID) -> np.ndarray:
         for p, off in ((link["from"], 0), (link["to"], 6)):
             if not all(releases[link["name"]][off + 3 : off + 6]):
                 held.add(node(p))
+    p = node(model["platform"]["point"])
     for n in nodes.values():
         free_rot = n not in held  # no member holds its rotations: support them (they carry nothing)
-        fe.def_support(n, n in supported, n in supported, n in supported, n in supported or free_rot,
-                       n in supported or free_rot, n in supported or free_rot)
-    p = node(model["platform"]["point"])
+        fixed = [n in supported] * 3 + [n in supported or free_rot] * 3
+        if n == p and stack_supports:
+            fixed = [stack_supports[d] is True for d in ("DX", "DY", "DZ", "RX", "RY", "RZ")]
+            for d in ("DX", "DY", "DZ"):
+                if stack_supports[d] not in (True, False):
+                    fe.def_support_spring(n, d, float(stack_supports[d]), None)
+        fe.def_support(n, *fixed)
     for d, f in zip(("FX", "FY", "FZ"), model["load"]["force"], strict=True):
         fe.add_node_load(p, d, float(f))
     fe.analyze_linear(check_stability=False)

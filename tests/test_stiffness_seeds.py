@@ -8,6 +8,7 @@ actuator-only model built from the mechanism's own Jacobian; deflection linear i
 infinite, never NaN; bad input is one line naming it, exit 2."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -38,6 +39,30 @@ def scaled(C, length):
 
 def cli(*args):
     return CliRunner().invoke(app, ["stiffness", *args])
+
+
+def assert_converges(gaps):
+    """Gaps to the rigid-link limit at three decades of link stiffness: < 1e-4 at the last, 10x smaller per decade."""
+    assert gaps[2] < 1e-4
+    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+
+
+def assert_spd(model, dofs):
+    """Not singular, platform DOFs ``dofs``, K symmetric positive definite."""
+    res = solve(model)
+    assert not res.singular and res.dofs == dofs and res.K.shape == (len(dofs), len(dofs))
+    assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
+    assert np.linalg.eigvalsh(res.K)[0] > 0
+
+
+def assert_linear(model_with_load):
+    """Superposition: the deflection under f1 + f2 is the sum of those under f1 and f2 (to 1e-12)."""
+    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
+    d1, d2, d3 = (solve(model_with_load(f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
+    assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+
+
+SPATIAL = ("x", "y", "z", "rx", "ry", "rz")
 
 
 # ----- seed 001: pprs-rprs ----------------------------------------------------------------------------------------
@@ -81,19 +106,13 @@ def test_pprs_rprs_rigid_links_give_the_jacobian_model():
     for e in (1e3, 1e4, 1e5):
         C = solve(pprs_model(pose, youngs_modulus=70 * e, actuator_stiffness=k, beta_stiffness=kb)).C
         gaps.append(np.max(np.abs(scaled(C - cj, r))) / np.max(np.abs(scaled(cj, r))))
-    assert gaps[2] < 1e-4
-    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+    assert_converges(gaps)
 
 
 def test_pprs_rprs_spd_and_linear():
     for pose in PPRS_POSES:
-        res = solve(pprs_model(pose))
-        assert not res.singular and res.K.shape == (6, 6) and res.dofs == ("x", "y", "z", "rx", "ry", "rz")
-        assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
-        assert np.linalg.eigvalsh(res.K)[0] > 0
-    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
-    d1, d2, d3 = (solve(pprs_model(PPRS_POSES[0], load=f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
-    assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+        assert_spd(pprs_model(pose), SPATIAL)
+    assert_linear(lambda f: pprs_model(PPRS_POSES[0], load=f))
     # the default load is 150 N along -z (gravity) at O1
     assert pprs_model(PPRS_POSES[0]).to_dict()["load"]["force"] == [0.0, 0.0, -150.0]
 
@@ -210,21 +229,15 @@ def test_rps_upu_rigid_links_give_the_jacobian_model(mech, pose, opts):
     for e in (1e2, 1e3, 1e4):
         C = solve(rps_model(mech, pose, youngs_modulus=70 * e, actuator_stiffness=k, **opts)).C
         gaps.append(np.max(np.abs(scaled(C - cj, h))) / np.max(np.abs(scaled(cj, h))))
-    assert gaps[2] < 1e-4
-    assert gaps[0] / gaps[1] == pytest.approx(10, rel=0.05) and gaps[1] / gaps[2] == pytest.approx(10, rel=0.05)
+    assert_converges(gaps)
 
 
 def test_rps_upu_spd_and_linear():
     for mech, pose, opts in ([(RPS, p, o) for p, o in RPS_POSES] + [(TOOL, p, o) for p, o in TOOL_POSES]
                              + [(RPS, p, {"model": "C", "c3_variant": "upu"}) for p in UPU_POSES]):
-        res = solve(rps_model(mech, pose, **opts))
-        assert not res.singular and res.K.shape == (6, 6) and res.dofs == ("x", "y", "z", "rx", "ry", "rz")
-        assert np.max(np.abs(res.K - res.K.T)) <= 1e-10 * np.max(np.abs(res.K))
-        assert np.linalg.eigvalsh(res.K)[0] > 0
-    f1, f2 = [5.0, -7.0, -150.0], [30.0, 10.0, 2.0]
+        assert_spd(rps_model(mech, pose, **opts), SPATIAL)
     for mech, pose in ((RPS, RPS_POSES[0][0]), (TOOL, TOOL_POSES[1][0])):
-        d1, d2, d3 = (solve(rps_model(mech, pose, load=f)).deflection for f in (f1, f2, list(np.add(f1, f2))))
-        assert np.max(np.abs(d3 - d1 - d2)) < 1e-12 * np.linalg.norm(d3)
+        assert_linear(lambda f, mech=mech, pose=pose: rps_model(mech, pose, load=f))
 
 
 def test_rps_upu_frame_is_the_constraint_consistent_placement():
@@ -280,5 +293,101 @@ def test_rps_upu_cli_model_rebuilds_in_pynite(name, pose):
 ])
 def test_rps_upu_bad_input(name, args, field):
     bad = cli(name, *args)
+    assert bad.exit_code == 2 and bad.output.strip().startswith(f"error: {field}"), bad.output
+    assert len(bad.output.strip().splitlines()) == 1
+
+
+# ----- seed 000: 2pauu-ppap ---------------------------------------------------------------------------------------
+PAUU = get("2pauu-ppap")
+PAUU_DESIGN = PAUU.resolve_design({})  # Table-4 group 1 (m): m 0.857, n 0.706, l1 1.499, l2 1.5, c 0.1
+# P (m), mode ++, from a 31^3 grid of the workspace box: its centroid (0, 0, 0.2), the figure's pose, the grid points
+# nearest five box corners (two of them near-singular, LCI 0.0088 and 0.0091) and a pose 0.1 m above the forward
+# singularity at (0, 0.5, 1.00703) (PAUU_SINGULAR; LCI 0.059)
+PAUU_POSES = [(0.0, 0.0, 0.2), (0.25, 0.35, 1.6), (1.32906667, 1.4, 1.59953333), (1.32906667, -1.1, 2.19933333),
+              (-1.89866667, -1.1, -1.19953333), (1.32906667, -1.3, -1.39946667), (-1.32906667, 1.4, -1.19953333),
+              (0.0, 0.5, 1.107)]
+PAUU_SINGULAR = (0.0, 0.5, 1.007026948643399)  # det Jx = 0 (the l2 links' xz-projections parallel), bisected
+
+
+def pauu_model(pose, joints="ideal", **opts):
+    return PAUU.stiffness_model(PAUU_DESIGN, PAUU.resolve_options(opts), pose, joints)
+
+
+@pytest.mark.parametrize("joints", ["ideal", "bonded"])
+@pytest.mark.parametrize("pose", PAUU_POSES)
+def test_2pauu_ppap_against_pynite(pose, joints):
+    # measured <= 1.5e-4 (the near-singular pose; PyNite's rigid-member penalty 1e4 ideal, 1e5 bonded)
+    m = pauu_model(pose, joints, load=[10.0, 20.0, -150.0])
+    assert fe_gap(m, 1e4 if joints == "ideal" else 1e5) < FE_TOL
+
+
+def test_2pauu_ppap_rigid_links_give_the_jacobian_model():
+    """Links e times stiffer: the compliance of P (platform DOFs x, y, z: the PPaP chain holds the rotations)
+    tends to J K_q^-1 J^T, J = Jx^-1 Jq of the kinematics (P_dot = J q_dot), K_q = diag(k, k, k_d), gap ~ 1/e
+    (1.5 m links of 40 x 3 tubes are soft: the gap is 1.2 % at 1e3, so the decades run 1e4 ... 1e6)."""
+    pose = (0.25, 0.35, 1.6)
+    k, kd = 1e5, 2e7
+    opts = PAUU.resolve_options({})
+    (q,) = [s.values for s in PAUU.inverse_kinematics(PAUU_DESIGN, opts, pose) if s.label == "++"]
+    J = PAUU.jacobians(PAUU_DESIGN, opts, pose, q)["J"]
+    cj = J @ np.diag([1 / k, 1 / k, 1 / kd]) @ J.T
+    gaps = []
+    for e in (1e4, 1e5, 1e6):
+        res = solve(pauu_model(pose, youngs_modulus=70 * e, actuator_stiffness=k, stroke_stiffness=kd))
+        assert res.dofs == ("x", "y", "z")
+        gaps.append(np.max(np.abs(res.C - cj)) / np.max(np.abs(cj)))
+    assert_converges(gaps)
+
+
+def test_2pauu_ppap_spd_linear_and_parallelograms_matter():
+    for pose in PAUU_POSES:
+        assert_spd(pauu_model(pose), ("x", "y", "z"))
+    assert_linear(lambda f: pauu_model(PAUU_POSES[1], load=f))
+    # where the platform is off the xz-plane (y != 0) the arm links carry load (the U-U links' constraint couples and
+    # their y forces bend the parallelograms out of plane): a 10x thinner-walled arm link makes the platform 41 %
+    # softer at this corner (measured 1.409); at y = 0 the U-U links lie in the xz-plane, nothing loads the arm
+    # links out of plane and, as in seed 004's five-bar, the moment balance of the hinge plate leaves them unloaded
+    def ratio(pose):
+        thin = solve(pauu_model(pose, sections={"arm_link": [0.04, 0.0003]})).deflection_norm
+        return thin / solve(pauu_model(pose)).deflection_norm
+
+    assert ratio(PAUU_POSES[2]) > 1.3
+    assert ratio(PAUU_POSES[0]) == pytest.approx(1.0, abs=1e-8)
+
+
+def test_2pauu_ppap_singular_pose_is_infinite():
+    out = cli("2pauu-ppap", "--pose=" + ",".join(repr(v) for v in PAUU_SINGULAR), "--json")
+    assert out.exit_code == 0, out.output
+    assert "NaN" not in out.output
+    data = json.loads(out.output)
+    assert data["singular"] and data["deflection"] == ["inf"] * 3 and data["stiffness_min"] == 0.0
+    assert data["dofs"] == ["x", "y", "z"] and data["units"]["length"] == "m"
+    near = solve(pauu_model((0.0, 0.5, 1.057)))  # 5 cm above: finite, far softer than 10 cm above
+    assert not near.singular and near.deflection_norm > 3 * solve(pauu_model(PAUU_POSES[7])).deflection_norm
+
+
+def test_2pauu_ppap_cli_model_rebuilds_in_pynite():
+    out = cli("2pauu-ppap", "--pose=1.32906667,-1.1,2.19933333", "--load=0,30,-150", "--json")
+    assert out.exit_code == 0, out.output
+    data = json.loads(out.output)
+    assert data["branch"] == "++" and data["dofs"] == ["x", "y", "z"]
+    kinds = sorted((a["kind"], a["stiffness_unit"]) for a in data["model"]["actuators"])
+    assert kinds == [("prismatic", "N/m"), ("revolute", "N*m/rad"), ("revolute", "N*m/rad")]
+    assert data["model"]["links"][0]["EA"] == pytest.approx(70e9 * math.pi / 4 * (0.04**2 - 0.034**2), rel=1e-12)
+    gap = np.max(np.abs(np.subtract(data["deflection"], solve_model(data["model"]))))
+    assert gap < FE_TOL * data["deflection_norm"]
+
+
+@pytest.mark.parametrize("args, field", [
+    (["--pose=0,0,5"], "pose"),  # out of reach
+    (["--pose=0.25,0.35,1.6", "--load=1,2"], "--load"),
+    (["--pose=0.25,0.35,1.6", "--set", "youngs_modulus=0"], "options.youngs_modulus"),
+    (["--pose=0.25,0.35,1.6", "--set", "tube=[0.04, 0.03]"], "options.tube"),
+    (["--pose=0.25,0.35,1.6", "--set", "sections={arm_link: [-0.04, 0.003]}"], "options.sections.arm_link[0]"),
+    (["--pose=0.25,0.35,1.6", "--set", "actuator_stiffness=-1e5"], "options.actuator_stiffness"),
+    (["--pose=0.25,0.35,1.6", "--set", "stroke_stiffness=0"], "options.stroke_stiffness"),
+])
+def test_2pauu_ppap_bad_input(args, field):
+    bad = cli("2pauu-ppap", *args)
     assert bad.exit_code == 2 and bad.output.strip().startswith(f"error: {field}"), bad.output
     assert len(bad.output.strip().splitlines()) == 1

@@ -925,7 +925,8 @@ class PprsRprs(Mechanism):
         n3 = e3 x d3 at D3, spherical at C3). The platform C1 C2 C3 is rigid with reference point O1 (6 DOFs: x, y,
         z and the small rotations rx, ry, rz about the fixed axes); the load is a force at O1. ``joints`` 'bonded'
         welds the passive joints."""
-        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
+        from scalesynth.stiffness.builder import FrameBuilder
+        from scalesynth.stiffness.model import Body
         from scalesynth.stiffness.sections import tube_section
 
         x, y, z = self.check_vector("pose", pose, 3)
@@ -938,25 +939,7 @@ class PprsRprs(Mechanism):
         q = st.q
         zhat = np.array([0.0, 0.0, 1.0])
         k, k_beta = options["actuator_stiffness"], options["beta_stiffness"]
-        sec = {g: tube_section(options, g, "mm") for g in LINK_GROUPS}
-        links_, js = [], []
-
-        def unit(v):
-            v = np.asarray(v, dtype=float)
-            return v / np.linalg.norm(v)
-
-        def link(name, group, start, end):
-            s = sec[group]
-            d = unit(end - start)
-            up = zhat if abs(d[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-            links_.append(Link(name, group, np.array(start, float), np.array(end, float), s.EA, s.EI, s.EI, s.GJ, up))
-
-        def joint(name, kind, at, part_a, part_b, axes=(), stiffness=None):
-            if joints == "bonded" and stiffness is None:
-                kind, axes = "fixed", ()
-            js.append(Joint(name, kind, np.array(at, float), (part_a, part_b), tuple(unit(a) for a in axes),
-                            stiffness))
-
+        fb = FrameBuilder({g: tube_section(options, g, "mm") for g in LINK_GROUPS}, joints)
         bodies = [Body("base", np.zeros(3))]
         for i in (0, 1):
             n = i + 1
@@ -964,33 +947,30 @@ class PprsRprs(Mechanism):
             b = (u @ c) * u
             d = b + q[3 + i] * zhat
             bodies.append(Body(f"carriage{n}", b.copy()))
-            link(f"slider{n}", "column", b, d)
-            link(f"link{n}", "link", d, c)
-            joint(f"P_w{n}", "prismatic", b, f"carriage{n}", "base", (u,), k)
-            joint(f"P_s{n}", "prismatic", b, f"slider{n}.a", f"carriage{n}", (zhat,), k)
-            joint(f"R{n}", "revolute", d, f"slider{n}.b", f"link{n}.a", (u,))
-            joint(f"S{n}", "spherical", c, f"link{n}.b", "platform")
+            fb.link(f"slider{n}", "column", b, d)
+            fb.link(f"link{n}", "link", d, c)
+            fb.joint(f"P_w{n}", "prismatic", b, f"carriage{n}", "base", (u,), k)
+            fb.joint(f"P_s{n}", "prismatic", b, f"slider{n}.a", f"carriage{n}", (zhat,), k)
+            fb.joint(f"R{n}", "revolute", d, f"slider{n}.b", f"link{n}.a", (u,))
+            fb.joint(f"S{n}", "spherical", c, f"link{n}.b", "platform")
         u3, e3, beta = geo.u[2], geo.e[2], q[2]
         d3 = -math.cos(beta) * u3 + math.sin(beta) * zhat
         b3 = geo.rail * u3
         top = b3 + q[5] * d3
         c3 = st.centres[2]
         bodies.append(Body("rocker3", b3.copy()))
-        link("leg3", "column", b3, top)
-        link("link3", "link", top, c3)
-        joint("R_beta", "revolute", b3, "rocker3", "base", (e3,), k_beta)
-        joint("P_s3", "prismatic", b3, "leg3.a", "rocker3", (d3,), k)
-        joint("R3", "revolute", top, "leg3.b", "link3.a", (np.cross(e3, d3),))
-        joint("S3", "spherical", c3, "link3.b", "platform")
+        fb.link("leg3", "column", b3, top)
+        fb.link("link3", "link", top, c3)
+        fb.joint("R_beta", "revolute", b3, "rocker3", "base", (e3,), k_beta)
+        fb.joint("P_s3", "prismatic", b3, "leg3.a", "rocker3", (d3,), k)
+        fb.joint("R3", "revolute", top, "leg3.b", "link3.a", (np.cross(e3, d3),))
+        fb.joint("S3", "spherical", c3, "link3.b", "platform")
         bodies.append(Body("platform", X[:3].copy()))
         notes = ["spatial frame O-xyz of the paper (z up, mm); rigid platform C1C2C3 with reference point O1, "
                  "DOFs x, y, z, rx, ry, rz (small rotations about the fixed axes); the load is a force at O1",
                  f"orientation (phi, theta, psi) = {tuple(float(v) for v in X[3:])} rad, "
                  f"working mode {options['sigma']}"]
-        if joints == "bonded":
-            notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
-        return FrameModel(3, "mm", tuple(links_), tuple(js), tuple(bodies), "platform",
-                          np.asarray(options["load"], float), tuple(notes))
+        return fb.model("mm", bodies, options["load"], notes)
 
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):

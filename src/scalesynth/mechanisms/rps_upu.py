@@ -565,6 +565,7 @@ class RpsUpu(Mechanism):
             raise InvalidParameter(f"options.model: must be 'P' or 'C', got {options['model']!r}")
         if options["c3_variant"] not in C3_VARIANTS:
             raise InvalidParameter(f"options.c3_variant: must be 'plane' or 'upu', got {options['c3_variant']!r}")
+        check_stiffness_options(options, 3, LINK_GROUPS)
         self._check_limits(options)
         length = options["characteristic_length"]
         if length is not None:
@@ -574,7 +575,6 @@ class RpsUpu(Mechanism):
                 raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
             options["characteristic_length"] = float(length)
         links.check_radius_option(options, LINK_RADII)
-        check_stiffness_options(options, 3, LINK_GROUPS)
 
     @staticmethod
     def _check_limits(options: dict[str, Any]) -> None:
@@ -768,96 +768,6 @@ class RpsUpu(Mechanism):
             return np.full((3, 3), np.inf)
         return jac["dq_dx"]
 
-    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
-    def _in_box(self, options, x) -> bool:
-        return all(options[name][0] <= v <= options[name][1]
-                   for name, v in zip(("z_range", "theta_range", "psi_range"), x, strict=True))
-
-    def _stiffness_placement(self, design, options, pose) -> tuple[np.ndarray, str, np.ndarray]:
-        """(z, theta, psi) of the constraint-consistent (C-model) frame, its chain-3 variant and the platform
-        reference point (O'); raises InvalidPose outside the workspace box, the configured model's workspace or the
-        C-model's stroke limits."""
-        x = self.check_vector("pose", pose, 3)
-        variant = options["c3_variant"]
-        c_opts = {**options, "model": "C"}
-        if (not self._in_box(options, x) or self.point_kernel(self.pack(design, options), *x) < 0.0
-                or self.point_kernel(self.pack(design, c_opts), *x) < 0.0):
-            raise InvalidPose(f"pose: ({', '.join(f'{v:g}' for v in x)}) is outside the workspace (box and stroke "
-                              f"limits of the {options['model']}-model and of the C-model frame)")
-        return x, variant, RpsUpu.platform_pose(self, design, c_opts, x)["p"]
-
-    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
-        """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at a pose (z, theta, psi) of the
-        constraint-consistent placement (the C-model with the configured chain-3 variant: the P-model violates the
-        RPS joint constraints, spec §2.3, so its joints would not assemble); raises InvalidPose outside the workspace
-        box, the configured model's stroke limits or the C-model's. Joints as in joint_screws: RPS_i (revolute about
-        x at A_i, a prismatic actuator spring between cylinder and rod, each half the leg, spherical at B_i); chain 3
-        'plane': revolute about y at A3, prismatic actuator, spherical at B3; 'upu': universal (x, m) at A3,
-        prismatic actuator, universal (m, w) at B3, m = x X w. The platform B1B2B3 is rigid, reference point O' (6
-        DOFs: x, y, z and the small rotations rx, ry, rz about the fixed axes); the load is a force at O'.
-        ``joints`` 'bonded' welds the passive joints."""
-        x, variant, ref = self._stiffness_placement(design, options, pose)
-        return self._frame(design, options, x, variant, ref, joints)
-
-    def _frame(self, design, options, x, variant, ref, joints):
-        from scalesynth.stiffness.model import Body, FrameModel, Joint, Link
-        from scalesynth.stiffness.sections import tube_section
-
-        g, h, c, e = self._geom(design)
-        plat = RpsUpu.platform_pose(self, design, {**options, "model": "C", "c3_variant": variant}, x)
-        rot, p = plat["R"], plat["p"]
-        base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
-        top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
-        k = options["actuator_stiffness"]
-        sec = tube_section(options, "leg", "mm")
-        xhat, yhat = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-        links_, js = [], []
-
-        def unit(v):
-            v = np.asarray(v, dtype=float)
-            return v / np.linalg.norm(v)
-
-        def joint(name, kind, at, part_a, part_b, axes=(), stiffness=None):
-            if joints == "bonded" and stiffness is None:
-                kind, axes = "fixed", ()
-            js.append(Joint(name, kind, np.array(at, float), (part_a, part_b), tuple(unit(a) for a in axes),
-                            stiffness))
-
-        w = rot[:, 2]
-        m_axis = unit(np.cross(xhat, w))
-        for i in range(3):
-            n = i + 1
-            a, b = base[i], top[i]
-            mid = 0.5 * (a + b)
-            d = unit(b - a)
-            up = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.9 else xhat
-            for name, s0, s1 in ((f"cylinder{n}", a, mid), (f"rod{n}", mid, b)):
-                links_.append(Link(name, "leg", s0.copy(), s1.copy(), sec.EA, sec.EI, sec.EI, sec.GJ, up))
-            if n < 3:
-                joint(f"R{n}", "revolute", a, f"cylinder{n}.a", "base", (xhat,))
-            elif variant == "upu":
-                joint("U3_base", "universal", a, "cylinder3.a", "base", (xhat, m_axis))
-            else:
-                joint("R3", "revolute", a, "cylinder3.a", "base", (yhat,))
-            joint(f"P{n}", "prismatic", mid, f"cylinder{n}.b", f"rod{n}.a", (b - a,), k)
-            if n == 3 and variant == "upu":
-                joint("U3_platform", "universal", b, "rod3.b", "platform", (m_axis, w))
-            else:
-                joint(f"S{n}", "spherical", b, f"rod{n}.b", "platform")
-        bodies = (Body("base", np.zeros(3)), Body("platform", np.asarray(ref, float).copy()))
-        notes = [f"spatial frame O-xyz of spec §2.1 (z up, mm) at the constraint-consistent (C-model, chain 3 "
-                 f"'{variant}') placement of (z, theta, psi) = ({', '.join(f'{v:g}' for v in x)}): yaw phi = "
-                 f"{plat['phi']:.6g} rad, y0 = {plat['y0']:.6g} mm",
-                 "rigid platform B1B2B3, DOFs x, y, z, rx, ry, rz (small rotations about the fixed axes) at its "
-                 "reference point; the load is a force there"]
-        if options.get("model", "P") == "P":
-            notes.append("the P-model violates the RPS joint constraints (spec §2.3): the frame uses the C-model "
-                         "placement")
-        if joints == "bonded":
-            notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
-        return FrameModel(3, "mm", tuple(links_), tuple(js), bodies, "platform", np.asarray(options["load"], float),
-                          tuple(notes))
-
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
@@ -906,6 +816,80 @@ class RpsUpu(Mechanism):
             chains.append(chain_screws([Joint("R", base[2], ((0.0, 1.0, 0.0),)), leg, Joint("S", top[2])]))
         return chains
 
+    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
+    def _in_box(self, options, x) -> bool:
+        return all(options[name][0] <= v <= options[name][1]
+                   for name, v in zip(("z_range", "theta_range", "psi_range"), x, strict=True))
+
+    def _stiffness_placement(self, design, options, pose) -> tuple[np.ndarray, str, np.ndarray]:
+        """(z, theta, psi) of the constraint-consistent (C-model) frame, its chain-3 variant and the platform
+        reference point (O'); raises InvalidPose outside the workspace box, the configured model's workspace or the
+        C-model's stroke limits."""
+        x = self.check_vector("pose", pose, 3)
+        variant = options["c3_variant"]
+        c_opts = {**options, "model": "C"}
+        if (not self._in_box(options, x) or self.point_kernel(self.pack(design, options), *x) < 0.0
+                or self.point_kernel(self.pack(design, c_opts), *x) < 0.0):
+            raise InvalidPose(f"pose: ({', '.join(f'{v:g}' for v in x)}) is outside the workspace (box and stroke "
+                              f"limits of the {options['model']}-model and of the C-model frame)")
+        return x, variant, RpsUpu.platform_pose(self, design, c_opts, x)["p"]
+
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at a pose (z, theta, psi) of the
+        constraint-consistent placement (the C-model with the configured chain-3 variant: the P-model violates the
+        RPS joint constraints, spec §2.3, so its joints would not assemble); raises InvalidPose outside the workspace
+        box, the configured model's stroke limits or the C-model's. Joints as in joint_screws: RPS_i (revolute about
+        x at A_i, a prismatic actuator spring between cylinder and rod, each half the leg, spherical at B_i); chain 3
+        'plane': revolute about y at A3, prismatic actuator, spherical at B3; 'upu': universal (x, m) at A3,
+        prismatic actuator, universal (m, w) at B3, m = x X w. The platform B1B2B3 is rigid, reference point O' (6
+        DOFs: x, y, z and the small rotations rx, ry, rz about the fixed axes); the load is a force at O'.
+        ``joints`` 'bonded' welds the passive joints."""
+        x, variant, ref = self._stiffness_placement(design, options, pose)
+        return self._frame(design, options, x, variant, ref, joints)
+
+    def _frame(self, design, options, x, variant, ref, joints):
+        from scalesynth.stiffness.builder import FrameBuilder, unit
+        from scalesynth.stiffness.model import Body
+        from scalesynth.stiffness.sections import tube_section
+
+        g, h, c, e = self._geom(design)
+        plat = RpsUpu.platform_pose(self, design, {**options, "model": "C", "c3_variant": variant}, x)
+        rot, p = plat["R"], plat["p"]
+        base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
+        k = options["actuator_stiffness"]
+        fb = FrameBuilder({"leg": tube_section(options, "leg", "mm")}, joints)
+        xhat, yhat = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+        w = rot[:, 2]
+        m_axis = unit(np.cross(xhat, w))
+        for i in range(3):
+            n = i + 1
+            a, b = base[i], top[i]
+            mid = 0.5 * (a + b)
+            fb.link(f"cylinder{n}", "leg", a, mid)
+            fb.link(f"rod{n}", "leg", mid, b)
+            if n < 3:
+                fb.joint(f"R{n}", "revolute", a, f"cylinder{n}.a", "base", (xhat,))
+            elif variant == "upu":
+                fb.joint("U3_base", "universal", a, "cylinder3.a", "base", (xhat, m_axis))
+            else:
+                fb.joint("R3", "revolute", a, "cylinder3.a", "base", (yhat,))
+            fb.joint(f"P{n}", "prismatic", mid, f"cylinder{n}.b", f"rod{n}.a", (b - a,), k)
+            if n == 3 and variant == "upu":
+                fb.joint("U3_platform", "universal", b, "rod3.b", "platform", (m_axis, w))
+            else:
+                fb.joint(f"S{n}", "spherical", b, f"rod{n}.b", "platform")
+        bodies = (Body("base", np.zeros(3)), Body("platform", np.asarray(ref, float).copy()))
+        notes = [f"spatial frame O-xyz of spec §2.1 (z up, mm) at the constraint-consistent (C-model, chain 3 "
+                 f"'{variant}') placement of (z, theta, psi) = ({', '.join(f'{v:g}' for v in x)}): yaw phi = "
+                 f"{plat['phi']:.6g} rad, y0 = {plat['y0']:.6g} mm",
+                 "rigid platform B1B2B3, DOFs x, y, z, rx, ry, rz (small rotations about the fixed axes) at its "
+                 "reference point; the load is a force there"]
+        if options.get("model", "P") == "P":
+            notes.append("the P-model violates the RPS joint constraints (spec §2.3): the frame uses the C-model "
+                         "placement")
+        return fb.model("mm", bodies, options["load"], notes)
+
 
 DESIGN_METRICS = (
     DesignMetric(
@@ -946,9 +930,9 @@ MECHANISM = RpsUpu(
         Option("theta_range", [-0.314, 0.314], "workspace box in theta (rad), the paper's"),
         Option("psi_range", [-0.314, 0.314], "workspace box in psi (rad), the paper's"),
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
+        *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6 (illustrative)"),
-        *STIFFNESS_OPTIONS,
     ),
     default_length_unit="mm",
     fields=FIELDS,
@@ -1052,12 +1036,12 @@ class RpsUpuTool(RpsUpu):
 
     def check_options(self, options: dict[str, Any]) -> None:
         self._check_limits(options)
+        check_stiffness_options(options, 3, LINK_GROUPS)
         d = options["tool_offset"]
         if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) or d <= 0:
             raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
         options["tool_offset"] = float(d)
         links.check_radius_option(options, TOOL_RADII)
-        check_stiffness_options(options, 3, LINK_GROUPS)
 
     @staticmethod
     def _p(options: Mapping[str, Any]) -> dict[str, Any]:
@@ -1263,9 +1247,9 @@ TOOL_MECHANISM = RpsUpuTool(
     options=(
         Option("tool_offset", 50.0, "d (mm): T = O' + R (0, 0, -d); illustrative default, the paper has no tool"),
         *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
+        *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6, tool 4 (illustrative)"),
-        *STIFFNESS_OPTIONS,
     ),
     default_length_unit="mm",
     fields=base_fields("1", "J = dT/dq of the tool point (mm/mm)"),
