@@ -33,6 +33,7 @@ from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -43,6 +44,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     wrap_angle,
 )
+from scalesynth.stiffness import legs as _legs_k
 from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
@@ -58,7 +60,11 @@ IK_LABEL = "Z+"  # the only IK branch: leg lengths are positive square roots, th
 _C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
 _L1LO, _L1HI, _L2LO, _L2HI, _L3LO, _L3HI = 6, 7, 8, 9, 10, 11
 _ALO, _AHI, _BLO, _BHI, _YLO, _YHI = 12, 13, 14, 15, 16, 17
-N_PACKED = 18
+# stiffness (point_fields slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N mm^2), GJ (N mm^2) of the 'leg' and
+# 'link' groups, actuator stiffness (N/mm), load (N)
+_EA_LEG, _EI_LEG, _GJ_LEG, _EA_LINK, _EI_LINK, _GJ_LINK, _KACT, _FX, _FY, _FZ = 18, 19, 20, 21, 22, 23, 24, 25, 26, 27
+N_PACKED = 28
+_F_STIFFNESS_MIN, _F_DEFLECTION = 3, 4  # slots of the stiffness fields in the field kernel's out
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -87,29 +93,30 @@ def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
     return ln, ja, jb, jy
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def point_fields(p, alpha, beta, yy, out):
-    """LCI at task point (alpha [rad], beta [rad], Y [mm]) if it lies in the workspace box with every actuator
-    length within its limits, else -1. LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the angle columns divided by
-    the characteristic length. Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq,
-    x = (L alpha, L beta, Y) (dimensionless)."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _kinematics(p, alpha, beta, yy, out):
+    """Slots 0-2 at task point (alpha [rad], beta [rad], Y [mm]): LCI if it lies in the workspace box with every
+    actuator length within its limits, else -1 (write_unreachable). LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the
+    angle columns divided by the characteristic length; sigma_min, sigma_max of J = dx/dq, x = (L alpha, L beta, Y)
+    (dimensionless). Returns (ok, sin alpha, cos alpha, sin beta, cos beta, P_x, P_z, longest leg); ok False where
+    slots 0-2 say unreachable or singular (the other slots are then written too)."""
     if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if yy < p[_YLO] or yy > p[_YHI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     c = p[_C]
     rho2 = c * c - yy * yy
     if not rho2 > 0.0:
         _grid.write_unreachable(out)  # |Y| >= c: no Z > 0 assembly
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     am = p[_AM]
     # spec §3.3: l1 = |(2/3) P - M| depends on Y only; > 0 whenever |Y| < c
     l1 = math.sqrt(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy)
     if l1 < p[_L1LO] or l1 > p[_L1HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     rho = math.sqrt(rho2)
     sa = math.sin(alpha)
     ca = math.cos(alpha)
@@ -124,18 +131,133 @@ def point_fields(p, alpha, beta, yy, out):
     l2, j2a, j2b, j2y = _ups_row(-ax, ay, -bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l2 < p[_L2LO] or l2 > p[_L2HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     l3, j3a, j3b, j3y = _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l3 < p[_L3LO] or l3 > p[_L3HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if l2 <= 0.0 or l3 <= 0.0:
-        _grid.write_singular(out)  # zero-length leg: inverse singularity
-        return
+        _grid.write_singular(out)  # zero-length leg: inverse singularity (stiffness fields 0)
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     s = p[_INV_L]
     lci, smin, smax = sv_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    return True, sa, ca, sb, cb, px, pz, max(l1, l2, l3)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, alpha, beta, yy, out):
+    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
+    the LCI alone) and the stiffness twin tests."""
+    _kinematics(p, alpha, beta, yy, out)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_fields(p, alpha, beta, yy, out):
+    """Fields at task point (alpha [rad], beta [rad], Y [mm]) (kernels.grid contract): slots 0-2 LCI, sigma_min,
+    sigma_max of J = dx/dq, x = (L alpha, L beta, Y) (dimensionless); _F_STIFFNESS_MIN (N/mm) and _F_DEFLECTION
+    (mm) under the packed load (ideal joints, docs/stiffness.md); LCI -1 (and zeros) outside the workspace box or
+    the actuator limits."""
+    ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
+    if ok:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+    elif out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
+        out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
+    """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model, by
+    per-chain condensation in the wrench form K = sum_i W_i Phi_i^-1 W_i^T (scalesynth.stiffness.legs), written
+    out in the orthonormal frame (x, e, h) at P: x = x_link = Ry(beta) x (the revolute axes), e = P / c (the link
+    axis), h = x cross e. stiffness_min and |deflection| do not depend on the frame (the load is rotated into it).
+
+    * UPS leg i (U at A_i, S at B_i): a two-force member; wrench (u, (B_i - P) x u), flexibility
+      l_i / EA + 1 / k (cylinder and rod in series with the actuator spring).
+    * (S+SPR)R: with ideal joints the link A0-B0-B1 is statically determinate under the wrenches it can take from
+      the platform: the revolute at B1 passes no moment about x, the S at A0 a force R, the SPR leg (S at M,
+      revolute about x at B0) a force Q = alpha d + beta x through M (d the unit vector M -> B0, normal to x).
+      The platform's wrench on the link is f = (R + Q, -P x R + (M - P) x Q) (at P; A0 is the origin), and its x
+      moment vanishing ties R . h to alpha: a 4-dimensional wrench space with basis f1 (R = e), f2 (R = x),
+      f3 (Q = x), f4 (Q = d, R = (K0 - 1)(d . h) h). Its flexibility Phi (4x4) is the complementary energy of the
+      upper link (B0 -> B1, a cantilever clamped at B0 loaded by f at P), the lower link (A0 -> B0, loaded by R
+      at A0) and the SPR leg (length l1, loaded by Q at M: axial l1 / EA + 1 / k, lateral l1^3 / 3 EI). With
+      M - P and d normal to x, Phi splits into the blocks (f1, f4) and (f2, f3). Round sections (EIy = EIz), as
+      the tube options give.
+
+    The generic per-leg routine of scalesynth.stiffness.legs on the same frame (tests/test_stiffness_legs.py)
+    and the reference solver agree with it. Characteristic length of the singularity test: the reference
+    solver's longest link (the halves of the legs, the lower link)."""
+    c = p[_C]
+    am = p[_AM]
+    k = p[_KACT]
+    ea_leg, ei_leg = p[_EA_LEG], p[_EI_LEG]
+    ex, ey, ez = px / c, py / c, pz / c  # e
+    xx, xz = cb, -sb  # x = (cb, 0, -sb)
+    hx, hy, hz = -xz * ey, xz * ex - xx * ez, xx * ey  # h = x cross e
+    kk = (0.0,) * 21
+    for sx in (-1.0, 1.0):  # UPS legs 2 (x < 0) and 3
+        bx0 = sx * p[_BX]
+        by0 = p[_BY]
+        rbx = cb * bx0 + sb * sa * by0  # B - P = R B'
+        rby = ca * by0
+        rbz = -sb * bx0 + cb * sa * by0
+        dx = px + rbx - sx * p[_AX]
+        dy = py + rby + am
+        dz = pz + rbz
+        s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+        w = 1.0 / math.sqrt(1.0 / (s * ea_leg) + 1.0 / k)
+        s *= w  # u / sqrt(flexibility)
+        ux, ue, uh = (dx * xx + dz * xz) * s, (dx * ex + dy * ey + dz * ez) * s, (dx * hx + dy * hy + dz * hz) * s
+        bx, be, bh = rbx * xx + rbz * xz, rbx * ex + rby * ey + rbz * ez, rbx * hx + rby * hy + rbz * hz
+        kk = _legs_k.outer_add(kk, ux, ue, uh, be * uh - bh * ue, bh * ux - bx * uh, bx * ue - be * ux)
+    # the (S+SPR)R chain in the frame (x, e, h): d = (0, de, dh), M - P = (0, me, mh)
+    dx, dy, dz = K0 * px, K0 * py + am, K0 * pz  # B0 - M
+    l1 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    de = (dx * ex + dy * ey + dz * ez) / l1
+    dh = (dx * hx + dy * hy + dz * hz) / l1
+    me = -am * ey - c
+    mh = -am * hy
+    g = (K0 - 1.0) * dh
+    ea, ei, gj = p[_EA_LINK], p[_EI_LINK], p[_GJ_LINK]
+    lu = (1.0 - K0) * c
+    ua, ub, ut, ur, uk = lu / ea, lu * lu * lu / (3.0 * ei), lu / gj, lu / ei, lu * lu / (2.0 * ei)
+    lo = K0 * c
+    lo_lat = lo * lo * lo / (3.0 * ei)
+    # block (f1, f4): f1 = (F (0, 1, 0), M 0); f4 = (F (0, de, dh + g), M (m4, 0, 0))
+    fh4 = dh + g
+    m4 = me * dh - mh * de - g * c
+    p11 = ua + lo / ea
+    p14 = ua * de
+    p44 = (ub * fh4 * fh4 + ua * de * de + ur * m4 * m4 + 2.0 * uk * fh4 * m4 + g * g * lo_lat
+           + l1 / ea_leg + 1.0 / k)
+    # block (f2, f3): f2 = (F (1, 0, 0), M (0, 0, c)); f3 = (F (1, 0, 0), M (0, mh, -me))
+    p22 = ub + ur * c * c - 2.0 * uk * c + lo_lat
+    p23 = ub - ur * c * me + uk * (me - c)
+    p33 = ub + ur * me * me + ut * mh * mh + 2.0 * uk * me + l1 * l1 * l1 / (3.0 * ei_leg)
+    l11 = math.sqrt(p11)
+    l41 = p14 / l11
+    q44 = p44 - l41 * l41
+    l22 = math.sqrt(p22)
+    l32 = p23 / l22
+    q33 = p33 - l32 * l32
+    if not (q44 > 0.0 and q33 > 0.0):
+        return 0.0, _legs_k.DEFLECTION_CAP
+    i11 = 1.0 / l11
+    i44 = 1.0 / math.sqrt(q44)
+    i22 = 1.0 / l22
+    i33 = 1.0 / math.sqrt(q33)
+    # columns W L^-T: f1 / l11, (f4 - l41 f1 / l11) / l44; f2 / l22, (f3 - l32 f2 / l22) / l33
+    kk = _legs_k.outer_add(kk, 0.0, i11, 0.0, 0.0, 0.0, 0.0)
+    kk = _legs_k.outer_add(kk, 0.0, (de - l41 * i11) * i44, fh4 * i44, m4 * i44, 0.0, 0.0)
+    kk = _legs_k.outer_add(kk, i22, 0.0, 0.0, 0.0, 0.0, c * i22)
+    t = l32 * i22
+    kk = _legs_k.outer_add(kk, (1.0 - t) * i33, 0.0, 0.0, 0.0, mh * i33, (-me - t * c) * i33)
+    fx, fy, fz = p[_FX], p[_FY], p[_FZ]
+    fxx, fe, fh = fx * xx + fz * xz, fx * ex + fy * ey + fz * ez, fx * hx + fy * hy + fz * hz
+    length = max(0.5 * lmax, K0 * c)
+    return _legs_k.response_upper(kk, fxx, fe, fh, length)
 
 
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
@@ -226,13 +348,20 @@ class UpsSspr(Mechanism):
         p[_ALO], p[_AHI] = options["alpha_range"]
         p[_BLO], p[_BHI] = options["beta_range"]
         p[_YLO], p[_YHI] = self.y_box(design, options)
+        from scalesynth.stiffness.sections import tube_section
+
+        for o, group in ((_EA_LEG, "leg"), (_EA_LINK, "link")):
+            sec = tube_section(options, group, "mm")
+            p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
+        p[_KACT] = options["actuator_stiffness"]
+        p[_FX], p[_FY], p[_FZ] = options["load"]
         return p
 
     @property
     def field_kernel(self):
         return point_fields
 
-    # ----- stiffness (scalesynth.stiffness; pose level only, no per-voxel fields yet) ------------------
+    # ----- stiffness (scalesynth.stiffness; per voxel: point_fields slots 3, 4, the same frame) ---------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
         """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at pose (alpha, beta, Y); raises InvalidPose
         outside the workspace box or the actuator limits. Joints as in joint_screws: UPS legs (U at A_i with both
@@ -559,7 +688,13 @@ MECHANISM = UpsSspr(
                            [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
     default_length_unit="mm",
-    fields=base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+    fields=(
+        *base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+        Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at B1 "
+              "under a pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
+        Field("deflection", "{length}", "magnitude of the deflection of B1 under options.load (default 150 N along "
+              "-z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP)),
+    ),
     design_metrics=(
         DesignMetric(
             "link_length_sum", "{length}",
