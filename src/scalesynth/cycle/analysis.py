@@ -10,11 +10,15 @@ Along the sampled trajectory (``cycle.trajectory``), in the configured working m
 * q from the closed-form IK; q_dot = A x_dot with the mechanism's velocity map A (inverse Jacobian);
   q_ddot = A x_ddot + A_dot x_dot, where A_dot x_dot is the derivative of A along the motion, taken by a
   central difference of A over a displacement of 1e-6 of the mechanism's size (IK re-solved in the branch);
-* actuator forces for the payload, quasi-static plus payload inertia: the payload is a point mass m at the
-  task point, the links are massless and joint friction is ignored, so A_SI^T tau = [F; 0] with
-  F = m (a - g) (N), tau in N for prismatic and N m for revolute actuators (SI units, whatever the config's
-  length unit). This is what the actuators must exert on the payload, gravity included: sum tau_i q_dot_i
-  equals F . x_dot at every sample (power balance);
+* actuator forces for the payload, quasi-static plus payload inertia: the payload is a point mass m, the
+  links are massless and joint friction is ignored, so A_SI^T tau = [F; 0] with F the generalised force on
+  the task axes, tau in N for prismatic and N m for revolute actuators (SI units, whatever the config's
+  length unit). With Cartesian task axes the payload sits at the task point and F = m (a - g) (N). With an
+  angular task axis (rps-upu, ups-sspr) it sits at the mechanism's ``payload_point`` c(x) (3-D, mechanism
+  frame): c_dot = J_c x_dot, c_ddot = J_c x_ddot + (d J_c/dt) x_dot, and F = J_c^T m (c_ddot - g), i.e.
+  tau = A_SI^-T [J_c^T m (c_ddot - g); 0]: N along a length axis, N m about an angle axis (J_c and its
+  derivative by central differences of c). Either way sum tau_i q_dot_i = F . x_dot = m (c_ddot - g) . c_dot
+  (W) at every sample (power balance);
 * the LCI from the point kernel and the clearance of the link capsules (``cycle.clearance``).
 
 Deflection along the cycle (stiffness, issue 12) goes into ``CycleResult.deflection`` when a mechanism provides
@@ -37,6 +41,8 @@ from scalesynth.mechanisms.base import Mechanism, wrap_angle
 
 # relative displacement (of the mechanism's size) for the directional derivative of the velocity map
 _DERIV_STEP = 1e-6
+# relative displacement for the second difference of the payload point along the motion (rounding ~ 1e-16 / step^2)
+_SECOND_STEP = 1e-4
 
 
 class CycleError(InvalidPose):
@@ -46,9 +52,12 @@ class CycleError(InvalidPose):
 @dataclass(frozen=True)
 class CycleResult:
     """One design's cycle. Arrays per sample (n rows): q, qd, qdd (n, n_joints) in the length unit or rad
-    (per s, per s^2); force (n, n_joints) in N or N m; task_force (n, k) the force F on the payload (N);
-    lci (n,); clearance (n,) in the length unit (< 0: interference) and clearance_pair the two segments at it.
-    ``deflection``: hook for the stiffness model, None until a mechanism provides one."""
+    (per s, per s^2); force (n, n_joints) in N or N m, force_gravity (n, n_joints) its part due to gravity
+    alone; task_force (n, k) the generalised force F on the task axes (N along a length axis, N m about an
+    angle axis); payload_velocity, payload_accel (n, 3 or k) the payload point's velocity and acceleration
+    (length unit per s, per s^2; payload axes, ``cycle.config.payload_axes``); lci (n,); clearance (n,) in the
+    length unit (< 0: interference) and clearance_pair the two segments at it. ``deflection``: hook for the
+    stiffness model, None until a mechanism provides one."""
 
     traj: trajectory.Trajectory
     q: np.ndarray
@@ -67,6 +76,9 @@ class CycleResult:
     payload: float
     gravity: np.ndarray
     force_map: np.ndarray  # (n, n_joints, k): force = force_map @ F
+    force_gravity: np.ndarray
+    payload_velocity: np.ndarray
+    payload_accel: np.ndarray
     deflection: np.ndarray | None = None
 
     def columns(self) -> dict[str, np.ndarray]:
@@ -202,7 +214,8 @@ def analyse(
     qd = np.einsum("nij,nj->ni", A, pd_full)
     qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(mech, design, options, traj, q, label, angular, size)
     g = ccfg.gravity_vector(cyc, mech)
-    force, task_force, force_map = _forces(mech, A, traj, cyc.payload, g, length_unit)
+    vel, acc, jc = _payload_motion(mech, design, options, traj, size)
+    force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
     gaps, pairs = [], []
     for s in range(n):
         c = clearance(mech.link_geometry(design, options, traj.p[s], q[s]))
@@ -212,7 +225,7 @@ def analyse(
         traj=traj, q=q, qd=qd, qdd=qdd, force=force, task_force=task_force, lci=lci, clearance=np.array(gaps),
         clearance_pair=tuple(pairs), task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
         joint_units=mech.joint_units, length_unit=length_unit, payload=cyc.payload, gravity=g,
-        force_map=force_map,
+        force_map=force_map, force_gravity=force_gravity, payload_velocity=vel, payload_accel=acc,
     )
 
 
@@ -251,18 +264,59 @@ def si_velocity_map(mech: Mechanism, A: np.ndarray, length_unit: str) -> np.ndar
     return A * row[:, None] * col[None, :]
 
 
-def _forces(mech, A, traj, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Actuator forces (n, n_joints), the payload force F = m (a - g) (n, k) and the map between them
-    (n, n_joints, k), SI."""
-    if any(u != "length" for u in mech.task_units):
-        axes = ", ".join(mech.task_axes)
-        raise CycleError(f"cycle: payload forces need Cartesian task axes; {mech.name} has {axes}")
+def _payload_motion(mech, design, options, traj, size) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The payload point's velocity and acceleration (n, 3) in the length unit per s (s^2) and its Jacobian
+    J_c = dc/dx (n, 3, k; length unit per task unit) for a mechanism with an angular task axis; with Cartesian
+    task axes the payload is the task point: (pd, pdd, None), exactly.
+
+    J_c by central differences of ``payload_point`` along each task axis (step _DERIV_STEP times the size for a
+    length axis, _DERIV_STEP rad for an angle); (d J_c/dt) x_dot = c''[x_dot, x_dot] by the second difference
+    of c along x_dot with the pose moving by _SECOND_STEP (size or rad)."""
+    if ccfg.cartesian_task(mech):
+        return traj.pd, traj.pdd, None
     n, k = traj.p.shape
+    scale = np.array([size if u == "length" else 1.0 for u in mech.task_units])
+
+    def c(x):
+        return np.asarray(mech.payload_point(design, options, x), dtype=float)
+
+    jc = np.empty((n, 3, k))
+    vel = np.empty((n, 3))
+    acc = np.empty((n, 3))
+    for s in range(n):
+        x, v = traj.p[s], traj.pd[s]
+        for a in range(k):
+            h = np.zeros(k)
+            h[a] = _DERIV_STEP * scale[a]
+            jc[s, :, a] = (c(x + h) - c(x - h)) / (2.0 * h[a])
+        vel[s] = jc[s] @ v
+        acc[s] = jc[s] @ traj.pdd[s]
+        reach = float(np.max(np.abs(v) / scale))
+        if reach > 0.0:
+            eps = _SECOND_STEP / reach  # a time step: the pose moves by _SECOND_STEP of its scale
+            acc[s] += (c(x + eps * v) - 2.0 * c(x) + c(x - eps * v)) / (eps * eps)
+    return vel, acc, jc
+
+
+def _forces(mech, A, jc, acc, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Actuator forces (n, n_joints), their gravity part (n, n_joints), the generalised payload force F on the
+    task axes (n, k) and the map from F to the forces (n, n_joints, k), SI. F = m (a - g) with Cartesian task
+    axes (``jc`` None), else J_c^T m (c_ddot - g) with J_c in metres per task unit."""
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
-    F = mass * (traj.pdd * m_per_unit - g[None, :])
+    cart = mass * (acc * m_per_unit - g[None, :])  # the force the payload needs, payload axes (N)
+    weight = np.broadcast_to(-mass * g, cart.shape)
+    if jc is None:
+        F, F_g = cart, weight
+    else:
+        # m per task unit: mm/mm columns are m/m already, mm/rad columns scale to m/rad
+        jc_si = jc * np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])
+        F = np.einsum("nck,nc->nk", jc_si, cart)
+        F_g = np.einsum("nck,nc->nk", jc_si, weight)
+    k = F.shape[1]
     A_si = si_velocity_map(mech, A, length_unit)
     force_map = np.linalg.inv(np.transpose(A_si, (0, 2, 1)))[:, :, :k]
-    return np.einsum("nik,nk->ni", force_map, F), F, force_map
+    return (np.einsum("nik,nk->ni", force_map, F), np.einsum("nik,nk->ni", force_map, F_g), np.asarray(F),
+            force_map)
 
 
 # ----- design-level metrics (catalogue: cycle_*) ------------------------------------------------------------
@@ -280,7 +334,7 @@ def max_rate_scale(res: CycleResult, speed_limits, force_limits) -> float:
         with np.errstate(divide="ignore"):
             k2 = min(k2, float(np.min((speed_limits / peak) ** 2)))
     if force_limits is not None:
-        tau_g = np.einsum("nik,k->ni", res.force_map, -res.payload * res.gravity)
+        tau_g = res.force_gravity
         tau_a = res.force - tau_g
         if np.any(np.abs(tau_g) > force_limits):
             return 0.0

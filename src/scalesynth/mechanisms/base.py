@@ -237,6 +237,12 @@ class Mechanism(ABC):
         forward Jacobian; actuator forces of a task-space force F follow from A^T tau = [F; 0]."""
         raise InvalidParameter(f"mechanism: {self.name} has no velocity map yet (cycle analysis needs it)")
 
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """Where a cycle's payload (a point mass) sits at a pose: a 3-D point of the mechanism frame (length unit).
+        Needed only by mechanisms with an angular task axis (with Cartesian task axes the payload is at the task
+        point); the cycle analysis differentiates it to get the payload's velocity and acceleration."""
+        raise InvalidParameter(f"mechanism: {self.name} has no payload point yet (cycles on its task axes need it)")
+
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
         """Statistics rows of every field for many designs (layout in kernels.grid). A mechanism may override this
         with a faster kernel that feeds the same accumulator (kernels.grid.gather_column, accumulate_cells)."""

@@ -759,6 +759,10 @@ class RpsUpu(Mechanism):
             return np.full((3, 3), np.inf)
         return jac["dq_dx"]
 
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """The cycle's payload sits at the platform origin O' = (0, y0, z) (mm; y0 = 0 in the P-model)."""
+        return self._joint_points(design, options, pose)[2]
+
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),

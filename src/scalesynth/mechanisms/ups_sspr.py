@@ -31,6 +31,7 @@ from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Mechanism,
@@ -53,6 +54,12 @@ SQRT3_2 = math.sqrt(3.0) / 2.0
 INV_SQRT2 = 1.0 / math.sqrt(2.0)
 Y_OPEN = 0.999  # default Y box = +-0.999 c: Y = +-c (rho = 0) is singular (spec §3.5)
 IK_LABEL = "Z+"  # the only IK branch: leg lengths are positive square roots, the SR link above the base
+# default capsule radii (mm), illustrative (the paper gives no cross-sections)
+LINK_RADII = {"base": 6.0, "leg1": 5.0, "leg2": 5.0, "leg3": 5.0, "link": 6.0, "platform": 6.0}
+# bodies sharing a joint: U/S of each leg on the base, S of the SR link at A0, S of the legs on the platform, the
+# SPR revolute at B0 on the link, the revolute at B1 between link and platform
+ADJACENT = (("base", "leg1"), ("base", "leg2"), ("base", "leg3"), ("base", "link"), ("leg1", "link"),
+            ("leg2", "platform"), ("leg3", "platform"), ("link", "platform"))
 
 # packed-parameter layout (see UpsSspr.pack)
 _C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
@@ -192,6 +199,7 @@ class UpsSspr(Mechanism):
                 raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {value!r}")
             options["characteristic_length"] = float(value)
         check_stiffness_options(options, 3, LINK_GROUPS)
+        links.check_radius_option(options, LINK_RADII)
 
     def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         """L in mm (default c): the angle columns of Jx are divided by L before conditioning."""
@@ -424,6 +432,51 @@ class UpsSspr(Mechanism):
             out.append(Solution(label, np.array([alpha, beta, yy])))
         return out
 
+    # ----- link geometry, velocity map, payload point (scalesynth.cycle) ----------------------------------
+    def joint_points(self, design, options, pose) -> dict[str, np.ndarray]:
+        """Joint centres (mm, base frame A0-xyz of spec §3.1) at a pose (alpha, beta, Y) with |Y| < c: A0 (origin),
+        A1, A2, A3, M (base), B0 = k0 B1 (SPR revolute on the link), B1 = P, B2, B3 (platform)."""
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        a, b, c = design["a"], design["b"], design["c"]
+        if not abs(yy) < c:
+            raise InvalidPose(f"pose: |Y| = {abs(yy):g} must be below c = {c:g}")
+        rho = math.sqrt(c * c - yy * yy)
+        sa, ca, sb, cb = math.sin(alpha), math.cos(alpha), math.sin(beta), math.cos(beta)
+        rot = np.array([[cb, sb * sa, sb * ca], [0.0, ca, -sa], [-sb, cb * sa, cb * ca]])  # Ry(beta) Rx(alpha)
+        p = np.array([sb * rho, yy, cb * rho])
+        bxy = b * INV_SQRT2
+        return {
+            "A0": np.zeros(3), "A1": np.array([0.0, a, 0.0]), "A2": np.array([-SQRT3_2 * a, -a / 2.0, 0.0]),
+            "A3": np.array([SQRT3_2 * a, -a / 2.0, 0.0]), "M": np.array([0.0, -a / 2.0, 0.0]), "B0": K0 * p,
+            "B1": p, "B2": p + rot @ np.array([-bxy, bxy, 0.0]), "B3": p + rot @ np.array([bxy, bxy, 0.0]),
+        }
+
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules (mm) at a pose (alpha, beta, Y): the base triangle A1 A2 A3 (its side A2A3 holds M) and the
+        strut A0 -> M; leg1 the SPR actuator M -> B0, leg2/leg3 the UPS actuators A_i -> B_i (cylinder and rod as
+        one capsule); link the SR link A0 -> B1 (B0 on it); platform the triangle B1 B2 B3. Adjacent: base with
+        leg1, leg2, leg3 and link; leg1-link (revolute at B0); leg2/leg3-platform; link-platform (revolute at B1).
+        q is not needed (the legs follow from the pose). Radii: option ``link_radius``, defaults LINK_RADII."""
+        j = self.joint_points(design, options, pose)
+        rad = links.radii(options, LINK_RADII)
+        parts = [("base12", "base", "A1", "A2"), ("base23", "base", "A2", "A3"), ("base31", "base", "A3", "A1"),
+                 ("strut", "base", "A0", "M"), ("leg1", "leg1", "M", "B0"), ("leg2", "leg2", "A2", "B2"),
+                 ("leg3", "leg3", "A3", "B3"), ("link", "link", "A0", "B1"), ("platform12", "platform", "B1", "B2"),
+                 ("platform23", "platform", "B2", "B3"), ("platform31", "platform", "B3", "B1")]
+        segments = tuple(links.Segment(n, body, j[a], j[b], rad[body]) for n, body, a, b in parts)
+        return links.LinkGeometry(segments, links.adjacency(ADJACENT))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """Jx = dl/d(alpha, beta, Y) (mm/rad, mm/rad, mm/mm): l_dot = Jx x_dot (Jq = I); infinite where Jx is
+        undefined (|Y| = c or a zero-length leg)."""
+        jx = self.jacobians(design, options, pose)["Jx"]
+        return np.where(np.isfinite(jx), jx, np.inf)
+
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """The cycle's payload sits at B1 = P = (sin(beta) rho, Y, cos(beta) rho) (mm), the platform's reference
+        point (where the stiffness model's load acts)."""
+        return self.joint_points(design, options, pose)["B1"]
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §3.2: chains UPS, UPS and the hybrid (S+SPR)R (S at A0 on the link A0B1, the
@@ -555,6 +608,8 @@ MECHANISM = UpsSspr(
             None,
             "L in mm homogenising the Jacobian (angle columns / L) for the LCI, null = c",
         ),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
+               "leg1/leg2/leg3 5, link 6, platform 6 (illustrative)"),
         *stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator, N/mm (an assumption)",
                            [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
