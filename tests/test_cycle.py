@@ -338,9 +338,12 @@ def test_numba_segment_distance_matches_the_numpy_version():
         assert jit_distance(*p1, *q1, *p2, *q2) == pytest.approx(float(segment_distance(p1, q1, p2, q2)), abs=1e-12)
 
 
-@pytest.mark.parametrize("name, radius", [("planar-fivebar", None), ("planar-fivebar", 150.0),  # field kernels
-                                          ("pprs-rprs", None), ("pprs-rprs", 30.0)])
-def test_clearance_field_matches_numpy_link_geometry(name, radius):
+@pytest.mark.parametrize("name, radius, extra", [
+    ("planar-fivebar", None, {}), ("planar-fivebar", 150.0, {}), ("pprs-rprs", None, {}), ("pprs-rprs", 30.0, {}),
+    ("rps-upu", None, {}), ("rps-upu", 25.0, {}), ("rps-upu", 25.0, {"model": "C"}),
+    ("rps-upu", 25.0, {"model": "C", "c3_variant": "upu"}), ("rps-upu-tool", None, {}), ("rps-upu-tool", 20.0, {}),
+])
+def test_clearance_field_matches_numpy_link_geometry(name, radius, extra):
     """The field kernel's clearance at every reachable node of a grid against cycle.clearance of the mechanism's
     link_geometry (NumPy, the cycle's code path), and interference_free = reachable and clearance >= 0."""
     from scalesynth.evaluate import make_grid
@@ -349,7 +352,7 @@ def test_clearance_field_matches_numpy_link_geometry(name, radius):
     cfg = CASES[name]
     mech = cfg.mech
     design = cfg.resolved_design()
-    options = mech.resolve_options({**cfg.options, "link_radius": radius})
+    options = mech.resolve_options({**cfg.options, "link_radius": radius, **extra})
     g = make_grid(mech, design, options, 31 if mech.planar else 9)
     slot = mech.field_names.index("clearance")
     fields = kgrid.sample_fields(mech.field_kernel, mech.n_fields, mech.pack(design, options), g.lo, g.step, g.shape)

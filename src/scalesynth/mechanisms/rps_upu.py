@@ -38,6 +38,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import segment_distance
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -59,9 +60,30 @@ MODELS = ("P", "C")
 C3_VARIANTS = ("plane", "upu")
 BRANCH = "+++"  # the only IK branch: every leg length is the positive root q_i = |A_i B_i|
 
-# packed-parameter layout (see RpsUpu.pack)
+# packed-parameter layout (see RpsUpu.pack); _RAD: capsule radii of base, leg1, leg2, leg3, platform (LINK_RADII
+# order); _FREE_ONLY 1: poses whose capsules overlap are unreachable
 _G, _H, _C, _E, _MODEL_C, _UPU, _QLO, _QHI, _INV_L = range(9)
-N_PACKED = 9
+_RAD = 9
+_FREE_ONLY = 14
+N_PACKED = 15
+_F_CLEARANCE = 3  # slot of the clearance field in the field kernels' out (its index in ``fields``), both workspaces
+
+# capsules of the clearance field in link_geometry's order (base12, base23, base31, leg1..3, platform12, 23, 31,
+# then the tool of rps-upu-tool) and their bodies (0 base, 1-3 leg_i, 4 platform, 5 tool)
+_SEGMENT_BODY = np.array([0, 0, 0, 1, 2, 3, 4, 4, 4, 5], dtype=np.int64)
+_ADJACENT_BODIES = {frozenset(p) for p in ((0, 1), (0, 2), (0, 3), (1, 4), (2, 4), (3, 4), (4, 5))}
+
+
+def _checked_pairs(n_segments: int) -> np.ndarray:
+    """Segment index pairs whose clearance counts: different bodies sharing no joint (LinkGeometry's rule)."""
+    body = _SEGMENT_BODY
+    return np.array([(i, j) for i in range(n_segments) for j in range(i + 1, n_segments)
+                     if body[i] != body[j] and frozenset((int(body[i]), int(body[j]))) not in _ADJACENT_BODIES],
+                    dtype=np.int64)
+
+
+_PAIRS = _checked_pairs(9)
+_PAIRS_TOOL = _checked_pairs(10)
 
 # a parametrisation is degenerate below these (dimensionless) values: yaw undefined (cos psi = 0 with
 # sin theta sin psi = 0), or, for the upu variant, R[2, 2] = cos theta cos psi = 0 (y0 unbounded)
@@ -95,13 +117,14 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
 
     Every leg vector d_i = B_i - A_i is differentiated by the chain rule through the parasitic yaw (its sine
     and cosine sf = N/n, cf = M/n with N = sin theta sin psi, M = cos psi, n = |(N, M)| = R[1, 1]) and y0; the
-    row is d_i . dB_i/dx. Returns ok = False where the parametrisation is degenerate.
+    row is d_i . dB_i/dx. Returns ok = False where the parametrisation is degenerate; then y0, sin and cos of the
+    yaw (for the platform's placement).
     """
     nn = st * sp
     mm = cp
     n2 = nn * nn + mm * mm
     if n2 < _YAW_EPS2:
-        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0
     n = math.sqrt(n2)
     sf = nn / n
     cf = mm / n
@@ -118,7 +141,7 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     if upu:
         r22 = ct * cp
         if abs(r22) < _R22_EPS:
-            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0
         r12 = sf * st * cp - cf * sp
         r12_t = sf_t * st * cp + sf * ct * cp - cf_t * sp
         r12_p = sf_p * st * cp - sf * st * sp - cf_p * sp - cf * cp
@@ -156,7 +179,58 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     r31 = d3y * y0_z + d3z
     r32 = d3x * c * (cf_t * ct - cf * st) + d3y * (y0_t + c * r10_t) + d3z * (-c * ct)
     r33 = d3x * c * cf_p * ct + d3y * (y0_p + c * r10_p)
-    return True, q1s, q2s, q3s, r11, r12_, r13, r21, r22_, r23, r31, r32, r33
+    return True, q1s, q2s, q3s, r11, r12_, r13, r21, r22_, r23, r31, r32, r33, y0, sf, cf
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _clearance(p, y0, z, st, ct, sp, cp, sf, cf, pairs, tx, ty, tz, r_tool):
+    """Smallest gap (mm) between the capsules of link_geometry that share no joint, at the platform pose
+    p = (0, y0, z), R = Rz(phi) Ry(theta) Rx(psi) (sf, cf: sine and cosine of the yaw phi; P-model 0, 1). With the
+    tool pairs (rps-upu-tool) the 10th capsule is the tool O' -> T = (tx, ty, tz) of radius r_tool."""
+    g = p[_G]
+    h = p[_H]
+    c = p[_C]
+    e = p[_E]
+    ux = cf * ct  # R x
+    uy = sf * ct
+    uz = -st
+    vx = cf * st * sp - sf * cp  # R y
+    vy = sf * st * sp + cf * cp
+    vz = ct * sp
+    b1x, b1y, b1z = -h * vx, y0 - h * vy, z - h * vz
+    b2x, b2y, b2z = h * vx, y0 + h * vy, z + h * vz
+    b3x, b3y, b3z = c * ux, y0 + c * uy, z + c * uz
+    seg = np.empty((10, 6))
+    _put_seg(seg, 0, 0.0, -g, 0.0, 0.0, g, 0.0)
+    _put_seg(seg, 1, 0.0, g, 0.0, e, 0.0, 0.0)
+    _put_seg(seg, 2, e, 0.0, 0.0, 0.0, -g, 0.0)
+    _put_seg(seg, 3, 0.0, -g, 0.0, b1x, b1y, b1z)
+    _put_seg(seg, 4, 0.0, g, 0.0, b2x, b2y, b2z)
+    _put_seg(seg, 5, e, 0.0, 0.0, b3x, b3y, b3z)
+    _put_seg(seg, 6, b1x, b1y, b1z, b2x, b2y, b2z)
+    _put_seg(seg, 7, b2x, b2y, b2z, b3x, b3y, b3z)
+    _put_seg(seg, 8, b3x, b3y, b3z, b1x, b1y, b1z)
+    _put_seg(seg, 9, 0.0, y0, z, tx, ty, tz)
+    gap = math.inf
+    for k in range(pairs.shape[0]):
+        i = pairs[k, 0]
+        j = pairs[k, 1]
+        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
+                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
+        ri = r_tool if i == 9 else p[_RAD + _SEGMENT_BODY[i]]
+        rj = r_tool if j == 9 else p[_RAD + _SEGMENT_BODY[j]]
+        gap = min(gap, d - ri - rj)
+    return gap
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_seg(seg, k, ax, ay, az, bx, by, bz):
+    seg[k, 0] = ax
+    seg[k, 1] = ay
+    seg[k, 2] = az
+    seg[k, 3] = bx
+    seg[k, 4] = by
+    seg[k, 5] = bz
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -170,7 +244,8 @@ def _leg_ok(qs, lo, hi):
 def point_fields(p, x, y, z, out):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
     length leaves the stroke limits or the parametrisation is degenerate (C-model). Fields (kernels.grid contract):
-    LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless)."""
+    LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless); 3 clearance (mm) of the link capsules
+    (with interference_free, overlapping capsules make the pose unreachable)."""
     g = p[_G]
     h = p[_H]
     c = p[_C]
@@ -179,8 +254,9 @@ def point_fields(p, x, y, z, out):
     ct = math.cos(y)
     sp = math.sin(z)
     cp = math.cos(z)
+    y0, sf, cf = 0.0, 0.0, 1.0  # P-model: O' on the z axis, no yaw
     if p[_MODEL_C] > 0.0:
-        ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _c_model_rows(
+        ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33, y0, sf, cf = _c_model_rows(
             g, h, c, e, p[_UPU] > 0.0, x, st, ct, sp, cp
         )
         if not ok:
@@ -196,8 +272,13 @@ def point_fields(p, x, y, z, out):
     if not (ok1 and ok2 and ok3):
         _grid.write_unreachable(out)
         return
+    gap = _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0)
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0:
         _grid.write_singular(out)  # inverse singularity: a leg of zero length has no direction
+        out[_F_CLEARANCE] = gap
         return
     # row i of dq/dx is (q_i dq_i/dx) / q_i; the angle columns are divided by L (homogenisation)
     i1 = 1.0 / q1
@@ -211,6 +292,7 @@ def point_fields(p, x, y, z, out):
     )  # fmt: skip
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    out[_F_CLEARANCE] = gap
 
 
 # ----- NumPy kinematics (vectorised over poses; CLI, FK and tests) ----------------------------------------
@@ -566,6 +648,7 @@ class RpsUpu(Mechanism):
                 raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
             options["characteristic_length"] = float(length)
         links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     @staticmethod
     def _check_limits(options: dict[str, Any]) -> None:
@@ -592,6 +675,9 @@ class RpsUpu(Mechanism):
         stroke = options.get("stroke_limits")
         p[_QLO], p[_QHI] = stroke if stroke is not None else (-math.inf, math.inf)
         p[_INV_L] = 1.0 / self.characteristic_length(design, options)
+        rad = links.radii(options, LINK_RADII)
+        p[_RAD : _RAD + 5] = [rad[body] for body in LINK_RADII]
+        p[_FREE_ONLY] = 1.0 if options.get("interference_free") else 0.0
         return p
 
     @property
@@ -825,7 +911,8 @@ DESIGN_METRICS = (
         lambda d, o: enclosing_circle_radius([(0.0, -d["g"]), (0.0, d["g"]), (d["e"], 0.0)]),
     ),
 )
-FIELDS = base_fields("1", "J = dx/dq, x = (z, L theta, L psi) homogenised by the characteristic length L (mm/mm)")
+FIELDS = (*base_fields("1", "J = dx/dq, x = (z, L theta, L psi) homogenised by the characteristic length L (mm/mm)"),
+          links.CLEARANCE_FIELD)
 
 MECHANISM = RpsUpu(
     name="rps-upu",
@@ -853,6 +940,7 @@ MECHANISM = RpsUpu(
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
     fields=FIELDS,
@@ -862,8 +950,8 @@ MECHANISM = RpsUpu(
 
 # ----- optional second workspace: the tool point T = O' + R (0, 0, -d) over (x, y, z) (spec §2.8) ---------
 # packed layout of the tool kernel (see RpsUpuTool.pack): the first N_PACKED entries as above, then
-_D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI = range(N_PACKED, N_PACKED + 7)
-N_PACKED_TOOL = N_PACKED + 7
+_D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI, _RAD_TOOL = range(N_PACKED, N_PACKED + 8)
+N_PACKED_TOOL = N_PACKED + 8
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -874,7 +962,8 @@ def tool_point_fields(p, x, y, z, out):
 
     Pose from T (spec §2.8): sin psi = T_y/d, sin theta = -T_x/(d cos psi), z0 = T_z + d cos theta cos psi; then
     dq/dT = dq/d(z0, theta, psi) . d(z0, theta, psi)/dT with the closed-form inverse of dT/d(z0, theta, psi).
-    Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dT/dq (dimensionless).
+    Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dT/dq (dimensionless); 3 clearance (mm) of the
+    link capsules and the tool O' -> T (with interference_free, overlapping capsules make the pose unreachable).
     """
     d = p[_D]
     sp = y / d
@@ -907,8 +996,13 @@ def tool_point_fields(p, x, y, z, out):
     if not (ok1 and ok2 and ok3):
         _grid.write_unreachable(out)
         return
+    gap = _clearance(p, 0.0, z0, st, ct, sp, cp, 0.0, 1.0, _PAIRS_TOOL, x, y, z, p[_RAD_TOOL])
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0 or ct <= 1e-12:
         _grid.write_singular(out)  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
+        out[_F_CLEARANCE] = gap
         return
     # d(z0, theta, psi)/dT, rows z0, theta, psi; columns T_x, T_y, T_z
     inv = 1.0 / (d * ct * cp)
@@ -928,6 +1022,7 @@ def tool_point_fields(p, x, y, z, out):
     )  # fmt: skip
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    out[_F_CLEARANCE] = gap
 
 
 def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -961,6 +1056,7 @@ class RpsUpuTool(RpsUpu):
             raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
         options["tool_offset"] = float(d)
         links.check_radius_option(options, TOOL_RADII)
+        links.check_flag_option(options, "interference_free")
 
     @staticmethod
     def _p(options: Mapping[str, Any]) -> dict[str, Any]:
@@ -970,6 +1066,7 @@ class RpsUpuTool(RpsUpu):
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.empty(N_PACKED_TOOL)
         p[:N_PACKED] = super().pack(design, self._p(options))
+        p[_RAD_TOOL] = links.radii(options, TOOL_RADII)["tool"]
         p[_D] = options["tool_offset"]
         p[_ZLO], p[_ZHI] = options["z_range"]
         p[_TLO], p[_THI] = options["theta_range"]
@@ -1134,8 +1231,9 @@ TOOL_MECHANISM = RpsUpuTool(
         *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6, tool 4 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
-    fields=base_fields("1", "J = dT/dq of the tool point (mm/mm)"),
+    fields=(*base_fields("1", "J = dT/dq of the tool point (mm/mm)"), links.CLEARANCE_FIELD),
     design_metrics=DESIGN_METRICS,
 )
