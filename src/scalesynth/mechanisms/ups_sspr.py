@@ -34,6 +34,7 @@ from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -44,6 +45,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     wrap_angle,
 )
+from scalesynth.stiffness import legs as _legs_k
 from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 K0 = 2.0 / 3.0  # |A0B0| / |A0B1| (paper)
@@ -65,7 +67,11 @@ ADJACENT = (("base", "leg1"), ("base", "leg2"), ("base", "leg3"), ("base", "link
 _C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
 _L1LO, _L1HI, _L2LO, _L2HI, _L3LO, _L3HI = 6, 7, 8, 9, 10, 11
 _ALO, _AHI, _BLO, _BHI, _YLO, _YHI = 12, 13, 14, 15, 16, 17
-N_PACKED = 18
+# stiffness (point_fields slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N mm^2), GJ (N mm^2) of the 'leg' and
+# 'link' groups, actuator stiffness (N/mm), load (N)
+_EA_LEG, _EI_LEG, _GJ_LEG, _EA_LINK, _EI_LINK, _GJ_LINK, _KACT, _FX, _FY, _FZ = 18, 19, 20, 21, 22, 23, 24, 25, 26, 27
+N_PACKED = 28
+_F_STIFFNESS_MIN, _F_DEFLECTION = 3, 4  # slots of the stiffness fields in the field kernel's out
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -94,29 +100,30 @@ def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
     return ln, ja, jb, jy
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def point_fields(p, alpha, beta, yy, out):
-    """LCI at task point (alpha [rad], beta [rad], Y [mm]) if it lies in the workspace box with every actuator
-    length within its limits, else -1. LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the angle columns divided by
-    the characteristic length. Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq,
-    x = (L alpha, L beta, Y) (dimensionless)."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _kinematics(p, alpha, beta, yy, out):
+    """Slots 0-2 at task point (alpha [rad], beta [rad], Y [mm]): LCI if it lies in the workspace box with every
+    actuator length within its limits, else -1 (write_unreachable). LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the
+    angle columns divided by the characteristic length; sigma_min, sigma_max of J = dx/dq, x = (L alpha, L beta, Y)
+    (dimensionless). Returns (ok, sin alpha, cos alpha, sin beta, cos beta, P_x, P_z, longest leg); ok False where
+    slots 0-2 say unreachable or singular (the other slots are then written too)."""
     if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if yy < p[_YLO] or yy > p[_YHI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     c = p[_C]
     rho2 = c * c - yy * yy
     if not rho2 > 0.0:
         _grid.write_unreachable(out)  # |Y| >= c: no Z > 0 assembly
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     am = p[_AM]
     # spec §3.3: l1 = |(2/3) P - M| depends on Y only; > 0 whenever |Y| < c
     l1 = math.sqrt(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy)
     if l1 < p[_L1LO] or l1 > p[_L1HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     rho = math.sqrt(rho2)
     sa = math.sin(alpha)
     ca = math.cos(alpha)
@@ -131,18 +138,145 @@ def point_fields(p, alpha, beta, yy, out):
     l2, j2a, j2b, j2y = _ups_row(-ax, ay, -bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l2 < p[_L2LO] or l2 > p[_L2HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     l3, j3a, j3b, j3y = _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, yy, pz, rho, yy)
     if l3 < p[_L3LO] or l3 > p[_L3HI]:
         _grid.write_unreachable(out)
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if l2 <= 0.0 or l3 <= 0.0:
-        _grid.write_singular(out)  # zero-length leg: inverse singularity
-        return
+        _grid.write_singular(out)  # zero-length leg: inverse singularity (stiffness fields 0)
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     s = p[_INV_L]
     lci, smin, smax = sv_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    return True, sa, ca, sb, cb, px, pz, max(l1, l2, l3)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, alpha, beta, yy, out):
+    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
+    the LCI alone) and the stiffness twin tests."""
+    _kinematics(p, alpha, beta, yy, out)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_fields(p, alpha, beta, yy, out):
+    """Fields at task point (alpha [rad], beta [rad], Y [mm]) (kernels.grid contract): slots 0-2 LCI, sigma_min,
+    sigma_max of J = dx/dq, x = (L alpha, L beta, Y) (dimensionless); _F_STIFFNESS_MIN (N/mm) and _F_DEFLECTION
+    (mm) under the packed load (ideal joints, docs/stiffness.md); LCI -1 (and zeros) outside the workspace box or
+    the actuator limits."""
+    ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
+    if ok:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+    elif out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
+        out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _bilinear(up_a, up_b, up_t, up_r, up_k, ex, ey, ez, f, g):
+    """f^T C_up g for two wrenches f, g (6-vectors at P) and C_up the tip compliance at P of the upper link (axis e,
+    round section) clamped at B0: translations a e e^T + b (I - e e^T), rotations t e e^T + r (I - e e^T), coupling
+    k e . (F_f x M_g + F_g x M_f)."""
+    fe = f[0] * ex + f[1] * ey + f[2] * ez
+    ge = g[0] * ex + g[1] * ey + g[2] * ez
+    fme = f[3] * ex + f[4] * ey + f[5] * ez
+    gme = g[3] * ex + g[4] * ey + g[5] * ez
+    ff = f[0] * g[0] + f[1] * g[1] + f[2] * g[2]
+    mm = f[3] * g[3] + f[4] * g[4] + f[5] * g[5]
+    # e . (F_f x M_g) + e . (F_g x M_f)
+    c1 = ex * (f[1] * g[5] - f[2] * g[4]) + ey * (f[2] * g[3] - f[0] * g[5]) + ez * (f[0] * g[4] - f[1] * g[3])
+    c2 = ex * (g[1] * f[5] - g[2] * f[4]) + ey * (g[2] * f[3] - g[0] * f[5]) + ez * (g[0] * f[4] - g[1] * f[3])
+    return up_b * ff + (up_a - up_b) * fe * ge + up_r * mm + (up_t - up_r) * fme * gme + up_k * (c1 + c2)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
+    """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model, by
+    per-chain condensation (scalesynth.stiffness.legs' wrench form K = sum_i W_i Phi_i^-1 W_i^T = A A^T):
+
+    * UPS leg i (U at A_i, S at B_i): a two-force member; wrench W = (u, (B_i - P) x u), flexibility
+      Phi = l_i / EA + 1 / k (cylinder and rod in series with the actuator spring).
+    * (S+SPR)R: with ideal joints the link A0-B0-B1 is statically determinate under the wrenches it can take from
+      the platform: the revolute at B1 passes no moment about x_link, the S at A0 a force R, the SPR leg (S at M,
+      revolute about x_link at B0) a force Q = alpha d + beta x_link through M (d along M -> B0). The link is in
+      equilibrium under the platform's wrench f = (R + Q, -P x R + (M - P) x Q) (at P; A0 is the origin), and
+      x_link . moment = 0 ties R . h to alpha (h = x_link x e, e = P / c): a 4-dimensional wrench space with basis
+      (R = e), (R = x_link), (beta = 1), (alpha = 1, R = (K0 - 1)(d . h) h). Its flexibility Phi (4x4) is the
+      complementary energy: the upper link (B0 -> B1) as a cantilever clamped at B0 loaded by f, the lower link
+      (A0 -> B0) as one loaded by R at A0, the SPR leg (length l1) as one loaded by Q at M (axial
+      l1 / EA + 1 / k, lateral l1^3 / 3 EI). Round sections (EIy = EIz), as the tube options give.
+
+    The six wrench columns W L^-T (L L^T = Phi) form A; platform_response_wrenches gives the fields. The generic
+    per-leg routine on the same frame (tests/test_stiffness_legs.py) and the reference solver agree with it.
+    Characteristic length for the singularity test: the reference solver's longest link (halves of the legs, the
+    lower link)."""
+    w = np.empty((3, 6, 6))
+    A, work, fw = w[0], w[1], w[2]
+    c = p[_C]
+    am = p[_AM]
+    k = p[_KACT]
+    ea_leg, ei_leg = p[_EA_LEG], p[_EI_LEG]
+    for col in range(2):  # UPS legs 2 (x < 0) and 3: columns 4, 5
+        sx = -1.0 if col == 0 else 1.0
+        bx0 = sx * p[_BX]
+        by0 = p[_BY]
+        rbx = cb * bx0 + sb * sa * by0  # B - P = R B'
+        rby = ca * by0
+        rbz = -sb * bx0 + cb * sa * by0
+        dx = px + rbx - sx * p[_AX]
+        dy = py + rby + am
+        dz = pz + rbz
+        ln = math.sqrt(dx * dx + dy * dy + dz * dz)
+        ux, uy, uz = dx / ln, dy / ln, dz / ln
+        s = 1.0 / math.sqrt(ln / ea_leg + 1.0 / k)
+        j = 4 + col
+        A[0, j], A[1, j], A[2, j] = ux * s, uy * s, uz * s
+        A[3, j] = (rby * uz - rbz * uy) * s
+        A[4, j] = (rbz * ux - rbx * uz) * s
+        A[5, j] = (rbx * uy - rby * ux) * s
+    # (S+SPR)R chain: frame e (link axis), x (revolute axes), h = x cross e
+    ex, ey, ez = px / c, py / c, pz / c
+    xx, xz = cb, -sb  # x_link = (cb, 0, -sb)
+    hx, hy, hz = -xz * ey, xz * ex - xx * ez, xx * ey
+    dx, dy, dz = K0 * px, K0 * py + am, K0 * pz  # B0 - M
+    l1 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    dx, dy, dz = dx / l1, dy / l1, dz / l1
+    g = (K0 - 1.0) * (dx * hx + dy * hy + dz * hz)
+    mpx, mpy, mpz = -px, -am - py, -pz  # M - P
+    # wrench basis f_j = (R + Q, -P x R + (M - P) x Q): -P x e = 0, -P x x_link = c h, -P x h = -c x_link
+    fw[:, :] = 0.0
+    fw[0, 0], fw[1, 0], fw[2, 0] = ex, ey, ez  # R = e
+    fw[0, 1], fw[1, 1], fw[2, 1] = xx, 0.0, xz  # R = x_link
+    fw[3, 1], fw[4, 1], fw[5, 1] = c * hx, c * hy, c * hz
+    fw[0, 2], fw[1, 2], fw[2, 2] = xx, 0.0, xz  # Q = x_link through M
+    fw[3, 2], fw[4, 2], fw[5, 2] = mpy * xz, mpz * xx - mpx * xz, -mpy * xx
+    fw[0, 3], fw[1, 3], fw[2, 3] = dx + g * hx, dy + g * hy, dz + g * hz  # Q = d through M, R = g h
+    fw[3, 3] = mpy * dz - mpz * dy - g * c * xx
+    fw[4, 3] = mpz * dx - mpx * dz
+    fw[5, 3] = mpx * dy - mpy * dx - g * c * xz
+    ea, ei, gj = p[_EA_LINK], p[_EI_LINK], p[_GJ_LINK]
+    lu = (1.0 - K0) * c
+    up_a, up_b, up_t, up_r, up_k = lu / ea, lu * lu * lu / (3.0 * ei), lu / gj, lu / ei, lu * lu / (2.0 * ei)
+    lo = K0 * c
+    lo_ax, lo_lat = lo / ea, lo * lo * lo / (3.0 * ei)
+    spr_ax, spr_lat = l1 / ea_leg + 1.0 / k, l1 * l1 * l1 / (3.0 * ei_leg)
+    phi = work
+    for a in range(4):
+        for b in range(a, 4):
+            phi[a, b] = _bilinear(up_a, up_b, up_t, up_r, up_k, ex, ey, ez, fw[:, a], fw[:, b])
+    phi[0, 0] += lo_ax
+    phi[1, 1] += lo_lat
+    phi[2, 2] += spr_lat
+    phi[3, 3] += g * g * lo_lat + spr_ax
+    for a in range(4):
+        for b in range(a):
+            phi[a, b] = phi[b, a]
+    if not _legs_k.cholesky(phi, 4):
+        return 0.0, _legs_k.DEFLECTION_CAP
+    _legs_k.wrench_columns(phi, fw, 4, A, 0)
+    length = max(0.5 * lmax, K0 * c)
+    return _legs_k.platform_response_wrenches(A, p[_FX], p[_FY], p[_FZ], length, work)
 
 
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
@@ -234,13 +368,20 @@ class UpsSspr(Mechanism):
         p[_ALO], p[_AHI] = options["alpha_range"]
         p[_BLO], p[_BHI] = options["beta_range"]
         p[_YLO], p[_YHI] = self.y_box(design, options)
+        from scalesynth.stiffness.sections import tube_section
+
+        for o, group in ((_EA_LEG, "leg"), (_EA_LINK, "link")):
+            sec = tube_section(options, group, "mm")
+            p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
+        p[_KACT] = options["actuator_stiffness"]
+        p[_FX], p[_FY], p[_FZ] = options["load"]
         return p
 
     @property
     def field_kernel(self):
         return point_fields
 
-    # ----- stiffness (scalesynth.stiffness; pose level only, no per-voxel fields yet) ------------------
+    # ----- stiffness (scalesynth.stiffness; per voxel: point_fields slots 3, 4, the same frame) ---------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
         """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at pose (alpha, beta, Y); raises InvalidPose
         outside the workspace box or the actuator limits. Joints as in joint_screws: UPS legs (U at A_i with both
@@ -614,7 +755,13 @@ MECHANISM = UpsSspr(
                            [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
     default_length_unit="mm",
-    fields=base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+    fields=(
+        *base_fields("1", "J = dx/dq, x = (L alpha, L beta, Y) homogenised by the characteristic length L (mm/mm)"),
+        Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at B1 "
+              "under a pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
+        Field("deflection", "{length}", "magnitude of the deflection of B1 under options.load (default 150 N along "
+              "-z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP)),
+    ),
     design_metrics=(
         DesignMetric(
             "link_length_sum", "{length}",
