@@ -342,6 +342,7 @@ def test_numba_segment_distance_matches_the_numpy_version():
     ("planar-fivebar", None, {}), ("planar-fivebar", 150.0, {}), ("pprs-rprs", None, {}), ("pprs-rprs", 30.0, {}),
     ("rps-upu", None, {}), ("rps-upu", 25.0, {}), ("rps-upu", 25.0, {"model": "C"}),
     ("rps-upu", 25.0, {"model": "C", "c3_variant": "upu"}), ("rps-upu-tool", None, {}), ("rps-upu-tool", 20.0, {}),
+    ("ups-sspr", None, {}), ("ups-sspr", 30.0, {}),
 ])
 def test_clearance_field_matches_numpy_link_geometry(name, radius, extra):
     """The field kernel's clearance at every reachable node of a grid against cycle.clearance of the mechanism's

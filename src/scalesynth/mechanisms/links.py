@@ -14,7 +14,7 @@ bodies it does not name keeping the mechanism's default (each mechanism states i
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -79,6 +79,15 @@ class LinkGeometry:
 def adjacency(pairs: Iterable[tuple[str, str]]) -> frozenset[frozenset[str]]:
     """The adjacency set of body-name pairs."""
     return frozenset(frozenset(p) for p in pairs)
+
+
+def kernel_pairs(segment_bodies: Sequence[str], adjacent: frozenset[frozenset[str]]) -> np.ndarray:
+    """Index pairs (n, 2) int64, i < j, of the segments whose clearance counts (different bodies that share no
+    joint: the rule of LinkGeometry.checked_pairs), for a field kernel's fixed list of capsules whose bodies are
+    ``segment_bodies`` (in link_geometry's order)."""
+    b = list(segment_bodies)
+    return np.array([(i, j) for i in range(len(b)) for j in range(i + 1, len(b))
+                     if b[i] != b[j] and frozenset((b[i], b[j])) not in adjacent], dtype=np.int64).reshape(-1, 2)
 
 
 def point(*coords: float) -> np.ndarray:

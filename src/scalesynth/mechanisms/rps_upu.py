@@ -69,21 +69,13 @@ N_PACKED = 15
 _F_CLEARANCE = 3  # slot of the clearance field in the field kernels' out (its index in ``fields``), both workspaces
 
 # capsules of the clearance field in link_geometry's order (base12, base23, base31, leg1..3, platform12, 23, 31,
-# then the tool of rps-upu-tool) and their bodies (0 base, 1-3 leg_i, 4 platform, 5 tool)
+# then the tool of rps-upu-tool) and their bodies (index into TOOL_RADII: base, leg1..3, platform, tool)
 _SEGMENT_BODY = np.array([0, 0, 0, 1, 2, 3, 4, 4, 4, 5], dtype=np.int64)
-_ADJACENT_BODIES = {frozenset(p) for p in ((0, 1), (0, 2), (0, 3), (1, 4), (2, 4), (3, 4), (4, 5))}
-
-
-def _checked_pairs(n_segments: int) -> np.ndarray:
-    """Segment index pairs whose clearance counts: different bodies sharing no joint (LinkGeometry's rule)."""
-    body = _SEGMENT_BODY
-    return np.array([(i, j) for i in range(n_segments) for j in range(i + 1, n_segments)
-                     if body[i] != body[j] and frozenset((int(body[i]), int(body[j]))) not in _ADJACENT_BODIES],
-                    dtype=np.int64)
-
-
-_PAIRS = _checked_pairs(9)
-_PAIRS_TOOL = _checked_pairs(10)
+_BODY_NAMES = ("base", "leg1", "leg2", "leg3", "platform", "tool")
+_ADJACENT = links.adjacency([("base", "leg1"), ("base", "leg2"), ("base", "leg3"), ("leg1", "platform"),
+                             ("leg2", "platform"), ("leg3", "platform"), ("tool", "platform")])
+_PAIRS = links.kernel_pairs([_BODY_NAMES[b] for b in _SEGMENT_BODY[:9]], _ADJACENT)
+_PAIRS_TOOL = links.kernel_pairs([_BODY_NAMES[b] for b in _SEGMENT_BODY], _ADJACENT)
 
 # a parametrisation is degenerate below these (dimensionless) values: yaw undefined (cos psi = 0 with
 # sin theta sin psi = 0), or, for the upu variant, R[2, 2] = cos theta cos psi = 0 (y0 unbounded)

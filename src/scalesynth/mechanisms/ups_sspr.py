@@ -29,6 +29,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import segment_distance
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -62,6 +63,10 @@ LINK_RADII = {"base": 6.0, "leg1": 5.0, "leg2": 5.0, "leg3": 5.0, "link": 6.0, "
 # SPR revolute at B0 on the link, the revolute at B1 between link and platform
 ADJACENT = (("base", "leg1"), ("base", "leg2"), ("base", "leg3"), ("base", "link"), ("leg1", "link"),
             ("leg2", "platform"), ("leg3", "platform"), ("link", "platform"))
+# the clearance field's capsules in link_geometry's order (base12, base23, base31, strut, leg1, leg2, leg3, link,
+# platform12, platform23, platform31) and their bodies (index into LINK_RADII)
+_SEGMENT_BODY = np.array([0, 0, 0, 0, 1, 2, 3, 4, 5, 5, 5], dtype=np.int64)
+_PAIRS = links.kernel_pairs([tuple(LINK_RADII)[b] for b in _SEGMENT_BODY], links.adjacency(ADJACENT))
 
 # packed-parameter layout (see UpsSspr.pack)
 _C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
@@ -70,8 +75,12 @@ _ALO, _AHI, _BLO, _BHI, _YLO, _YHI = 12, 13, 14, 15, 16, 17
 # stiffness (point_fields slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N mm^2), GJ (N mm^2) of the 'leg' and
 # 'link' groups, actuator stiffness (N/mm), load (N)
 _EA_LEG, _EI_LEG, _GJ_LEG, _EA_LINK, _EI_LINK, _GJ_LINK, _KACT, _FX, _FY, _FZ = 18, 19, 20, 21, 22, 23, 24, 25, 26, 27
-N_PACKED = 28
+# capsule radii of base, leg1, leg2, leg3, link, platform (LINK_RADII order); 1 = interference-free poses only
+_RAD = 28
+_FREE_ONLY = 34
+N_PACKED = 35
 _F_STIFFNESS_MIN, _F_DEFLECTION = 3, 4  # slots of the stiffness fields in the field kernel's out
+_F_CLEARANCE = 5  # slot of the clearance field
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -164,13 +173,66 @@ def kinematic_fields(p, alpha, beta, yy, out):
 def point_fields(p, alpha, beta, yy, out):
     """Fields at task point (alpha [rad], beta [rad], Y [mm]) (kernels.grid contract): slots 0-2 LCI, sigma_min,
     sigma_max of J = dx/dq, x = (L alpha, L beta, Y) (dimensionless); _F_STIFFNESS_MIN (N/mm) and _F_DEFLECTION
-    (mm) under the packed load (ideal joints, docs/stiffness.md); LCI -1 (and zeros) outside the workspace box or
-    the actuator limits."""
+    (mm) under the packed load (ideal joints, docs/stiffness.md); _F_CLEARANCE (mm) of link_geometry's capsules;
+    LCI -1 (and zeros) outside the workspace box or the actuator limits, or, with interference_free, where the
+    capsules overlap (an exact singular pose, a zero-length leg, has clearance 0)."""
     ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
     if ok:
+        gap = _clearance(p, sa, ca, sb, cb, px, yy, pz)
+        if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+            _grid.write_unreachable(out)
+            return
         out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+        out[_F_CLEARANCE] = gap
     elif out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
         out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_seg(seg, k, ax, ay, az, bx, by, bz):
+    seg[k, 0] = ax
+    seg[k, 1] = ay
+    seg[k, 2] = az
+    seg[k, 3] = bx
+    seg[k, 4] = by
+    seg[k, 5] = bz
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _clearance(p, sa, ca, sb, cb, px, py, pz):
+    """Smallest gap (mm) between the capsules of link_geometry that share no joint at the pose with P = B1 =
+    (px, py, pz) and R = Ry(beta) Rx(alpha) (sines and cosines given); negative where two of them overlap."""
+    am = p[_AM]
+    ax = p[_AX]
+    bx = p[_BX]
+    by = p[_BY]
+    # B2, B3 = P + R (-+bx, by, 0)
+    b2x = px - cb * bx + sb * sa * by
+    b2y = py + ca * by
+    b2z = pz + sb * bx + cb * sa * by
+    b3x = px + cb * bx + sb * sa * by
+    b3y = b2y
+    b3z = pz - sb * bx + cb * sa * by
+    seg = np.empty((11, 6))
+    _put_seg(seg, 0, 0.0, 2.0 * am, 0.0, -ax, -am, 0.0)
+    _put_seg(seg, 1, -ax, -am, 0.0, ax, -am, 0.0)
+    _put_seg(seg, 2, ax, -am, 0.0, 0.0, 2.0 * am, 0.0)
+    _put_seg(seg, 3, 0.0, 0.0, 0.0, 0.0, -am, 0.0)
+    _put_seg(seg, 4, 0.0, -am, 0.0, K0 * px, K0 * py, K0 * pz)
+    _put_seg(seg, 5, -ax, -am, 0.0, b2x, b2y, b2z)
+    _put_seg(seg, 6, ax, -am, 0.0, b3x, b3y, b3z)
+    _put_seg(seg, 7, 0.0, 0.0, 0.0, px, py, pz)
+    _put_seg(seg, 8, px, py, pz, b2x, b2y, b2z)
+    _put_seg(seg, 9, b2x, b2y, b2z, b3x, b3y, b3z)
+    _put_seg(seg, 10, b3x, b3y, b3z, px, py, pz)
+    gap = math.inf
+    for k in range(_PAIRS.shape[0]):
+        i = _PAIRS[k, 0]
+        j = _PAIRS[k, 1]
+        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
+                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
+        gap = min(gap, d - p[_RAD + _SEGMENT_BODY[i]] - p[_RAD + _SEGMENT_BODY[j]])
+    return gap
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -334,6 +396,7 @@ class UpsSspr(Mechanism):
             options["characteristic_length"] = float(value)
         check_stiffness_options(options, 3, LINK_GROUPS)
         links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         """L in mm (default c): the angle columns of Jx are divided by L before conditioning."""
@@ -375,6 +438,9 @@ class UpsSspr(Mechanism):
             p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
         p[_KACT] = options["actuator_stiffness"]
         p[_FX], p[_FY], p[_FZ] = options["load"]
+        rad = links.radii(options, LINK_RADII)
+        p[_RAD : _RAD + 6] = [rad[body] for body in LINK_RADII]
+        p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
         return p
 
     @property
@@ -751,6 +817,7 @@ MECHANISM = UpsSspr(
         ),
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, link 6, platform 6 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
         *stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator, N/mm (an assumption)",
                            [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
@@ -761,6 +828,7 @@ MECHANISM = UpsSspr(
               "under a pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
         Field("deflection", "{length}", "magnitude of the deflection of B1 under options.load (default 150 N along "
               "-z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP)),
+        links.CLEARANCE_FIELD,
     ),
     design_metrics=(
         DesignMetric(
