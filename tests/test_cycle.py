@@ -279,7 +279,7 @@ def test_cycle_command_writes_csv_json_and_plots(tmp_path):
     info = json.loads(res.stdout)
     header = (tmp_path / "cycle.csv").read_text().splitlines()[0].split(",")
     assert header == ["t", "p_x", "pd_x", "pdd_x", "p_y", "pd_y", "pdd_y", "q1", "qd1", "qdd1", "force1",
-                      "q2", "qd2", "qdd2", "force2", "lci", "clearance"]
+                      "q2", "qd2", "qdd2", "force2", "lci", "clearance", "deflection"]  # the five-bar has stiffness
     units = json.loads((tmp_path / "cycle.json").read_text())["units"]
     assert units["pdd_x"] == "mm/s^2" and units["qd1"] == "rad/s" and units["force2"] == "N m"
     assert info["metrics"]["cycle_feasible"] == 1.0
@@ -498,3 +498,35 @@ def test_pprs_rail_input_follows_x_exactly():
     np.testing.assert_allclose(res.qd[:, 0], res.traj.pd[:, 0], atol=1e-9)
     np.testing.assert_allclose(res.qdd[:, 0], res.traj.pdd[:, 0], atol=1e-6 * np.abs(res.traj.pdd).max())
     assert np.abs(res.qd[:, 0]).max() == pytest.approx(150.0, rel=1e-4)
+
+
+# ----- deflection along the cycle -----------------------------------------------------------------------------
+STIFF = load_config(ROOT / "configs" / "fivebar_stiffness.yaml")
+
+
+@pytest.mark.parametrize("cfg, samples", [(STIFF, (0, 13, 31, 47)), (UPS, (5, 29))])
+def test_deflection_along_the_cycle_equals_the_pose_level_stiffness_command(cfg, samples):
+    """At sample poses, the cycle's deflection column equals `scalesynth stiffness MECH --pose P --load F` (the
+    frame model solved by the NumPy reference, ideal joints) with F = m (g - a) the force the payload exerts on the
+    platform at that sample (N; its weight at rest)."""
+    res = run(cfg, samples=60)
+    assert res.deflection is not None and np.all(res.deflection > 0)
+    m = METRES_PER_UNIT[cfg.units.length]
+    design = cfg.resolved_design()
+    sets = [f"{k}={v}" for k, v in design.items()]
+    for s in samples:
+        load = cfg.cycle.payload * (res.gravity - res.payload_accel[s] * m)
+        cli = CliRunner().invoke(app, ["stiffness", cfg.mech.name, "--pose", ",".join(f"{v:.17g}" for v in
+                                 res.traj.p[s]), "--load", ",".join(f"{v:.17g}" for v in load), "--json",
+                                 *[a for kv in sets for a in ("--set", kv)],
+                                 *[a for k, v in cfg.options.items() for a in ("--set", f"{k}={json.dumps(v)}")]])
+        assert cli.exit_code == 0, cli.output
+        ref = json.loads(cli.stdout)["deflection_norm"]
+        assert res.deflection[s] == pytest.approx(ref, rel=1e-7), s
+    assert analysis.result_metrics(res, cfg.cycle)["cycle_max_deflection"] == pytest.approx(res.deflection.max())
+
+
+def test_mechanisms_without_a_stiffness_model_report_no_deflection():
+    res = run(PPRS)
+    assert res.deflection is None and "deflection" not in res.columns()
+    assert "cycle_max_deflection" not in analysis.result_metrics(res, PPRS.cycle)

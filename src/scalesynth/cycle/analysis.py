@@ -21,8 +21,11 @@ Along the sampled trajectory (``cycle.trajectory``), in the configured working m
   (W) at every sample (power balance);
 * the LCI from the point kernel and the clearance of the link capsules (``cycle.clearance``).
 
-Deflection along the cycle (stiffness, issue 12) goes into ``CycleResult.deflection`` when a mechanism provides
-a compliance model; it is None until then.
+* the deflection (``CycleResult.deflection``, where the mechanism has a per-voxel ``deflection`` field and a
+  ``load`` option: planar-fivebar, ups-sspr): at every sample the magnitude of the payload point's deflection
+  under the force the payload exerts on the platform, m (g - c_ddot) (N; at rest its weight), from the
+  mechanism's stiffness model with ideal joints (its field kernel re-packed with that load; the same model as
+  the pose-level ``scalesynth stiffness`` command, tested against it). None for the other mechanisms.
 """
 
 from __future__ import annotations
@@ -57,7 +60,7 @@ class CycleResult:
     angle axis); payload_velocity, payload_accel (n, 3 or k) the payload point's velocity and acceleration
     (length unit per s, per s^2; payload axes, ``cycle.config.payload_axes``); lci (n,); clearance (n,) in the
     length unit (< 0: interference) and clearance_pair the two segments at it. ``deflection``: hook for the
-    stiffness model, None until a mechanism provides one."""
+    stiffness model, None until a mechanism provides one; see ``deflection_along``."""
 
     traj: trajectory.Trajectory
     q: np.ndarray
@@ -96,6 +99,8 @@ class CycleResult:
             out[f"force{i + 1}"] = self.force[:, i]
         out["lci"] = self.lci
         out["clearance"] = self.clearance
+        if self.deflection is not None:
+            out["deflection"] = self.deflection
         return out
 
     def units(self) -> dict[str, str]:
@@ -110,6 +115,8 @@ class CycleResult:
             out.update({f"q{i}": base, f"qd{i}": f"{base}/s", f"qdd{i}": f"{base}/s^2",
                         f"force{i}": "N" if u == "length" else "N m"})
         out.update({"lci": "1", "clearance": lu})
+        if self.deflection is not None:
+            out["deflection"] = lu
         return out
 
 
@@ -214,6 +221,7 @@ def analyse(
     qd = np.einsum("nij,nj->ni", A, pd_full)
     qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(mech, design, options, traj, q, label, angular, size)
     g = ccfg.gravity_vector(cyc, mech)
+    m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     vel, acc, jc = _payload_motion(mech, design, options, traj, size)
     force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
     gaps, pairs = [], []
@@ -226,6 +234,7 @@ def analyse(
         clearance_pair=tuple(pairs), task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
         joint_units=mech.joint_units, length_unit=length_unit, payload=cyc.payload, gravity=g,
         force_map=force_map, force_gravity=force_gravity, payload_velocity=vel, payload_accel=acc,
+        deflection=deflection_along(mech, design, options, traj.p, cyc.payload * (g[None, :] - acc * m_per_unit)),
     )
 
 
@@ -262,6 +271,24 @@ def si_velocity_map(mech: Mechanism, A: np.ndarray, length_unit: str) -> np.ndar
     col = np.ones(nj)
     col[: len(mech.task_units)] = [1.0 / m if u == "length" else 1.0 for u in mech.task_units]
     return A * row[:, None] * col[None, :]
+
+
+def has_deflection(mech: Mechanism) -> bool:
+    """Whether the cycle analysis reports a deflection for ``mech`` (a per-voxel deflection field and a load)."""
+    return "deflection" in mech.field_names and "load" in mech.option_names
+
+
+def deflection_along(mech: Mechanism, design, options, poses: np.ndarray, loads: np.ndarray) -> np.ndarray | None:
+    """Deflection magnitude (length unit) of the platform at each pose (n, k) under its load (n, 2 or 3; N, the
+    mechanism's load axes), from the field kernel's ``deflection`` slot with ``options['load']`` replaced per
+    sample; None when the mechanism has no deflection field."""
+    if not has_deflection(mech):
+        return None
+    from scalesynth.kernels.paired import paired_points_fields
+
+    params = np.stack([mech.pack(design, {**options, "load": [float(v) for v in f]}) for f in loads])
+    pts = np.pad(np.asarray(poses, dtype=float), ((0, 0), (0, 3 - poses.shape[1])))
+    return paired_points_fields(mech.field_kernel, mech.n_fields, params, pts)[:, mech.field_names.index("deflection")]
 
 
 def _payload_motion(mech, design, options, traj, size) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -361,6 +388,8 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
         bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
                 "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
                 "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
+        if has_deflection(mech):
+            bad["cycle_max_deflection"] = CYCLE_PENALTY
         if cyc.speed_limits is not None or cyc.force_limits is not None:
             bad["max_cycles_per_minute"] = 0.0
         return bad
@@ -382,6 +411,8 @@ def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:
         "cycle_min_lci": float(np.min(res.lci)),
         "cycle_min_clearance": float(min(np.min(res.clearance), CYCLE_PENALTY)),
     }
+    if res.deflection is not None:
+        out["cycle_max_deflection"] = float(min(np.max(res.deflection), CYCLE_PENALTY))
     if speed is not None or force is not None:
         out["max_cycles_per_minute"] = 60.0 / cyc.cycle_time * scale
     return out

@@ -253,6 +253,7 @@ CYCLE_METRICS = (
     "cycle_max_actuator_force",
     "cycle_min_lci",
     "cycle_min_clearance",
+    "cycle_max_deflection",
     "max_cycles_per_minute",
 )
 
