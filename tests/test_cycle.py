@@ -313,6 +313,12 @@ def _write(tmp_path, cfg, **cycle):
     ("fivebar_packing.yaml", {"law": "cubic"}, "error: cycle.law: unknown motion law 'cubic'"),
     ("fivebar_packing.yaml", {"payload": -2.0}, "error: cycle.payload: must be a finite number > 0"),
     ("fivebar_packing.yaml", {"direction": [1.0, 1.0]}, "error: cycle.direction: must be perpendicular to gravity"),
+    ("fivebar_packing.yaml", {"preset": None, "start": None, "direction": None, "path": [[0, -700], [1e13, -700]]},
+     "error: cycle.path.1: 1e+13 is beyond +-1e+12"),
+    ("fivebar_packing.yaml", {"preset": None, "start": None, "direction": None, "path": [[0, -700], [0, -700]]},
+     "error: cycle.path: all points coincide"),
+    ("fivebar_packing.yaml", {"payload": 2e12}, "error: cycle.payload: 2e+12 is beyond +-1e+12"),
+    ("fivebar_packing.yaml", {"gravity": [0.0, -1e13]}, "error: cycle.gravity.1: -1e+13 is beyond +-1e+12"),
     ("rps_upu.yaml", {"path": None, "preset": "adept", "start": [40, 0, 0], "cycles_per_minute": 30},
      "error: cycle.preset: adept needs two Cartesian task axes; rps-upu has z, theta, psi"),
 ])
@@ -530,3 +536,22 @@ def test_mechanisms_without_a_stiffness_model_report_no_deflection():
     res = run(PPRS)
     assert res.deflection is None and "deflection" not in res.columns()
     assert "cycle_max_deflection" not in analysis.result_metrics(res, PPRS.cycle)
+
+
+def test_seed001_square_stays_in_one_assembly_mode_and_a_larger_square_is_refused():
+    """Seed 001's square (the old drive_curves checks, now on the cycle): Newton FK of each sample's actuators from
+    the previous sample's pose lands back on the sample (one assembly mode along the whole loop); the 40 mm square
+    centred at (-30, -30) leaves the workspace at z = 200 mm, a one-line CycleError naming the sample."""
+    from scalesynth.mechanisms.pprs_rprs import Geometry, newton_fk, sigma_vector
+
+    res = run(PPRS, law="constant", period=1.0, cycles_per_minute=None, samples=100)
+    design, options = PPRS.resolved_design(), PPRS.resolved_options()
+    geo = Geometry.of(design, options)
+    poses = np.column_stack([res.traj.p, np.tile(options["orientation"], (len(res.traj.t), 1))])
+    fk, conv = newton_fk(geo, sigma_vector(options["sigma"]), res.q[1:], poses[:-1])
+    assert conv.all()
+    np.testing.assert_allclose(fk, poses[1:], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(res.q[-1], res.q[0], atol=1e-12)  # back at E: back to the start values
+    big = [[-50, -50, 200], [-10, -50, 200], [-10, -10, 200], [-50, -10, 200]]
+    with pytest.raises(analysis.CycleError, match=r"^cycle\.path\[\d\]: .* is outside the workspace"):
+        run(PPRS, path=big)

@@ -36,6 +36,17 @@ ADEPT_ACROSS_MM = 305.0
 METRES_PER_UNIT = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001}
 
 
+def _within_magnitude(*values: float) -> None:
+    """ValueError for a value beyond +-MAX_MAGNITUDE (as every other number of a config)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
+    for i, v in enumerate(values):
+        if abs(v) > MAX_MAGNITUDE:
+            where = f"{i}: " if len(values) > 1 else ""
+            raise ValueError(f"{where}{v:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth computes "
+                             "with (products of such values overflow)")
+
+
 class CycleConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
@@ -55,17 +66,9 @@ class CycleConfig(BaseModel):
     @field_validator("path")
     @classmethod
     def _path_ok(cls, v):
-        if v is None:
-            return v
-        if len(v) < 2:
-            raise ValueError(f"need at least 2 points, got {len(v)}")
-        if len({len(p) for p in v}) != 1:
-            raise ValueError("every point needs the same number of coordinates")
-        if not all(math.isfinite(c) for p in v for c in p):
-            raise ValueError("coordinates must be finite")
-        if all(p == v[0] for p in v):
-            raise ValueError("all points coincide: the path has no length")
-        return v
+        from scalesynth.paths import check_polyline
+
+        return None if v is None else check_polyline(v, closed=True)
 
     @field_validator("preset")
     @classmethod
@@ -89,6 +92,8 @@ class CycleConfig(BaseModel):
     def _positive(cls, v):
         if v is not None and not (math.isfinite(v) and v > 0):
             raise ValueError(f"must be a finite number > 0, got {v}")
+        if v is not None:
+            _within_magnitude(v)
         return v
 
     @field_validator("start", "direction", "gravity")
@@ -96,6 +101,8 @@ class CycleConfig(BaseModel):
     def _finite(cls, v):
         if v is not None and not all(math.isfinite(c) for c in v):
             raise ValueError("must be finite")
+        if v is not None:
+            _within_magnitude(*v)
         return v
 
     @field_validator("speed_limits", "force_limits")
@@ -104,6 +111,7 @@ class CycleConfig(BaseModel):
         for x in [] if v is None else [v] if isinstance(v, (int, float)) else v:
             if not (math.isfinite(x) and x > 0):
                 raise ValueError(f"limits must be finite numbers > 0, got {x}")
+            _within_magnitude(x)
         return v
 
     @model_validator(mode="after")
