@@ -59,7 +59,7 @@ class CycleResult:
     alone; task_force (n, k) the generalised force F on the task axes (N along a length axis, N m about an
     angle axis); payload_velocity, payload_accel (n, 3 or k) the payload point's velocity and acceleration
     (length unit per s, per s^2; payload axes, ``cycle.config.payload_axes``); lci (n,); clearance (n,) in the
-    length unit (< 0: interference) and clearance_pair the two segments at it. ``deflection``: hook for the
+    length unit (< 0: interference) and min_clearance_pair the two segments at its minimum. ``deflection``: hook for the
     stiffness model, None until a mechanism provides one; see ``deflection_along``."""
 
     traj: trajectory.Trajectory
@@ -70,7 +70,7 @@ class CycleResult:
     task_force: np.ndarray
     lci: np.ndarray
     clearance: np.ndarray
-    clearance_pair: tuple[tuple[str, str] | None, ...]
+    min_clearance_pair: tuple[str, str] | None  # the two segments at the smallest clearance
     task_axes: tuple[str, ...]
     task_units: tuple[str, ...]
     joints: tuple[str, ...]
@@ -131,17 +131,6 @@ def _where(mech: Mechanism, traj, k: int) -> str:
     return f"sample {k} (t = {traj.t[k]:.4g} s, segment {traj.segment[k] + 1}) at ({axes}) = ({pos})"
 
 
-def _branches(mech: Mechanism, design, options, pose) -> dict[str, np.ndarray]:
-    return {s.label: s.values for s in mech.inverse_kinematics(design, options, pose)}
-
-
-def _unwrap(q: np.ndarray, ref: np.ndarray, angular: np.ndarray) -> np.ndarray:
-    """q with its angles moved by whole turns to lie within pi of ref."""
-    out = np.array(q, dtype=float)
-    out[angular] = ref[angular] + wrap_angle(out[angular] - ref[angular])
-    return out
-
-
 def check_vertices(mech: Mechanism, design, options, verts: np.ndarray, what: str) -> None:
     """Raise CycleError naming the first vertex outside the workspace (within every limit)."""
     from scalesynth.kernels.grid import points_lci
@@ -157,6 +146,25 @@ def check_vertices(mech: Mechanism, design, options, verts: np.ndarray, what: st
         )
 
 
+def _kinematics_source(mech: Mechanism, design, options, label: str, reference: bool):
+    """poses (n, k) -> (q (n, nj) with NaN rows out of reach in the branch, A (n, nj, nj)): the mechanism's
+    (possibly vectorised) ``cycle_kinematics``, or with ``reference`` the base class's per-pose loop over
+    inverse_kinematics and velocity_map (the obviously correct twin the tests compare with)."""
+    if reference:
+        return lambda poses: Mechanism.cycle_kinematics(mech, design, options, poses, label)
+    return lambda poses: mech.cycle_kinematics(design, options, poses, label)
+
+
+def _unwrap_along(q: np.ndarray, angular: np.ndarray) -> np.ndarray:
+    """q (n, nj) with its angle columns moved by whole turns so that each sample lies within pi of the previous
+    one (q[s] = q[s - 1] + wrap(q[s] - q[s - 1]))."""
+    out = np.array(q, dtype=float)
+    if np.any(angular) and len(out) > 1:
+        steps = wrap_angle(np.diff(out[:, angular], axis=0))
+        out[1:, angular] = out[0, angular] + np.cumsum(steps, axis=0)
+    return out
+
+
 def analyse(
     mech: Mechanism,
     design: Mapping[str, float],
@@ -165,9 +173,15 @@ def analyse(
     length_unit: str,
     *,
     rate_scale: float = 1.0,
+    reference: bool = False,
 ) -> CycleResult:
     """The cycle of one design (module docstring). ``rate_scale`` multiplies the cycle rate (2 = twice as many
-    cycles per minute). Raises CycleError where the cycle cannot be followed."""
+    cycles per minute). Raises CycleError where the cycle cannot be followed.
+
+    The per-sample kinematics come from ``Mechanism.cycle_kinematics`` (vectorised over the samples where the
+    mechanism provides it) and the clearance from the field kernel's ``clearance`` slot where the mechanism has
+    one; ``reference=True`` takes both from the per-pose NumPy methods instead (inverse_kinematics, velocity_map,
+    link_geometry), the slow twin the tests hold the fast path to."""
     from scalesynth.kernels.grid import points_lci
 
     design = mech.resolve_design(design)
@@ -177,35 +191,40 @@ def analyse(
     traj = trajectory.build(verts, cyc.law, cyc.cycle_time / rate_scale, cyc.samples)
     n, k = traj.p.shape
     nj = len(mech.joints)
-    lci = points_lci(mech.point_kernel, mech.pack(design, options), np.pad(traj.p, ((0, 0), (0, 3 - k))))
+    packed = mech.pack(design, options)
+    pts = np.pad(traj.p, ((0, 0), (0, 3 - k)))
+    lci = points_lci(mech.point_kernel, packed, pts)
     outside = np.nonzero(lci < 0)[0]
     if outside.size:
         raise CycleError(f"cycle: {_where(mech, traj, int(outside[0]))} is outside the workspace")
     label = mech.kernel_branch(options)
+    kin = _kinematics_source(mech, design, options, label, reference)
     angular = np.array([u == "angle" for u in mech.joint_units])
     size = _size(mech, design, options)
     joint_scale = np.where(angular, size, 1.0)
-    q = np.empty((n, nj))
-    A = np.empty((n, nj, nj))
-    for s in range(n):
-        sols = _branches(mech, design, options, traj.p[s])
-        if label not in sols:
-            raise CycleError(f"cycle: {_where(mech, traj, s)} is out of reach in working mode {label}")
-        q[s] = sols[label] if s == 0 else _unwrap(sols[label], q[s - 1], angular)
-        A[s] = mech.velocity_map(design, options, traj.p[s], q[s])
-        if s > 0 and np.all(np.isfinite(A[s - 1 : s + 1])):
-            # branch continuity: the step in q must be the one the velocity map predicts for the step in x (to
-            # first order; the trapezoidal rule's error is second order), else the branch jumped
-            dx = np.zeros(nj)
-            dx[:k] = traj.p[s] - traj.p[s - 1]
-            predicted = 0.5 * (A[s] + A[s - 1]) @ dx
-            if np.linalg.norm((q[s] - q[s - 1] - predicted) * joint_scale) > 0.5 * np.linalg.norm(
-                predicted * joint_scale
-            ) + 1e-9 * size:
-                raise CycleError(
-                    f"cycle: branch {label} jumps between sample {s - 1} and {_where(mech, traj, s)} (a singularity "
-                    "or a branch point on the path; more cycle.samples may resolve it)"
-                )
+    q_raw, A = kin(traj.p)
+    reach = np.all(np.isfinite(q_raw), axis=1)
+    first_out = int(np.argmin(reach)) if not reach.all() else n
+    q = _unwrap_along(np.where(reach[:, None], q_raw, 0.0)[:first_out], angular)
+    # branch continuity: the step in q must be the one the velocity map predicts for the step in x (to first
+    # order; the trapezoidal rule's error is second order), else the branch jumped
+    m = q.shape[0]
+    if m > 1:
+        dx = np.zeros((m - 1, nj))
+        dx[:, :k] = np.diff(traj.p[:m], axis=0)
+        with np.errstate(invalid="ignore"):
+            predicted = np.einsum("sij,sj->si", 0.5 * (A[1:m] + A[: m - 1]), dx)
+            miss = np.linalg.norm((np.diff(q, axis=0) - predicted) * joint_scale, axis=1)
+            finite = np.all(np.isfinite(A[1:m]), axis=(1, 2)) & np.all(np.isfinite(A[: m - 1]), axis=(1, 2))
+            jumps = np.nonzero(finite & (miss > 0.5 * np.linalg.norm(predicted * joint_scale, axis=1) + 1e-9 * size))[0]
+        if jumps.size:
+            s = int(jumps[0]) + 1
+            raise CycleError(
+                f"cycle: branch {label} jumps between sample {s - 1} and {_where(mech, traj, s)} (a singularity "
+                "or a branch point on the path; more cycle.samples may resolve it)"
+            )
+    if first_out < n:
+        raise CycleError(f"cycle: {_where(mech, traj, first_out)} is out of reach in working mode {label}")
     det = np.linalg.det(A)
     sign = np.sign(det)
     bad = np.nonzero(~np.isfinite(det) | (sign == 0) | (lci <= 0))[0]
@@ -219,46 +238,58 @@ def analyse(
     pdd_full = np.zeros((n, nj))
     pdd_full[:, :k] = traj.pdd
     qd = np.einsum("nij,nj->ni", A, pd_full)
-    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(mech, design, options, traj, q, label, angular, size)
+    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(kin, mech, traj, size)
     g = ccfg.gravity_vector(cyc, mech)
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     vel, acc, jc = _payload_motion(mech, design, options, traj, size)
     force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
-    gaps, pairs = [], []
-    for s in range(n):
-        c = clearance(mech.link_geometry(design, options, traj.p[s], q[s]))
-        gaps.append(c.value)
-        pairs.append(c.pair)
+    gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)
+    at = int(np.argmin(gaps))
     return CycleResult(
-        traj=traj, q=q, qd=qd, qdd=qdd, force=force, task_force=task_force, lci=lci, clearance=np.array(gaps),
-        clearance_pair=tuple(pairs), task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
+        traj=traj, q=q, qd=qd, qdd=qdd, force=force, task_force=task_force, lci=lci, clearance=gaps,
+        min_clearance_pair=clearance(mech.link_geometry(design, options, traj.p[at], q[at])).pair,
+        task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
         joint_units=mech.joint_units, length_unit=length_unit, payload=cyc.payload, gravity=g,
         force_map=force_map, force_gravity=force_gravity, payload_velocity=vel, payload_accel=acc,
         deflection=deflection_along(mech, design, options, traj.p, cyc.payload * (g[None, :] - acc * m_per_unit)),
     )
 
 
-def _a_dot_xdot(mech, design, options, traj, q, label, angular, size) -> np.ndarray:
-    """(dA/dt) x_dot per sample by a central difference of A along x_dot (IK re-solved in the branch)."""
+def _clearance_along(mech: Mechanism, design, options, packed, poses: np.ndarray, q: np.ndarray,
+                     reference: bool) -> np.ndarray:
+    """Clearance (n,) at each sample: the field kernel's clearance slot (one compiled call for all samples) where
+    the mechanism has that field, else (and with ``reference``) cycle.clearance of link_geometry per sample."""
+    if "clearance" in mech.field_names and not reference:
+        from scalesynth.kernels.grid import population_points_fields
+
+        pts = np.pad(poses, ((0, 0), (0, 3 - poses.shape[1])))
+        fields = population_points_fields(mech.field_kernel, mech.n_fields, packed[None, :], pts)[0]
+        return fields[:, mech.field_names.index("clearance")]
+    return np.array([clearance(mech.link_geometry(design, options, poses[s], q[s])).value
+                     for s in range(len(poses))])
+
+
+def _a_dot_xdot(kin, mech: Mechanism, traj, size) -> np.ndarray:
+    """(dA/dt) x_dot per sample by a central difference of A along x_dot (IK re-solved in the branch, all
+    moving samples in two calls of the kinematics source)."""
     n, k = traj.p.shape
-    nj = q.shape[1]
+    nj = len(mech.joints)
     out = np.zeros((n, nj))
-    for s in range(n):
-        v = traj.pd[s]
-        speed = float(np.linalg.norm(v))
-        if speed == 0.0:
-            continue
-        eps = _DERIV_STEP * size / speed  # a time step: the pose moves by _DERIV_STEP * size
-        mats = []
-        for sign in (1.0, -1.0):
-            pose = traj.p[s] + sign * eps * v
-            sols = _branches(mech, design, options, pose)
-            if label not in sols:
-                raise CycleError(f"cycle: {_where(mech, traj, s)} lies on the boundary of the workspace")
-            mats.append(mech.velocity_map(design, options, pose, _unwrap(sols[label], q[s], angular)))
-        vfull = np.zeros(nj)
-        vfull[:k] = v
-        out[s] = (mats[0] - mats[1]) @ vfull / (2.0 * eps)
+    speed = np.linalg.norm(traj.pd, axis=1)
+    moving = np.nonzero(speed > 0.0)[0]
+    if not moving.size:
+        return out
+    v = traj.pd[moving]
+    eps = _DERIV_STEP * size / speed[moving]  # a time step: the pose moves by _DERIV_STEP * size
+    q_plus, a_plus = kin(traj.p[moving] + eps[:, None] * v)
+    q_minus, a_minus = kin(traj.p[moving] - eps[:, None] * v)
+    lost = ~(np.all(np.isfinite(q_plus), axis=1) & np.all(np.isfinite(q_minus), axis=1))
+    if lost.any():
+        raise CycleError(f"cycle: {_where(mech, traj, int(moving[np.argmax(lost)]))} lies on the boundary of the "
+                         "workspace")
+    vfull = np.zeros((len(moving), nj))
+    vfull[:, :k] = v
+    out[moving] = np.einsum("sij,sj->si", a_plus - a_minus, vfull) / (2.0 * eps[:, None])
     return out
 
 

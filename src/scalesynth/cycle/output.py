@@ -38,7 +38,7 @@ def summary(res: CycleResult, metrics: dict[str, float], design: dict[str, float
         "vertices": res.traj.vertices.tolist(),
         "vertex_times_s": res.traj.vertex_times.tolist(),
         "metrics": metrics,
-        "min_clearance_at": {"t_s": float(res.traj.t[k]), "segments": list(res.clearance_pair[k] or [])},
+        "min_clearance_at": {"t_s": float(res.traj.t[k]), "segments": list(res.min_clearance_pair or [])},
         "units": res.units(),
         "model": "forces: quasi-static plus payload inertia (point mass at the task point, massless links, no "
         "friction): A^T tau = [m (a - g); 0]",
