@@ -555,3 +555,45 @@ def test_seed001_square_stays_in_one_assembly_mode_and_a_larger_square_is_refuse
     big = [[-50, -50, 200], [-10, -50, 200], [-10, -10, 200], [-50, -10, 200]]
     with pytest.raises(analysis.CycleError, match=r"^cycle\.path\[\d\]: .* is outside the workspace"):
         run(PPRS, path=big)
+
+
+# ----- fast path: vectorised kinematics and kernel clearance against the per-pose reference ---------------------
+@pytest.mark.parametrize("name", CASES)
+def test_fast_cycle_analysis_equals_the_reference_analysis(name):
+    """analyse() (Mechanism.cycle_kinematics, vectorised where a mechanism overrides it; clearance from the field
+    kernel where it has one) against analyse(reference=True) (inverse_kinematics, velocity_map and link_geometry
+    per pose): every column and metric equal to rounding."""
+    cfg = CASES[name]
+    fast, ref = run(cfg, samples=80), None
+    cyc = cfg.cycle.model_copy(update={"samples": 80})
+    ref = analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cyc, cfg.units.length,
+                           reference=True)
+    for key, col in ref.columns().items():
+        scale = max(np.abs(col).max(), 1e-300)
+        np.testing.assert_allclose(fast.columns()[key], col, rtol=0, atol=1e-9 * scale, err_msg=key)
+    assert fast.min_clearance_pair == ref.min_clearance_pair
+    assert analysis.result_metrics(fast, cyc) == pytest.approx(analysis.result_metrics(ref, cyc), rel=1e-9)
+
+
+@pytest.mark.parametrize("name", [n for n in CASES if type(CASES[n].mech).cycle_kinematics
+                                  is not analysis.Mechanism.cycle_kinematics])
+def test_vectorised_cycle_kinematics_equal_the_per_pose_loop(name):
+    """Each override of cycle_kinematics against the base class's loop at the cycle's samples and at a pose far
+    beyond the workspace (NaN rows wherever the loop finds no branch, in both)."""
+    cfg = CASES[name]
+    mech, design, options = cfg.mech, cfg.resolved_design(), cfg.resolved_options()
+    res = run(cfg, samples=40)
+    lo, hi = mech.bounding_box(design, options)
+    k = len(mech.task_axes)
+    far = np.array(hi[:k]) + 3.0 * (np.array(hi[:k]) - np.array(lo[:k])) + 1.0
+    poses = np.vstack([res.traj.p, far[None, :]])
+    label = mech.kernel_branch(options)
+    q, a = mech.cycle_kinematics(design, options, poses, label)
+    q_ref, a_ref = analysis.Mechanism.cycle_kinematics(mech, design, options, poses, label)
+    assert np.array_equal(np.isnan(q), np.isnan(q_ref)) and not np.isnan(q[:-1]).any()
+    live = ~np.isnan(q_ref).any(axis=1)
+    ang = np.array([u == "angle" for u in mech.joint_units])
+    dq = q[live] - q_ref[live]
+    dq[:, ang] = wrap_angle(dq[:, ang])
+    np.testing.assert_allclose(dq, 0.0, atol=1e-9)
+    np.testing.assert_allclose(a[live], a_ref[live], rtol=1e-9, atol=1e-12 * np.abs(a_ref[live]).max())

@@ -317,9 +317,30 @@ def deflection_along(mech: Mechanism, design, options, poses: np.ndarray, loads:
         return None
     from scalesynth.kernels.paired import paired_points_fields
 
-    params = np.stack([mech.pack(design, {**options, "load": [float(v) for v in f]}) for f in loads])
+    loads = np.asarray(loads, dtype=float)
+    params = _packed_with_loads(mech, design, options, loads)
     pts = np.pad(np.asarray(poses, dtype=float), ((0, 0), (0, 3 - poses.shape[1])))
     return paired_points_fields(mech.field_kernel, mech.n_fields, params, pts)[:, mech.field_names.index("deflection")]
+
+
+def _packed_with_loads(mech: Mechanism, design, options, loads: np.ndarray) -> np.ndarray:
+    """One packed vector per load (n, k_packed): the design packed once, the load's entries found by packing the
+    unit loads (each must set exactly one entry to 1) and overwritten per row; a mechanism that packs its load
+    otherwise is packed once per load."""
+    def pack(load):
+        return mech.pack(design, {**options, "load": [float(v) for v in load]})
+
+    dim = loads.shape[1]
+    zero = pack(np.zeros(dim))
+    slots = []
+    for a in range(dim):
+        diff = np.nonzero(pack(np.eye(dim)[a]) != zero)[0]
+        if diff.size != 1 or pack(np.eye(dim)[a])[diff[0]] != 1.0 or zero[diff[0]] != 0.0:
+            return np.stack([pack(f) for f in loads])
+        slots.append(int(diff[0]))
+    out = np.tile(zero, (len(loads), 1))
+    out[:, slots] = loads
+    return out
 
 
 def _payload_motion(mech, design, options, traj, size) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:

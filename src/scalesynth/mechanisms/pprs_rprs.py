@@ -778,6 +778,18 @@ class PprsRprs(Mechanism):
         orientation's angular velocity omega (rad/s) is 0 along a constant-orientation cycle (spec §1.5)."""
         return self.jacobians(design, options, pose, q)["Jt"]
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: chain_state of branch ``label`` at every pose (n, 3) at
+        the options' orientation and its twist Jacobian J_t (velocity_map); NaN rows where a link cannot reach."""
+        pts = np.asarray(poses, dtype=float)
+        X = np.concatenate([pts, np.tile(np.asarray(options["orientation"], dtype=float), (len(pts), 1))], axis=1)
+        geo = Geometry.of(design, options)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            st = chain_state(geo, X, sigma_vector(label))
+            jt = twist_jacobian(geo, st)
+        ok = np.asarray(st.ok, dtype=bool)
+        return np.where(ok[:, None], st.q, np.nan), np.where(ok[:, None, None], jt, np.nan)
+
     def joint_limits(self, options: Mapping[str, Any]) -> np.ndarray:
         """Limits (6, 2) of (w1, w2, beta, s1, s2, s3), mm and rad."""
         return np.array([options["w_limits"]] * 2 + [options["beta_limits"]] + [options["s_limits"]] * 3)

@@ -837,6 +837,16 @@ class RpsUpu(Mechanism):
             return np.full((3, 3), np.inf)
         return jac["dq_dx"]
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: leg lengths and dq/d(z, theta, psi) (velocity_map) at
+        poses (n, 3) from the vectorised _legs; NaN rows where the branch or the C-model parametrisation fails."""
+        x = np.asarray(poses, dtype=float)
+        valid, q, jx = _legs(self._geom(design), options["model"], options["c3_variant"], x)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = np.where(np.all(q > 0.0, axis=1)[:, None, None], jx / q[:, :, None], np.inf)
+        ok = valid & (label == BRANCH)
+        return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a, np.nan)
+
     def payload_point(self, design, options, pose) -> np.ndarray:
         """The cycle's payload sits at the platform origin O' = (0, y0, z) (mm; y0 = 0 in the P-model)."""
         return self._joint_points(design, options, pose)[2]
@@ -1174,6 +1184,32 @@ class RpsUpuTool(RpsUpu):
         """dq/dT (mm/mm) of the tool point; infinite where cos theta cos psi = 0 or a leg length is 0."""
         jac = self.jacobians(design, options, pose, q)
         return np.full((3, 3), np.inf) if jac["dq_dT"] is None else jac["dq_dT"]
+
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics for the kernel's branch '++' (cos theta, cos psi > 0):
+        the pose of each tool point in closed form (poses_of_tool_point), its legs and dq/dT = dq/dx (dT/dx)^-1
+        (velocity_map); other branches take the per-pose loop."""
+        if label != "++":
+            return Mechanism.cycle_kinematics(self, design, options, poses, label)
+        t = np.asarray(poses, dtype=float)
+        d = options["tool_offset"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ps = np.arcsin(np.clip(t[:, 1] / d, -1.0, 1.0))
+            cp = np.cos(ps)
+            ok = (np.abs(t[:, 1]) <= d) & (np.abs(cp) > 1e-12) & (np.abs(t[:, 0]) <= d * np.abs(cp))
+            th = np.arcsin(np.clip(-t[:, 0] / (d * cp), -1.0, 1.0))
+            ct, st, sp = np.cos(th), np.sin(th), np.sin(ps)
+            x = np.column_stack([t[:, 2] + d * ct * cp, wrap_angle(th), wrap_angle(ps)])
+            _, q, jx = _legs(self._geom(design), "P", "plane", np.where(ok[:, None], x, 0.0))
+            dt_dx = np.zeros((len(t), 3, 3))
+            dt_dx[:, 0, 1], dt_dx[:, 0, 2] = -d * ct * cp, d * st * sp
+            dt_dx[:, 1, 2] = d * cp
+            dt_dx[:, 2, 0], dt_dx[:, 2, 1], dt_dx[:, 2, 2] = 1.0, d * st * cp, d * ct * sp
+            regular = ok & (np.abs(ct * cp) > 0.0)
+            safe = np.where(regular[:, None, None], dt_dx, np.eye(3))
+            jx_t = np.transpose(np.linalg.solve(np.transpose(safe, (0, 2, 1)), np.transpose(jx, (0, 2, 1))), (0, 2, 1))
+            a = np.where((regular & np.all(q > 0.0, axis=1))[:, None, None], jx_t / q[:, :, None], np.inf)
+        return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a, np.nan)
 
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of dq/dT with NumPy's SVD (0 at any singularity)."""
