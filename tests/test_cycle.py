@@ -597,3 +597,12 @@ def test_vectorised_cycle_kinematics_equal_the_per_pose_loop(name):
     dq[:, ang] = wrap_angle(dq[:, ang])
     np.testing.assert_allclose(dq, 0.0, atol=1e-9)
     np.testing.assert_allclose(a[live], a_ref[live], rtol=1e-9, atol=1e-12 * np.abs(a_ref[live]).max())
+
+
+@pytest.mark.parametrize("name", ["rps-upu", "ups-sspr", "rps-upu-tool"])
+def test_vectorised_payload_points_equal_payload_point(name):
+    cfg = CASES[name]
+    mech, design, options = cfg.mech, cfg.resolved_design(), cfg.resolved_options()
+    poses = run(cfg, samples=30).traj.p
+    np.testing.assert_allclose(mech.payload_points(design, options, poses),
+                               [mech.payload_point(design, options, p) for p in poses], rtol=0, atol=1e-12)

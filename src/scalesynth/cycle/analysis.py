@@ -355,25 +355,20 @@ def _payload_motion(mech, design, options, traj, size) -> tuple[np.ndarray, np.n
         return traj.pd, traj.pdd, None
     n, k = traj.p.shape
     scale = np.array([size if u == "length" else 1.0 for u in mech.task_units])
-
-    def c(x):
-        return np.asarray(mech.payload_point(design, options, x), dtype=float)
-
-    jc = np.empty((n, 3, k))
-    vel = np.empty((n, 3))
-    acc = np.empty((n, 3))
-    for s in range(n):
-        x, v = traj.p[s], traj.pd[s]
-        for a in range(k):
-            h = np.zeros(k)
-            h[a] = _DERIV_STEP * scale[a]
-            jc[s, :, a] = (c(x + h) - c(x - h)) / (2.0 * h[a])
-        vel[s] = jc[s] @ v
-        acc[s] = jc[s] @ traj.pdd[s]
-        reach = float(np.max(np.abs(v) / scale))
-        if reach > 0.0:
-            eps = _SECOND_STEP / reach  # a time step: the pose moves by _SECOND_STEP of its scale
-            acc[s] += (c(x + eps * v) - 2.0 * c(x) + c(x - eps * v)) / (eps * eps)
+    x, v = traj.p, traj.pd
+    steps = np.eye(k) * (_DERIV_STEP * scale)  # one row per task axis
+    reach = np.max(np.abs(v) / scale, axis=1)
+    eps = np.where(reach > 0.0, _SECOND_STEP / np.where(reach > 0.0, reach, 1.0), 0.0)  # the pose moves by
+    # _SECOND_STEP of its scale along x_dot in the time step eps
+    poses = np.concatenate([x[:, None, :] + steps[None], x[:, None, :] - steps[None],
+                            np.stack([x + eps[:, None] * v, x, x - eps[:, None] * v], axis=1)], axis=1)
+    c = mech.payload_points(design, options, poses.reshape(-1, k)).reshape(n, 2 * k + 3, 3)
+    jc = np.transpose((c[:, :k] - c[:, k : 2 * k]) / (2.0 * _DERIV_STEP * scale)[None, :, None], (0, 2, 1))
+    vel = np.einsum("nck,nk->nc", jc, v)
+    acc = np.einsum("nck,nk->nc", jc, traj.pdd)
+    moving = reach > 0.0
+    second = c[:, 2 * k] - 2.0 * c[:, 2 * k + 1] + c[:, 2 * k + 2]
+    acc[moving] += second[moving] / (eps[moving] ** 2)[:, None]
     return vel, acc, jc
 
 

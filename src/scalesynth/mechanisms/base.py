@@ -252,6 +252,10 @@ class Mechanism(ABC):
                 a[s] = self.velocity_map(design, options, pose, q[s])
         return q, a
 
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        """payload_point at many poses (n, k) -> (n, 3); this default loops, a mechanism may vectorise it."""
+        return np.array([self.payload_point(design, options, pose) for pose in poses], dtype=float).reshape(-1, 3)
+
     def payload_point(self, design, options, pose) -> np.ndarray:
         """Where a cycle's payload (a point mass) sits at a pose: a 3-D point of the mechanism frame (length unit).
         Needed only by mechanisms with an angular task axis (with Cartesian task axes the payload is at the task

@@ -851,6 +851,13 @@ class RpsUpu(Mechanism):
         """The cycle's payload sits at the platform origin O' = (0, y0, z) (mm; y0 = 0 in the P-model)."""
         return self._joint_points(design, options, pose)[2]
 
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        """Vectorised payload_point: O' at poses (n, 3) from the vectorised _platform; NaN where the C-model
+        parametrisation is degenerate."""
+        valid, p, _, _, _ = _platform(self._geom(design), options["model"], options["c3_variant"],
+                                      np.asarray(poses, dtype=float))
+        return np.where(valid[:, None], p, np.nan)
+
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
@@ -1210,6 +1217,13 @@ class RpsUpuTool(RpsUpu):
             jx_t = np.transpose(np.linalg.solve(np.transpose(safe, (0, 2, 1)), np.transpose(jx, (0, 2, 1))), (0, 2, 1))
             a = np.where((regular & np.all(q > 0.0, axis=1))[:, None, None], jx_t / q[:, :, None], np.inf)
         return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a, np.nan)
+
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """The payload sits at the tool point T = pose (mm)."""
+        return self.check_vector("pose", pose, 3)
+
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        return np.asarray(poses, dtype=float).reshape(-1, 3)
 
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of dq/dT with NumPy's SVD (0 at any singularity)."""

@@ -679,6 +679,47 @@ class UpsSspr(Mechanism):
         jx = self.jacobians(design, options, pose)["Jx"]
         return np.where(np.isfinite(jx), jx, np.inf)
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: _legs' leg lengths and rows of Jx (velocity_map) at poses
+        (n, 3) in NumPy; NaN rows where |Y| > c (no Z > 0 assembly) or for another branch label."""
+        x = np.asarray(poses, dtype=float)
+        a, b, c = design["a"], design["b"], design["c"]
+        alpha, beta, yy = x[:, 0], x[:, 1], x[:, 2]
+        am, ax, bxy = a / 2.0, SQRT3_2 * a, b * INV_SQRT2
+        n = len(x)
+        q = np.empty((n, 3))
+        jx = np.empty((n, 3, 3))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rho = np.sqrt(np.maximum(c * c - yy * yy, 0.0))
+            sa, ca, sb, cb = np.sin(alpha), np.cos(alpha), np.sin(beta), np.cos(beta)
+            px, pz = sb * rho, cb * rho
+            q[:, 0] = np.sqrt(np.maximum(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy, 0.0))
+            jx[:, 0, :2] = 0.0
+            jx[:, 0, 2] = np.where(q[:, 0] > 0.0, K0 * am / q[:, 0], np.inf)
+            for i, sx in ((1, -1.0), (2, 1.0)):
+                rbx = cb * sx * bxy + sb * sa * bxy
+                rby = ca * bxy
+                rbz = -sb * sx * bxy + cb * sa * bxy
+                d0, d1, d2 = px + rbx - sx * ax, yy + rby + am, pz + rbz
+                ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                q[:, i] = ln
+                rows = np.stack([(d0 * sb * ca * bxy - d1 * sa * bxy + d2 * cb * ca * bxy) / ln,
+                                 (d0 * (pz + rbz) - d2 * (px + rbx)) / ln,
+                                 (d1 - (d0 * sb + d2 * cb) * yy / rho) / ln], axis=-1)
+                jx[:, i] = np.where(((ln > 0.0) & (rho > 0.0))[:, None], rows, np.nan)
+        a_map = np.where(np.isfinite(jx), jx, np.inf)
+        ok = (np.abs(yy) <= c) & (label == IK_LABEL)
+        return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a_map, np.nan)
+
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        """Vectorised payload_point: B1 = (sin(beta) rho, Y, cos(beta) rho) at poses (n, 3); NaN where |Y| >= c."""
+        x = np.asarray(poses, dtype=float)
+        c = design["c"]
+        with np.errstate(invalid="ignore"):
+            rho = np.sqrt(c * c - x[:, 2] ** 2)
+        out = np.column_stack([np.sin(x[:, 1]) * rho, x[:, 2], np.cos(x[:, 1]) * rho])
+        return np.where((np.abs(x[:, 2]) < c)[:, None], out, np.nan)
+
     def payload_point(self, design, options, pose) -> np.ndarray:
         """The cycle's payload sits at B1 = P = (sin(beta) rho, Y, cos(beta) rho) (mm), the platform's reference
         point (where the stiffness model's load acts)."""
