@@ -219,6 +219,7 @@ def bench_compile() -> dict:
 STIFFNESS_CASES = (  # (label, config, module of the field kernel, kinematic slots, grid N per axis, designs)
     ("planar-fivebar", "fivebar_stiffness.yaml", "planar_fivebar", 3, 256, 40),
     ("ups-sspr", "ups_sspr.yaml", "ups_sspr", 3, 40, 20),
+    ("pprs-rprs", "pprs_rprs.yaml", "pprs_rprs", 4, 40, 20),  # kinematic part: LCI, sigmas and clearance
 )
 
 
@@ -259,7 +260,7 @@ def bench_stiffness(repeat: int = 5) -> dict:
                 acc.append(time.perf_counter() - t0)
         voxels = n_designs * int(np.prod(shape))
         reachable = float(full()[:, 0].sum())
-        row = {"mechanism": label, "config": config, "designs": n_designs, "N": n, "dims": len(mech.task_axes),
+        row = {"load_average": os.getloadavg()[0], "mechanism": label, "config": config, "designs": n_designs, "N": n, "dims": len(mech.task_axes),
                "fields": n_full, "voxels": voxels, "reachable_voxels": reachable,
                "kinematic_s": min(t_kin), "full_s": min(t_full), "ratio": min(t_full) / min(t_kin),
                "ns_per_reachable_voxel_kinematic": 1e9 * min(t_kin) / reachable,
@@ -398,8 +399,12 @@ def write_results_md() -> None:
         lines += ["Random designs in the bounds of each config, N per axis grids over their bounding boxes, the generic",
                   "grid evaluator; best of 5, the two kernels timed alternately in one process. `kinematic` = LCI,",
                   "sigma_min, sigma_max (the field kernel without stiffness); `with stiffness` adds stiffness_min and",
-                  "deflection (five-bar: closed-form per-leg condensation, 2x2 platform stiffness; ups-sspr: the Numba",
-                  "per-leg condensation of `scalesynth.stiffness.legs`, 6x6 platform stiffness).", "",
+                  "deflection (five-bar: closed-form per-leg condensation, 2x2 platform stiffness; ups-sspr: closed-form",
+                  "per-chain condensation in the wrench form of `scalesynth.stiffness.legs`, 6x6 platform stiffness,",
+                  "3x3 Schur complement; pprs-rprs: closed-form per-chain condensation, `kinematic` there includes the",
+                  "clearance field).", "",
+                  f"Conditions: NUMBA_NUM_THREADS=1 on the shared 2-core machine, load average {_load_text(rows)}, so",
+                  "the absolute times are several times an idle machine's; the ratios come from one run.", "",
                   "| mechanism | designs x grid | kinematic (s) | with stiffness (s) | ns per reachable voxel, kinematic | "
                   "with stiffness | ratio |", "|---|---|---|---|---|---|---|"]
         for r in rows:
@@ -463,6 +468,11 @@ def _targets(data: dict) -> list[str]:
     out = ["## Targets", "", "| target | measured | met |", "|---|---|---|"]
     out += [f"| {t} | {m} | {'yes' if ok else 'NO'} |" for t, m, ok in rows]
     return out + [""]
+
+
+def _load_text(rows: list[dict]) -> str:
+    loads = [r["load_average"] for r in rows if "load_average" in r]
+    return f"{min(loads):.1f} to {max(loads):.1f}" if loads else "not recorded"
 
 
 def _stiffness_rows(result: dict) -> list[dict]:

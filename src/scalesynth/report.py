@@ -21,7 +21,13 @@ from scalesynth.evaluate import evaluate_config
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
-from scalesynth.workspace_view import band_labels, default_section_point, sample_plane, task_geometry
+from scalesynth.workspace_view import (  # SECTION_RESOLUTION, section_panels: also report's (memory, tests)
+    SECTION_RESOLUTION,  # noqa: F401
+    STIFFNESS_MAP_FIELDS,
+    band_labels,
+    map_range,
+    section_panels,
+)
 
 
 def _axes(problem: SynthesisProblem, cfg: RunConfig) -> tuple[str, str]:
@@ -112,41 +118,6 @@ def featured_designs(result: RunResult) -> list[tuple[str, int]]:
     return out
 
 
-SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; a plane costs 128^2 points
-
-
-def section_panels(cfg: RunConfig, design: dict[str, float]) -> list[dict[str, Any]]:
-    """Workspace sections coloured by LCI, each sampled on its plane only (never a full grid): for a 3-D mechanism
-    the planes normal to its second and third task axes through the workspace centroid (from a coarse grid; an
-    empty plane moves to the nearest one that cuts the workspace), for seed 000 the xz and xy sections; one map
-    for planar mechanisms. Axis labels carry units; axes of different units are not drawn to equal scale."""
-    mech = cfg.mech
-    unit = cfg.units.length
-    res = max(cfg.grid.resolution, SECTION_RESOLUTION)
-    box, path = task_geometry(cfg)
-    if mech.planar:
-        values, ext = sample_plane(cfg, design, 2, 0.0, res)
-        return [{"values": values, "extent": ext, "xlabel": lab.axis_label(mech, 0, unit),
-                 "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
-                 "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
-                 "path": None if path is None else path[:, :2]}]
-    point = default_section_point(cfg, design)
-    panels = []
-    for normal in (1, 2):
-        a, b = [x for x in range(3) if x != normal]
-        point[normal] = round(float(point[normal]), 10) + 0.0  # no '-7e-17' in titles for a symmetric workspace
-        values, ext = sample_plane(cfg, design, normal, float(point[normal]), res)
-        name = lab.axis_name(mech.task_axes[normal])
-        panel = {"values": values, "extent": ext, "xlabel": lab.axis_label(mech, a, unit),
-                 "ylabel": lab.axis_label(mech, b, unit), "equal": lab.same_units(mech, (a, b)),
-                 "title": f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at "
-                          f"{name} = {point[normal]:.4g} (centroid)"}
-        if box is not None and box[0, normal] <= point[normal] <= box[1, normal]:
-            panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
-        panels.append(panel)
-    return panels
-
-
 def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
     """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
     per-band Pareto sets bands/pareto_band<k>.csv with their plots."""
@@ -186,8 +157,30 @@ def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
         rio.save_figure(fig, plots / fname)
         plotting.close(fig)
         files.append(_rel(result.out_dir, plots / fname))
+        for field in STIFFNESS_MAP_FIELDS:
+            if field in cfg.mech.field_names:
+                files.append(_rel(result.out_dir, field_sections(cfg, design, field, title, plots, name, fmt)))
     return {"files": files, "featured": [(name, int(i)) for name, i in featured], "band_files": band_rel,
             "band_sizes": band_info["sizes"]}
+
+
+def field_sections(cfg: RunConfig, design: dict[str, float], field: str, title: str, plots: Path, name: str,
+                   fmt: str) -> Path:
+    """plots/sections_<field>_<design>: the report's sections coloured by a per-voxel field (a stiffness map:
+    deflection or stiffness_min), the colour bar labelled with its unit and the range of the shown cells in the
+    title. Returns the file written."""
+    panels = section_panels(cfg, design, field)
+    vmin, vmax = map_range(panels)
+    label = lab.field_label(cfg.mech, field, cfg.units.length)
+    v = np.concatenate([np.asarray(p["values"], dtype=float).ravel() for p in panels])
+    v = v[np.isfinite(v)]
+    shown = f" ({v.min():.4g} to {v.max():.4g} in these sections)" if v.size else " (no reachable cell)"
+    fig = plotting.sections_figure(panels, None, f"{title}\n{label}{shown}", field_label=label, vmin=vmin,
+                                   vmax=vmax)
+    target = plots / (f"sections_{field}_" + name.replace(" ", "_") + f".{fmt}")
+    rio.save_figure(fig, target)
+    plotting.close(fig)
+    return target
 
 
 def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> str:

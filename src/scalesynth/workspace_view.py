@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from scalesynth import labels as lab
 from scalesynth.errors import ConfigError, InvalidParameter
 from scalesynth.evaluate import Grid, make_grid
 from scalesynth.kernels import grid as _grid
@@ -69,15 +70,18 @@ def sample_fields(cfg, design: Mapping[str, float], resolution: int) -> FieldGri
     return FieldGrid(grid=g, lci=np.ascontiguousarray(lci), fields=fields)
 
 
-def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, resolution: int):
-    """LCI on the plane ``task axis normal = value`` only (the other axes at ``resolution`` cells over the grid box):
-    returns (2-D array indexed by the two remaining axes in order, their extent (a0, a1, b0, b1))."""
+def sample_plane(cfg, design: Mapping[str, float], normal: int, value: float, resolution: int, field: str = "lci"):
+    """A per-voxel field (default LCI) on the plane ``task axis normal = value`` only (the other axes at
+    ``resolution`` cells over the grid box): returns (2-D array indexed by the two remaining axes in order, their
+    extent (a0, a1, b0, b1)). Unreachable cells: LCI -1, any other field NaN."""
     mech = cfg.mech
+    slot = mech.field_names.index(check_field(mech, field))
     g = make_grid(mech, mech.resolve_design(design), cfg.resolved_options(), resolution, cfg.grid.region)
     lo, step, shape = g.lo.copy(), g.step.copy(), g.shape.copy()
     lo[normal] = value - 0.5 * step[normal]
     shape[normal] = 1
-    plane = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), lo, step, shape)[..., 0]
+    cells = _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), lo, step, shape)
+    plane = cells[..., 0] if slot == 0 else np.where(cells[..., 0] >= 0, cells[..., slot], np.nan)
     others = [a for a in range(3) if a != normal]
     values = np.take(plane, 0, axis=normal)
     ext = []
@@ -305,3 +309,53 @@ def robot(cfg, design, pose) -> dict[str, Any]:
     segs = [{"name": s.name, "body": s.body, "a": [float(v) for v in s.a], "b": [float(v) for v in s.b],
              "radius": float(s.radius)} for s in geo.segments]
     return {"pose": pose, "branch": sol.label, "segments": segs}
+
+
+# ----- report sections (report.md and report.html) ------------------------------------------------------------------
+# per-voxel fields drawn as their own section maps in a run's report, when the mechanism has them
+STIFFNESS_MAP_FIELDS = ("deflection", "stiffness_min")
+SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; a plane costs 128^2 points
+
+
+def section_panels(cfg, design: dict[str, float], field: str = "lci") -> list[dict[str, Any]]:
+    """Workspace sections coloured by a per-voxel field (default LCI), each sampled on its plane only (never a full
+    grid): for a 3-D mechanism the planes normal to its second and third task axes through the workspace centroid
+    (from a coarse grid; an empty plane moves to the nearest one that cuts the workspace), for seed 000 the xz and
+    xy sections; one map for planar mechanisms. Axis labels carry units; axes of different units are not drawn to
+    equal scale."""
+    mech = cfg.mech
+    unit = cfg.units.length
+    res = max(cfg.grid.resolution, SECTION_RESOLUTION)
+    box, path = task_geometry(cfg)
+    if mech.planar:
+        values, ext = sample_plane(cfg, design, 2, 0.0, res, field)
+        return [{"values": values, "extent": ext, "xlabel": lab.axis_label(mech, 0, unit),
+                 "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
+                 "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
+                 "path": None if path is None else path[:, :2]}]
+    point = default_section_point(cfg, design)
+    panels = []
+    for normal in (1, 2):
+        a, b = [x for x in range(3) if x != normal]
+        point[normal] = round(float(point[normal]), 10) + 0.0  # no '-7e-17' in titles for a symmetric workspace
+        values, ext = sample_plane(cfg, design, normal, float(point[normal]), res, field)
+        name = lab.axis_name(mech.task_axes[normal])
+        panel = {"values": values, "extent": ext, "xlabel": lab.axis_label(mech, a, unit),
+                 "ylabel": lab.axis_label(mech, b, unit), "equal": lab.same_units(mech, (a, b)),
+                 "title": f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at "
+                          f"{name} = {point[normal]:.4g} (centroid)"}
+        if box is not None and box[0, normal] <= point[normal] <= box[1, normal]:
+            panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
+        panels.append(panel)
+    return panels
+
+
+def map_range(panels: list[dict[str, Any]]) -> tuple[float, float]:
+    """Colour scale of a field's section maps: the 2nd to 98th percentile of its reachable values over the panels
+    (a few near-singular cells, e.g. the capped deflection, would otherwise squash the scale); (0, 1) if none."""
+    v = np.concatenate([np.asarray(p["values"], dtype=float).ravel() for p in panels])
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return 0.0, 1.0
+    lo, hi = (float(x) for x in np.percentile(v, [2, 98]))
+    return (lo, hi) if hi > lo else (lo, lo + max(abs(lo), 1.0))

@@ -22,7 +22,7 @@ Along the sampled trajectory (``cycle.trajectory``), in the configured working m
 * the LCI from the point kernel and the clearance of the link capsules (``cycle.clearance``).
 
 * the deflection (``CycleResult.deflection``, where the mechanism has a per-voxel ``deflection`` field and a
-  ``load`` option: planar-fivebar, ups-sspr): at every sample the magnitude of the payload point's deflection
+  ``load`` option: planar-fivebar, pprs-rprs, ups-sspr): at every sample the magnitude of the payload point's deflection
   under the force the payload exerts on the platform, m (g - c_ddot) (N; at rest its weight), from the
   mechanism's stiffness model with ideal joints (its field kernel re-packed with that load; the same model as
   the pose-level ``scalesynth stiffness`` command, tested against it). None for the other mechanisms.

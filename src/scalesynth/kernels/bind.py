@@ -7,9 +7,9 @@ plain Python function that calls the field kernel through the global names ``FIE
 result caches and hits across processes.
 
 Cache identity of a bound copy: its file is the field kernel's source file (Numba's staleness check follows that
-file's time stamp and size) and its name carries a hash of the sources of ``scalesynth/kernels/*.py`` and of that
-file, so editing either the mechanism or a shared kernel module compiles afresh (Numba alone would not notice an
-edited callee in another file).
+file's time stamp and size) and its name carries a hash of the sources of ``scalesynth/kernels/*.py``,
+``scalesynth/stiffness/legs.py`` and of that file, so editing either the mechanism or a shared kernel module
+compiles afresh (Numba alone would not notice an edited callee in another file).
 """
 
 from __future__ import annotations
@@ -25,6 +25,8 @@ from typing import Any
 from numba import njit
 
 _KERNELS_DIR = Path(__file__).resolve().parent
+# numba helpers outside kernels/ that field kernels inline (their edits must compile afresh too)
+_INLINED = [_KERNELS_DIR.parent / "stiffness" / "legs.py"]
 _BOUND: dict[tuple[Any, int, str], Any] = {}
 _SOURCE_HASH: dict[str, str] = {}
 
@@ -35,7 +37,7 @@ def _sources_hash(kernel_file: str) -> str:
     if h is None:
         digest = hashlib.sha256()
         try:
-            for path in sorted(_KERNELS_DIR.glob("*.py")) + [Path(kernel_file)]:
+            for path in sorted(_KERNELS_DIR.glob("*.py")) + _INLINED + [Path(kernel_file)]:
                 digest.update(path.read_bytes())
             h = digest.hexdigest()[:12]
         except OSError:

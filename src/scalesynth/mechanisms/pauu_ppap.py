@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numba import njit, prange
 
-from scalesynth.errors import InvalidParameter
+from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import SIGMA_CAP, inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
@@ -32,8 +32,16 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
+from scalesynth.stiffness.sections import check_positive_option, check_stiffness_options, stiffness_options
 
 MODES = ("++", "+-", "-+", "--")
+# stiffness (scalesynth.stiffness, docs/stiffness.md): link groups, the actuated long links of the parallelograms
+# (arm), their second long links (arm_link) and the U-U links (link); actuator stiffness defaults (assumptions, the
+# paper gives none): 1e5 N m/rad for theta1, theta2 (a servo with a stiff precision reducer), 2e7 N/m (2e4 N/mm, a
+# ball-screw axis) for the stroke d
+LINK_GROUPS = ("arm", "arm_link", "link")
+ACTUATOR_STIFFNESS = 1e5
+STROKE_STIFFNESS = 2e7
 # default capsule radii (m), illustrative (the paper gives no cross-sections)
 LINK_RADII = {"base": 0.05, "arm1": 0.03, "arm2": 0.03, "link1": 0.02, "link2": 0.02, "platform": 0.05}
 
@@ -394,6 +402,8 @@ class PauuPpap(Mechanism):
     """Seed-000 mechanism; see module docstring."""
 
     def check_options(self, options: dict[str, Any]) -> None:
+        check_stiffness_options(options, 3, LINK_GROUPS)
+        check_positive_option(options, "stroke_stiffness")
         if options["mode"] not in MODES:
             raise InvalidParameter(f"options.mode: must be one of {', '.join(MODES)}, got {options['mode']!r}")
         for name in ("theta1_limits", "theta2_limits", "stroke_limits"):
@@ -693,6 +703,67 @@ class PauuPpap(Mechanism):
         ]))
         return chains
 
+    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, spatial, m, N) at P = (x, y, z) in the working mode
+        ``options.mode``; raises InvalidPose outside the workspace. Frame of joint_screws / link_geometry.
+
+        PaUU_i: the parallelogram as two bars with a rigid hinge plate (its moving short side), the actuated arm
+        A_i -> C_i (A_i = (+-m, 0, e), a torsional actuator spring about y at A_i) and the arm link
+        A_i - c z -> C_i - c z (revolutes about y at both ends; the paper gives the short side's length c, not its
+        side: below the arm is assumed), the plate (reference C_i) joined to both bars by revolutes about y; the
+        link C_i -> D_i = P +- (n, 0, 0) on universal joints (y, t_i) at C_i and (t_i, y) at D_i,
+        t_i = y x w_i / |y x w_i|, w_i = D_i - C_i. PPaP: not dimensioned in the paper, so not elastic: rigid
+        bodies at P joined by the actuated slide d along y (a linear spring, stroke_stiffness), the parallelogram's
+        translation (-sin phi, 0, cos phi), cos phi = x / (l1 + l2), and the slide along z (joint_screws' model);
+        it holds the platform's rotations rigidly, so the platform DOFs are x, y, z. The platform is rigid with
+        reference point P; the load is a force at P. ``joints`` 'bonded' welds the passive revolute and universal
+        joints (the slides stay slides)."""
+        from scalesynth.stiffness.builder import FrameBuilder, unit
+        from scalesynth.stiffness.model import Body
+        from scalesynth.stiffness.sections import tube_section
+
+        x, y, z = self.check_vector("pose", pose, 3)
+        if self.point_kernel(self.pack(design, options), x, y, z) < 0.0:
+            raise InvalidPose(f"pose: ({x:g}, {y:g}, {z:g}) is outside the workspace (mode {options['mode']}, "
+                              "limits included)")
+        (q,) = [sol.values for sol in self.inverse_kinematics(design, options, (x, y, z))
+                if sol.label == options["mode"]]
+        m, n, l1, c = design["m"], design["n"], design["l1"], design["c"]
+        e = self.offset_e(design, options)
+        yhat, zhat = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
+        k, k_d = options["actuator_stiffness"], options["stroke_stiffness"]
+        fb = FrameBuilder({g: tube_section(options, g, "m") for g in LINK_GROUPS}, joints)
+        p = np.array([x, y, z])
+        bodies = [Body("base", np.zeros(3))]
+        for i, (sgn, t) in enumerate(((1.0, q[0]), (-1.0, q[1])), 1):
+            a = np.array([sgn * m, 0.0, e])
+            ci = np.array([sgn * (m + l1 * math.cos(t)), 0.0, e - l1 * math.sin(t)])
+            di = p + np.array([sgn * n, 0.0, 0.0])
+            ti = unit(np.cross(yhat, di - ci))
+            fb.link(f"arm{i}", "arm", a, ci)
+            fb.link(f"arm_link{i}", "arm_link", a - c * zhat, ci - c * zhat)
+            fb.link(f"link{i}", "link", ci, di)
+            bodies.append(Body(f"plate{i}", ci.copy()))
+            fb.joint(f"actuator{i}", "revolute", a, f"arm{i}.a", "base", (yhat,), k)
+            fb.joint(f"elbow{i}", "revolute", ci, f"arm{i}.b", f"plate{i}", (yhat,))
+            fb.joint(f"arm_link_base{i}", "revolute", a - c * zhat, f"arm_link{i}.a", "base", (yhat,))
+            fb.joint(f"arm_link_plate{i}", "revolute", ci - c * zhat, f"arm_link{i}.b", f"plate{i}", (yhat,))
+            fb.joint(f"U_C{i}", "universal", ci, f"link{i}.a", f"plate{i}", (yhat, ti))
+            fb.joint(f"U_D{i}", "universal", di, f"link{i}.b", "platform", (ti, yhat))
+        cos_phi = min(1.0, max(-1.0, x / (design["l1"] + design["l2"])))
+        sin_phi = math.sqrt(1.0 - cos_phi * cos_phi)
+        bodies += [Body("ppap_carriage", p.copy()), Body("ppap_slide", p.copy()), Body("platform", p.copy())]
+        fb.joint("P_d", "prismatic", p, "ppap_carriage", "base", (yhat,), k_d)
+        fb.joint("Pa_ppap", "prismatic", p, "ppap_slide", "ppap_carriage", ((-sin_phi, 0.0, cos_phi),))
+        fb.joint("P_z", "prismatic", p, "platform", "ppap_slide", (zhat,))
+        notes = ["spatial frame of spec §1.1 (z up, m); rigid platform with reference point P; the PPaP chain (rigid "
+                 "bodies, slides d along y, the parallelogram's translation and z) holds the platform's rotations, so "
+                 "its DOFs are x, y, z; the load is a force at P",
+                 f"parallelograms: arm and arm link (offset -c z, c = {c:g}) with a rigid hinge plate; working mode "
+                 f"{options['mode']}"]
+        return fb.model("m", bodies, options["load"], notes)
+
 
 MECHANISM = PauuPpap(
     name="2pauu-ppap",
@@ -717,6 +788,11 @@ MECHANISM = PauuPpap(
         Option("theta2_limits", None, "[lo, hi] rad for theta2 (convention T), null = none"),
         Option("stroke_limits", None, "[lo, hi] for the stroke d = y, null = none"),
         Option("z_min", None, "keep only z >= z_min, null = none"),
+        *stiffness_options("m", ACTUATOR_STIFFNESS, "torsional stiffness of each parallelogram actuator theta1, "
+                           "theta2, N m/rad (an assumption)", [0.0, 0.0, -150.0],
+                           "default 150 N along -z, the gravity direction (z up), at P"),
+        Option("stroke_stiffness", STROKE_STIFFNESS, "stiffness: axial stiffness of the PPaP chain's linear actuator "
+               "d, N/m (2e4 N/mm, an assumption)"),
         Option("link_radius", None, "capsule radius of every body, or {body: radius}; null = defaults base 0.05, "
                "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative)"),
     ),

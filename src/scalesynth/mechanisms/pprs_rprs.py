@@ -39,6 +39,7 @@ from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -48,6 +49,8 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     wrap_angle,
 )
+from scalesynth.stiffness import legs as _legs_k
+from scalesynth.stiffness.sections import check_positive_option, check_stiffness_options, stiffness_options
 
 SQRT3_2 = math.sqrt(3.0) / 2.0
 # spec §1.8 search box (mm); bounding_box never extends beyond it
@@ -69,7 +72,19 @@ _BLEN, _ALEN = 25, 26
 _RAD = 27  # capsule radii of the 8 bodies, in LINK_RADII order
 _FREE_ONLY = 35  # 1: poses whose capsules overlap are unreachable
 _F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
-N_PACKED = 36
+# stiffness (slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N mm^2), GJ (N mm^2) of the 'column' and 'link'
+# groups, linear actuator stiffness (N/mm), beta stiffness (N mm/rad), load (N)
+_EA_COL, _EA_LINK, _KACT, _KBETA, _FX = 36, 39, 42, 43, 44
+_F_STIFFNESS_MIN, _F_DEFLECTION = 4, 5
+N_PACKED = 47
+
+# stiffness (scalesynth.stiffness, docs/stiffness.md): link groups, the columns B_i D_i (the vertical sliders and
+# chain 3's tilting prismatic) and the links D_i C_i; actuator stiffness defaults (assumptions, the paper gives none):
+# 2e4 N/mm for the five linear actuators (a small ball-screw axis), 1e8 N mm/rad (1e5 N m/rad, a servo with a stiff
+# precision reducer) for chain 3's revolute input beta
+LINK_GROUPS = ("column", "link")
+ACTUATOR_STIFFNESS = 2e4
+BETA_STIFFNESS = 1e8
 
 # capsules of the clearance field, in link_geometry's order, with their body (index into LINK_RADII)
 _SEGMENT_BODY = np.array([0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7], dtype=np.int64)
@@ -163,13 +178,109 @@ def _put_row(a, row, scale, gx, gy, gz, rx, ry, rz, inv_alen):
     a[row, 5] = k * (rx * gy - ry * gx)
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _force_flex(p, ll, lx, ly, lz, s, ax, ay, az, fax, fay, faz, fbx, fby, fbz, hax, hay, haz, hbx, hby, hbz, hk):
+    """Flexibility f_a^T C f_b of a chain under two forces through C (see _chain_columns): the link (length ll,
+    unit l, clamped at D), the column (length s, unit a, clamped at B; the force's moment about D is ll l x f) and
+    the springs (g_a . f)(g_a . f') hk + (g_b . f)(g_b . f') / k."""
+    link = _legs_k.tip_bilinear(ll, p[_EA_LINK], p[_EA_LINK + 1], p[_EA_LINK + 2], lx, ly, lz, fax, fay, faz, 0.0,
+                                0.0, 0.0, fbx, fby, fbz, 0.0, 0.0, 0.0)
+    col = _legs_k.tip_bilinear(s, p[_EA_COL], p[_EA_COL + 1], p[_EA_COL + 2], ax, ay, az, fax, fay, faz,
+                               ll * (ly * faz - lz * fay), ll * (lz * fax - lx * faz), ll * (lx * fay - ly * fax),
+                               fbx, fby, fbz,
+                               ll * (ly * fbz - lz * fby), ll * (lz * fbx - lx * fbz), ll * (lx * fby - ly * fbx))
+    springs = ((hax * fax + hay * fay + haz * faz) * (hax * fbx + hay * fby + haz * fbz) * hk
+               + (hbx * fax + hby * fay + hbz * faz) * (hbx * fbx + hby * fby + hbz * fbz) / p[_KACT])
+    return link + col + springs
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _chain_columns(p, kk, ox, oy, oz, cx, cy, cz, bx, by, bz, dx, dy, dz, ax, ay, az, s, nx, ny, nz, hax, hay, haz,
+                   hbx, hby, hbz, hk):
+    """kk + the two wrench columns of one chain (column B -> D along a = (ax, ay, az), length s; link D -> C; revolute
+    about n at D; spherical at C) at the reference point O: with ideal joints the chain passes the forces through C
+    in the plane (link direction, n). Flexibility Phi (2x2) of those two forces: the link (a cantilever clamped at
+    D), the column (clamped at B, loaded by the force through C) and the actuator springs, which see the force
+    through the compliances hk[j] (g_j . f)^2 with g_j = (hax, hay, haz) (a linear spring, or for a revolute
+    spring the moment arm of its axis) and g_j = (hbx, hby, hbz) (a second linear spring; 1 / k each)."""
+    lx, ly, lz = cx - dx, cy - dy, cz - dz
+    ll = math.sqrt(lx * lx + ly * ly + lz * lz)
+    lx, ly, lz = lx / ll, ly / ll, lz / ll
+    p11 = _force_flex(p, ll, lx, ly, lz, s, ax, ay, az, lx, ly, lz, lx, ly, lz, hax, hay, haz, hbx, hby, hbz, hk)
+    p12 = _force_flex(p, ll, lx, ly, lz, s, ax, ay, az, lx, ly, lz, nx, ny, nz, hax, hay, haz, hbx, hby, hbz, hk)
+    p22 = _force_flex(p, ll, lx, ly, lz, s, ax, ay, az, nx, ny, nz, nx, ny, nz, hax, hay, haz, hbx, hby, hbz, hk)
+    l11 = math.sqrt(p11)
+    l21 = p12 / l11
+    q22 = p22 - l21 * l21
+    if not (l11 > 0.0 and q22 > 0.0):
+        return False, kk
+    i11 = 1.0 / l11
+    i22 = 1.0 / math.sqrt(q22)
+    rx, ry, rz = cx - ox, cy - oy, cz - oz
+    # column 1: f1 / l11; column 2: (f2 - l21 f1 / l11) / l22; wrench (f, (C - O) x f)
+    ux, uy, uz = lx * i11, ly * i11, lz * i11
+    kk = _legs_k.outer_add(kk, ux, uy, uz, ry * uz - rz * uy, rz * ux - rx * uz, rx * uy - ry * ux)
+    t = l21 * i11
+    vx, vy, vz = (nx - t * lx) * i22, (ny - t * ly) * i22, (nz - t * lz) * i22
+    kk = _legs_k.outer_add(kk, vx, vy, vz, ry * vz - rz * vy, rz * vx - rx * vz, rx * vy - ry * vx)
+    return True, kk
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, ox, oy, oz, c1x, c1y, c1z, s1, c2x, c2y, c2z, p2x, p2y, s2, c3x, c3y, c3z, b3x, b3y, t3x, t3y,
+               t3z, s3, d3x, d3y, d3z, e3x, e3y):
+    """(stiffness_min N/mm, deflection mm) at O1, ideal joints, the frame of stiffness_model, by per-chain
+    condensation in the wrench form K = sum_i W_i Phi_i^-1 W_i^T (scalesynth.stiffness.legs). Each chain is serial:
+    chains 1, 2: carriage on the rail (spring w_i along u_i), column B_i -> D_i along z (spring s_i along z), link
+    D_i -> C_i (revolute about u_i at D_i, spherical at C_i); chain 3: rocker at B3 (torsional spring beta about e3),
+    column B3 -> top along d3 (spring s3), link top -> C3 (revolute about n3 = e3 x d3, spherical at C3). With ideal
+    joints each chain passes two forces through C_i, in the plane of its link and its revolute axis; their
+    flexibility (2x2) adds the link, the column and the springs. Six wrench columns; the platform response from
+    the 21 entries of K (legs.response_upper). Round sections (EIy = EIz)."""
+    k = p[_KACT]
+    kk = (0.0,) * 21
+    # chain 1: u1 = x, B1 = (c1x, 0, 0), D1 = B1 + s1 z, revolute about u1
+    ok1, kk = _chain_columns(p, kk, ox, oy, oz, c1x, c1y, c1z, c1x, 0.0, 0.0, c1x, 0.0, s1, 0.0, 0.0, 1.0, s1,
+                             1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0 / k)
+    # chain 2: u2 = (-1/2, sqrt3/2, 0), B2 = (p2x, p2y, 0)
+    ok2, kk = _chain_columns(p, kk, ox, oy, oz, c2x, c2y, c2z, p2x, p2y, 0.0, p2x, p2y, s2, 0.0, 0.0, 1.0, s2,
+                             -0.5, SQRT3_2, 0.0, -0.5, SQRT3_2, 0.0, 0.0, 0.0, 1.0, 1.0 / k)
+    # chain 3: n3 = e3 x d3; the beta spring turns C3 by e3 x (C3 - B3) per rad: g = (C3 - B3) x e3 (up to sign)
+    n3x, n3y, n3z = e3y * d3z, -e3x * d3z, e3x * d3y - e3y * d3x
+    nn = math.sqrt(n3x * n3x + n3y * n3y + n3z * n3z)
+    n3x, n3y, n3z = n3x / nn, n3y / nn, n3z / nn
+    rx, ry, rz = c3x - b3x, c3y - b3y, c3z  # C3 - B3
+    gx, gy, gz = ry * 0.0 - rz * e3y, rz * e3x - rx * 0.0, rx * e3y - ry * e3x  # (C3 - B3) x e3
+    ok3, kk = _chain_columns(p, kk, ox, oy, oz, c3x, c3y, c3z, b3x, b3y, 0.0, t3x, t3y, t3z, d3x, d3y, d3z, s3,
+                             n3x, n3y, n3z, gx, gy, gz, d3x, d3y, d3z, 1.0 / p[_KBETA])
+    zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
+    if not (ok1 and ok2 and ok3):
+        return 0.0, zero
+    # the reference solver's characteristic length: its longest link (columns, links)
+    length = max(s1, s2, s3, p[_L1], p[_L2], p[_L3])
+    return _legs_k.response_upper(kk, p[_FX], p[_FX + 1], p[_FX + 2], length)
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
+    """Every field at O1 = (x, y, z) (see _fields): LCI, sigma_min, sigma_max, clearance, stiffness_min, deflection."""
+    _fields(p, x, y, z, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, x, y, z, out):
+    """Slots 0-3 only (LCI, sigma_min, sigma_max, clearance), for benchmarks (the cost without stiffness)."""
+    _fields(p, x, y, z, out, False)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, x, y, z, out, stiffness):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
     IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
     Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq, x = (O1, angle_length x angular
     velocity), the beta input times beta_length (dimensionless); clearance (mm) of the link capsules (with
-    interference_free, overlapping capsules make the pose unreachable)."""
+    interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, stiffness_min (N/mm) and
+    deflection (mm) at O1 under the packed load (ideal joints, docs/stiffness.md; _stiffness)."""
     c1x = x + p[_R1]
     c1y = y + p[_R1 + 1]
     c1z = z + p[_R1 + 2]
@@ -281,8 +392,14 @@ def point_fields(p, x, y, z, out):
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
         _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
         out[_F_CLEARANCE] = gap
+        if stiffness and (p[_FX] != 0.0 or p[_FX + 1] != 0.0 or p[_FX + 2] != 0.0):
+            out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # stiffness_min 0
         return
     out[_F_CLEARANCE] = gap
+    if stiffness:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(
+            p, x, y, z, c1x, c1y, c1z, s1, c2x, c2y, c2z, p2x, p2y, s2, c3x, c3y, c3z, b3x, b3y, d3x, d3y, d3z, s3,
+            -rho3 * u3x / mu3, -rho3 * u3y / mu3, h3 / mu3, e3x, e3y)
     # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
     inv_alen = 1.0 / p[_ALEN]
     a = np.empty((6, 6))
@@ -587,6 +704,8 @@ class PprsRprs(Mechanism):
                 options[name] = value
         links.check_radius_option(options, LINK_RADII)
         links.check_flag_option(options, "interference_free")
+        check_stiffness_options(options, 3, LINK_GROUPS)
+        check_positive_option(options, "beta_stiffness")
 
     # ----- kernel side -------------------------------------------------------------------------------
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
@@ -606,6 +725,13 @@ class PprsRprs(Mechanism):
         p[_ALEN] = geo.angle_length
         p[_RAD : _RAD + 8] = list(links.radii(options, LINK_RADII).values())
         p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
+        from scalesynth.stiffness.sections import tube_section
+
+        for o, group in ((_EA_COL, "column"), (_EA_LINK, "link")):
+            sec = tube_section(options, group, "mm")
+            p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
+        p[_KACT], p[_KBETA] = options["actuator_stiffness"], options["beta_stiffness"]
+        p[_FX : _FX + 3] = options["load"]
         return p
 
     @property
@@ -799,6 +925,65 @@ class PprsRprs(Mechanism):
         q = np.asarray(q, dtype=float)
         return [n for n, v, (lo, hi) in zip(JOINTS, q, self.joint_limits(options), strict=True) if not lo <= v <= hi]
 
+    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at O1 = (x, y, z) with the options'
+        orientation, working mode ``options.sigma``; raises InvalidPose outside the workspace (out of reach or an
+        actuator outside its limits). Joints as in joint_screws. Chains 1, 2: a rigid carriage at B_i = (u_i.C_i) u_i
+        on the rail (prismatic actuator w_i along u_i to the base), the column slider_i B_i -> D_i = B_i + s_i z
+        (prismatic actuator s_i along z between column and carriage at B_i), the link D_i C_i (revolute about u_i at
+        D_i, spherical at C_i). Chain 3: a rigid rocker at B3 = R u3 (revolute actuator beta about e3 to the base),
+        the column leg3 B3 -> D3 = B3 + s3 d3 (prismatic actuator s3 along d3 at B3), the link D3 C3 (revolute about
+        n3 = e3 x d3 at D3, spherical at C3). The platform C1 C2 C3 is rigid with reference point O1 (6 DOFs: x, y,
+        z and the small rotations rx, ry, rz about the fixed axes); the load is a force at O1. ``joints`` 'bonded'
+        welds the passive joints."""
+        from scalesynth.stiffness.builder import FrameBuilder
+        from scalesynth.stiffness.model import Body
+        from scalesynth.stiffness.sections import tube_section
+
+        x, y, z = self.check_vector("pose", pose, 3)
+        if self.point_kernel(self.pack(design, options), x, y, z) < 0.0:
+            raise InvalidPose(f"pose: ({x:g}, {y:g}, {z:g}) is outside the workspace (mode {options['sigma']}, "
+                              "actuator limits included)")
+        geo = Geometry.of(design, options)
+        X = self.full_pose(options, (x, y, z))
+        st = chain_state(geo, X, sigma_vector(options["sigma"]))
+        q = st.q
+        zhat = np.array([0.0, 0.0, 1.0])
+        k, k_beta = options["actuator_stiffness"], options["beta_stiffness"]
+        fb = FrameBuilder({g: tube_section(options, g, "mm") for g in LINK_GROUPS}, joints)
+        bodies = [Body("base", np.zeros(3))]
+        for i in (0, 1):
+            n = i + 1
+            u, c = geo.u[i], st.centres[i]
+            b = (u @ c) * u
+            d = b + q[3 + i] * zhat
+            bodies.append(Body(f"carriage{n}", b.copy()))
+            fb.link(f"slider{n}", "column", b, d)
+            fb.link(f"link{n}", "link", d, c)
+            fb.joint(f"P_w{n}", "prismatic", b, f"carriage{n}", "base", (u,), k)
+            fb.joint(f"P_s{n}", "prismatic", b, f"slider{n}.a", f"carriage{n}", (zhat,), k)
+            fb.joint(f"R{n}", "revolute", d, f"slider{n}.b", f"link{n}.a", (u,))
+            fb.joint(f"S{n}", "spherical", c, f"link{n}.b", "platform")
+        u3, e3, beta = geo.u[2], geo.e[2], q[2]
+        d3 = -math.cos(beta) * u3 + math.sin(beta) * zhat
+        b3 = geo.rail * u3
+        top = b3 + q[5] * d3
+        c3 = st.centres[2]
+        bodies.append(Body("rocker3", b3.copy()))
+        fb.link("leg3", "column", b3, top)
+        fb.link("link3", "link", top, c3)
+        fb.joint("R_beta", "revolute", b3, "rocker3", "base", (e3,), k_beta)
+        fb.joint("P_s3", "prismatic", b3, "leg3.a", "rocker3", (d3,), k)
+        fb.joint("R3", "revolute", top, "leg3.b", "link3.a", (np.cross(e3, d3),))
+        fb.joint("S3", "spherical", c3, "link3.b", "platform")
+        bodies.append(Body("platform", X[:3].copy()))
+        notes = ["spatial frame O-xyz of the paper (z up, mm); rigid platform C1C2C3 with reference point O1, "
+                 "DOFs x, y, z, rx, ry, rz (small rotations about the fixed axes); the load is a force at O1",
+                 f"orientation (phi, theta, psi) = {tuple(float(v) for v in X[3:])} rad, "
+                 f"working mode {options['sigma']}"]
+        return fb.model("mm", bodies, options["load"], notes)
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §1.2: chains PPRS, PPRS, RPRS; n = 11 (base, platform, three links per chain),
@@ -894,10 +1079,20 @@ MECHANISM = PprsRprs(
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 5, "
                "slider1/slider2/leg3 8, link1/link2/link3 5, platform 5 (illustrative)"),
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
+        *stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator (w1, w2, s1, s2, s3), "
+                           "N/mm (an assumption)", [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction "
+                           "(z up), at O1"),
+        Option("beta_stiffness", BETA_STIFFNESS, "stiffness: torsional stiffness of chain 3's revolute actuator beta, "
+               "N mm/rad (1e5 N m/rad, an assumption)"),
     ),
     default_length_unit="mm",
     fields=(*base_fields("1", "J = dx/dq, the twist of O1 with its angular part times angle_length and the beta "
-                         "input times beta_length (mm/mm)"), links.CLEARANCE_FIELD),
+                         "input times beta_length (mm/mm)"), links.CLEARANCE_FIELD,
+            Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at "
+                  "O1 under a pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)",
+                  "max"),
+            Field("deflection", "{length}", "magnitude of the deflection of O1 under options.load (default 150 N "
+                  "along -z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP))),
     design_metrics=(
         DesignMetric(
             "link_length_sum", "{length}",

@@ -55,6 +55,7 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
+from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
 
 MODELS = ("P", "C")
 C3_VARIANTS = ("plane", "upu")
@@ -620,6 +621,13 @@ _C_START_PSI = (-0.8, 0.0, 0.8)
 # default capsule radii (mm), illustrative (the paper gives no cross-sections); the tool only on rps-upu-tool
 LINK_RADII = {"base": 6.0, "leg1": 5.0, "leg2": 5.0, "leg3": 5.0, "platform": 6.0}
 TOOL_RADII = {**LINK_RADII, "tool": 4.0}
+# stiffness (scalesynth.stiffness, docs/stiffness.md): one link group, the three legs (cylinder and rod); the
+# linear actuators' stiffness default 2e4 N/mm (a small ball-screw actuator; an assumption, the paper gives none)
+LINK_GROUPS = ("leg",)
+ACTUATOR_STIFFNESS = 2e4
+STIFFNESS_OPTIONS = stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator (leg), N/mm "
+                                      "(an assumption)", [0.0, 0.0, -150.0],
+                                      "default 150 N along -z, the gravity direction (z up)")
 
 
 class RpsUpu(Mechanism):
@@ -631,6 +639,7 @@ class RpsUpu(Mechanism):
             raise InvalidParameter(f"options.model: must be 'P' or 'C', got {options['model']!r}")
         if options["c3_variant"] not in C3_VARIANTS:
             raise InvalidParameter(f"options.c3_variant: must be 'plane' or 'upu', got {options['c3_variant']!r}")
+        check_stiffness_options(options, 3, LINK_GROUPS)
         self._check_limits(options)
         length = options["characteristic_length"]
         if length is not None:
@@ -906,6 +915,80 @@ class RpsUpu(Mechanism):
             chains.append(chain_screws([Joint("R", base[2], ((0.0, 1.0, 0.0),)), leg, Joint("S", top[2])]))
         return chains
 
+    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
+    def _in_box(self, options, x) -> bool:
+        return all(options[name][0] <= v <= options[name][1]
+                   for name, v in zip(("z_range", "theta_range", "psi_range"), x, strict=True))
+
+    def _stiffness_placement(self, design, options, pose) -> tuple[np.ndarray, str, np.ndarray]:
+        """(z, theta, psi) of the constraint-consistent (C-model) frame, its chain-3 variant and the platform
+        reference point (O'); raises InvalidPose outside the workspace box, the configured model's workspace or the
+        C-model's stroke limits."""
+        x = self.check_vector("pose", pose, 3)
+        variant = options["c3_variant"]
+        c_opts = {**options, "model": "C"}
+        if (not self._in_box(options, x) or self.point_kernel(self.pack(design, options), *x) < 0.0
+                or self.point_kernel(self.pack(design, c_opts), *x) < 0.0):
+            raise InvalidPose(f"pose: ({', '.join(f'{v:g}' for v in x)}) is outside the workspace (box and stroke "
+                              f"limits of the {options['model']}-model and of the C-model frame)")
+        return x, variant, RpsUpu.platform_pose(self, design, c_opts, x)["p"]
+
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """Frame model (scalesynth.stiffness.FrameModel, spatial, mm, N) at a pose (z, theta, psi) of the
+        constraint-consistent placement (the C-model with the configured chain-3 variant: the P-model violates the
+        RPS joint constraints, spec §2.3, so its joints would not assemble); raises InvalidPose outside the workspace
+        box, the configured model's stroke limits or the C-model's. Joints as in joint_screws: RPS_i (revolute about
+        x at A_i, a prismatic actuator spring between cylinder and rod, each half the leg, spherical at B_i); chain 3
+        'plane': revolute about y at A3, prismatic actuator, spherical at B3; 'upu': universal (x, m) at A3,
+        prismatic actuator, universal (m, w) at B3, m = x X w. The platform B1B2B3 is rigid, reference point O' (6
+        DOFs: x, y, z and the small rotations rx, ry, rz about the fixed axes); the load is a force at O'.
+        ``joints`` 'bonded' welds the passive joints."""
+        x, variant, ref = self._stiffness_placement(design, options, pose)
+        return self._frame(design, options, x, variant, ref, joints)
+
+    def _frame(self, design, options, x, variant, ref, joints):
+        from scalesynth.stiffness.builder import FrameBuilder, unit
+        from scalesynth.stiffness.model import Body
+        from scalesynth.stiffness.sections import tube_section
+
+        g, h, c, e = self._geom(design)
+        plat = RpsUpu.platform_pose(self, design, {**options, "model": "C", "c3_variant": variant}, x)
+        rot, p = plat["R"], plat["p"]
+        base = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        top = p + np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]]) @ rot.T
+        k = options["actuator_stiffness"]
+        fb = FrameBuilder({"leg": tube_section(options, "leg", "mm")}, joints)
+        xhat, yhat = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+        w = rot[:, 2]
+        m_axis = unit(np.cross(xhat, w))
+        for i in range(3):
+            n = i + 1
+            a, b = base[i], top[i]
+            mid = 0.5 * (a + b)
+            fb.link(f"cylinder{n}", "leg", a, mid)
+            fb.link(f"rod{n}", "leg", mid, b)
+            if n < 3:
+                fb.joint(f"R{n}", "revolute", a, f"cylinder{n}.a", "base", (xhat,))
+            elif variant == "upu":
+                fb.joint("U3_base", "universal", a, "cylinder3.a", "base", (xhat, m_axis))
+            else:
+                fb.joint("R3", "revolute", a, "cylinder3.a", "base", (yhat,))
+            fb.joint(f"P{n}", "prismatic", mid, f"cylinder{n}.b", f"rod{n}.a", (b - a,), k)
+            if n == 3 and variant == "upu":
+                fb.joint("U3_platform", "universal", b, "rod3.b", "platform", (m_axis, w))
+            else:
+                fb.joint(f"S{n}", "spherical", b, f"rod{n}.b", "platform")
+        bodies = (Body("base", np.zeros(3)), Body("platform", np.asarray(ref, float).copy()))
+        notes = [f"spatial frame O-xyz of spec §2.1 (z up, mm) at the constraint-consistent (C-model, chain 3 "
+                 f"'{variant}') placement of (z, theta, psi) = ({', '.join(f'{v:g}' for v in x)}): yaw phi = "
+                 f"{plat['phi']:.6g} rad, y0 = {plat['y0']:.6g} mm",
+                 "rigid platform B1B2B3, DOFs x, y, z, rx, ry, rz (small rotations about the fixed axes) at its "
+                 "reference point; the load is a force there"]
+        if options.get("model", "P") == "P":
+            notes.append("the P-model violates the RPS joint constraints (spec §2.3): the frame uses the C-model "
+                         "placement")
+        return fb.model("mm", bodies, options["load"], notes)
+
 
 DESIGN_METRICS = (
     DesignMetric(
@@ -947,6 +1030,7 @@ MECHANISM = RpsUpu(
         Option("theta_range", [-0.314, 0.314], "workspace box in theta (rad), the paper's"),
         Option("psi_range", [-0.314, 0.314], "workspace box in psi (rad), the paper's"),
         Option("characteristic_length", None, "L (mm) dividing the angle columns of the Jacobian; null = h"),
+        *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6 (illustrative)"),
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
@@ -1060,6 +1144,7 @@ class RpsUpuTool(RpsUpu):
 
     def check_options(self, options: dict[str, Any]) -> None:
         self._check_limits(options)
+        check_stiffness_options(options, 3, LINK_GROUPS)
         d = options["tool_offset"]
         if isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) or d <= 0:
             raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
@@ -1250,6 +1335,40 @@ class RpsUpuTool(RpsUpu):
             forward = forward or abs(math.cos(x[1]) * math.cos(x[2])) <= tol
         return singularity_label(inverse, forward)
 
+    # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
+    def _stiffness_placement(self, design, options, pose) -> tuple[np.ndarray, str, np.ndarray]:
+        """The C-model pose (z, theta, psi), chain 3 'plane', that puts the tool at T = pose (Newton from the
+        P-model's principal pose '++'), and T; raises InvalidPose when T is outside the tool workspace, Newton
+        fails, or that pose leaves the pose ranges or the stroke limits."""
+        t = self.check_vector("pose", pose, 3)
+        where = f"pose: tool point ({', '.join(f'{v:g}' for v in t)})"
+        if self.point_kernel(self.pack(design, options), *t) < 0.0:
+            raise InvalidPose(f"{where} is outside the workspace (pose ranges and stroke limits, P-model)")
+        (x,) = [s.values for s in self.poses_of_tool_point(design, options, t) if s.label == "++"]
+        geom, d = self._geom(design), options["tool_offset"]
+        scale = max(geom[:3]) + d
+        for _ in range(50):
+            _, p, rot, _, tm = _platform(geom, "C", "plane", x[None])
+            r = rot[0] @ np.array([0.0, 0.0, -d])
+            res = p[0] + r - t
+            if np.max(np.abs(res)) <= 1e-13 * scale:
+                break
+            jac = tm[0, :3] - _skew(r[None])[0] @ tm[0, 3:]
+            x = x - np.linalg.solve(jac, res)
+        else:
+            raise InvalidPose(f"{where}: no constraint-consistent (C-model) pose places the tool there")
+        c_opts = {**self._p(options), "model": "C"}
+        if not self._in_box(options, x) or MECHANISM.point_kernel(MECHANISM.pack(design, c_opts), *x) < 0.0:
+            raise InvalidPose(f"{where}: its constraint-consistent pose ({', '.join(f'{v:g}' for v in x)}) leaves "
+                              "the pose ranges or the stroke limits")
+        return x, "plane", t
+
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """As RpsUpu.stiffness_model, at the constraint-consistent pose (C-model, chain 3 'plane') that puts the
+        tool at T = pose; the rigid platform's reference point (load, deflection) is the tool point T."""
+        x, variant, ref = self._stiffness_placement(design, options, pose)
+        return self._frame(design, self._p(options), x, variant, ref, joints)
+
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def joint_screws(self, design, options, pose, q):
         """RpsUpu.joint_screws at the pose (of up to four) that places the tool at T = pose with legs closest
@@ -1271,6 +1390,7 @@ TOOL_MECHANISM = RpsUpuTool(
     options=(
         Option("tool_offset", 50.0, "d (mm): T = O' + R (0, 0, -d); illustrative default, the paper has no tool"),
         *(o for o in MECHANISM.options if o.name in ("stroke_limits", "z_range", "theta_range", "psi_range")),
+        *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6, tool 4 (illustrative)"),
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),

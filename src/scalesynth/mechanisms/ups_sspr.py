@@ -235,52 +235,38 @@ def _clearance(p, sa, ca, sb, cb, px, py, pz):
     return gap
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _bilinear(up_a, up_b, up_t, up_r, up_k, ex, ey, ez, f, g):
-    """f^T C_up g for two wrenches f, g (6-vectors at P) and C_up the tip compliance at P of the upper link (axis e,
-    round section) clamped at B0: translations a e e^T + b (I - e e^T), rotations t e e^T + r (I - e e^T), coupling
-    k e . (F_f x M_g + F_g x M_f)."""
-    fe = f[0] * ex + f[1] * ey + f[2] * ez
-    ge = g[0] * ex + g[1] * ey + g[2] * ez
-    fme = f[3] * ex + f[4] * ey + f[5] * ez
-    gme = g[3] * ex + g[4] * ey + g[5] * ez
-    ff = f[0] * g[0] + f[1] * g[1] + f[2] * g[2]
-    mm = f[3] * g[3] + f[4] * g[4] + f[5] * g[5]
-    # e . (F_f x M_g) + e . (F_g x M_f)
-    c1 = ex * (f[1] * g[5] - f[2] * g[4]) + ey * (f[2] * g[3] - f[0] * g[5]) + ez * (f[0] * g[4] - f[1] * g[3])
-    c2 = ex * (g[1] * f[5] - g[2] * f[4]) + ey * (g[2] * f[3] - g[0] * f[5]) + ez * (g[0] * f[4] - g[1] * f[3])
-    return up_b * ff + (up_a - up_b) * fe * ge + up_r * mm + (up_t - up_r) * fme * gme + up_k * (c1 + c2)
-
-
 @njit(cache=True, fastmath=FASTMATH)
 def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
     """(stiffness_min N/mm, deflection mm) at a reachable pose, ideal joints, the frame of stiffness_model, by
-    per-chain condensation (scalesynth.stiffness.legs' wrench form K = sum_i W_i Phi_i^-1 W_i^T = A A^T):
+    per-chain condensation in the wrench form K = sum_i W_i Phi_i^-1 W_i^T (scalesynth.stiffness.legs), written
+    out in the orthonormal frame (x, e, h) at P: x = x_link = Ry(beta) x (the revolute axes), e = P / c (the link
+    axis), h = x cross e. stiffness_min and |deflection| do not depend on the frame (the load is rotated into it).
 
-    * UPS leg i (U at A_i, S at B_i): a two-force member; wrench W = (u, (B_i - P) x u), flexibility
-      Phi = l_i / EA + 1 / k (cylinder and rod in series with the actuator spring).
+    * UPS leg i (U at A_i, S at B_i): a two-force member; wrench (u, (B_i - P) x u), flexibility
+      l_i / EA + 1 / k (cylinder and rod in series with the actuator spring).
     * (S+SPR)R: with ideal joints the link A0-B0-B1 is statically determinate under the wrenches it can take from
-      the platform: the revolute at B1 passes no moment about x_link, the S at A0 a force R, the SPR leg (S at M,
-      revolute about x_link at B0) a force Q = alpha d + beta x_link through M (d along M -> B0). The link is in
-      equilibrium under the platform's wrench f = (R + Q, -P x R + (M - P) x Q) (at P; A0 is the origin), and
-      x_link . moment = 0 ties R . h to alpha (h = x_link x e, e = P / c): a 4-dimensional wrench space with basis
-      (R = e), (R = x_link), (beta = 1), (alpha = 1, R = (K0 - 1)(d . h) h). Its flexibility Phi (4x4) is the
-      complementary energy: the upper link (B0 -> B1) as a cantilever clamped at B0 loaded by f, the lower link
-      (A0 -> B0) as one loaded by R at A0, the SPR leg (length l1) as one loaded by Q at M (axial
-      l1 / EA + 1 / k, lateral l1^3 / 3 EI). Round sections (EIy = EIz), as the tube options give.
+      the platform: the revolute at B1 passes no moment about x, the S at A0 a force R, the SPR leg (S at M,
+      revolute about x at B0) a force Q = alpha d + beta x through M (d the unit vector M -> B0, normal to x).
+      The platform's wrench on the link is f = (R + Q, -P x R + (M - P) x Q) (at P; A0 is the origin), and its x
+      moment vanishing ties R . h to alpha: a 4-dimensional wrench space with basis f1 (R = e), f2 (R = x),
+      f3 (Q = x), f4 (Q = d, R = (K0 - 1)(d . h) h). Its flexibility Phi (4x4) is the complementary energy of the
+      upper link (B0 -> B1, a cantilever clamped at B0 loaded by f at P), the lower link (A0 -> B0, loaded by R
+      at A0) and the SPR leg (length l1, loaded by Q at M: axial l1 / EA + 1 / k, lateral l1^3 / 3 EI). With
+      M - P and d normal to x, Phi splits into the blocks (f1, f4) and (f2, f3). Round sections (EIy = EIz), as
+      the tube options give.
 
-    The six wrench columns W L^-T (L L^T = Phi) form A; platform_response_wrenches gives the fields. The generic
-    per-leg routine on the same frame (tests/test_stiffness_legs.py) and the reference solver agree with it.
-    Characteristic length for the singularity test: the reference solver's longest link (halves of the legs, the
-    lower link)."""
-    w = np.empty((3, 6, 6))
-    A, work, fw = w[0], w[1], w[2]
+    The generic per-leg routine of scalesynth.stiffness.legs on the same frame (tests/test_stiffness_legs.py)
+    and the reference solver agree with it. Characteristic length of the singularity test: the reference
+    solver's longest link (the halves of the legs, the lower link)."""
     c = p[_C]
     am = p[_AM]
     k = p[_KACT]
     ea_leg, ei_leg = p[_EA_LEG], p[_EI_LEG]
-    for col in range(2):  # UPS legs 2 (x < 0) and 3: columns 4, 5
-        sx = -1.0 if col == 0 else 1.0
+    ex, ey, ez = px / c, py / c, pz / c  # e
+    xx, xz = cb, -sb  # x = (cb, 0, -sb)
+    hx, hy, hz = -xz * ey, xz * ex - xx * ez, xx * ey  # h = x cross e
+    kk = (0.0,) * 21
+    for sx in (-1.0, 1.0):  # UPS legs 2 (x < 0) and 3
         bx0 = sx * p[_BX]
         by0 = p[_BY]
         rbx = cb * bx0 + sb * sa * by0  # B - P = R B'
@@ -289,56 +275,58 @@ def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
         dx = px + rbx - sx * p[_AX]
         dy = py + rby + am
         dz = pz + rbz
-        ln = math.sqrt(dx * dx + dy * dy + dz * dz)
-        ux, uy, uz = dx / ln, dy / ln, dz / ln
-        s = 1.0 / math.sqrt(ln / ea_leg + 1.0 / k)
-        j = 4 + col
-        A[0, j], A[1, j], A[2, j] = ux * s, uy * s, uz * s
-        A[3, j] = (rby * uz - rbz * uy) * s
-        A[4, j] = (rbz * ux - rbx * uz) * s
-        A[5, j] = (rbx * uy - rby * ux) * s
-    # (S+SPR)R chain: frame e (link axis), x (revolute axes), h = x cross e
-    ex, ey, ez = px / c, py / c, pz / c
-    xx, xz = cb, -sb  # x_link = (cb, 0, -sb)
-    hx, hy, hz = -xz * ey, xz * ex - xx * ez, xx * ey
+        s = 1.0 / math.sqrt(dx * dx + dy * dy + dz * dz)
+        w = 1.0 / math.sqrt(1.0 / (s * ea_leg) + 1.0 / k)
+        s *= w  # u / sqrt(flexibility)
+        ux, ue, uh = (dx * xx + dz * xz) * s, (dx * ex + dy * ey + dz * ez) * s, (dx * hx + dy * hy + dz * hz) * s
+        bx, be, bh = rbx * xx + rbz * xz, rbx * ex + rby * ey + rbz * ez, rbx * hx + rby * hy + rbz * hz
+        kk = _legs_k.outer_add(kk, ux, ue, uh, be * uh - bh * ue, bh * ux - bx * uh, bx * ue - be * ux)
+    # the (S+SPR)R chain in the frame (x, e, h): d = (0, de, dh), M - P = (0, me, mh)
     dx, dy, dz = K0 * px, K0 * py + am, K0 * pz  # B0 - M
     l1 = math.sqrt(dx * dx + dy * dy + dz * dz)
-    dx, dy, dz = dx / l1, dy / l1, dz / l1
-    g = (K0 - 1.0) * (dx * hx + dy * hy + dz * hz)
-    mpx, mpy, mpz = -px, -am - py, -pz  # M - P
-    # wrench basis f_j = (R + Q, -P x R + (M - P) x Q): -P x e = 0, -P x x_link = c h, -P x h = -c x_link
-    fw[:, :] = 0.0
-    fw[0, 0], fw[1, 0], fw[2, 0] = ex, ey, ez  # R = e
-    fw[0, 1], fw[1, 1], fw[2, 1] = xx, 0.0, xz  # R = x_link
-    fw[3, 1], fw[4, 1], fw[5, 1] = c * hx, c * hy, c * hz
-    fw[0, 2], fw[1, 2], fw[2, 2] = xx, 0.0, xz  # Q = x_link through M
-    fw[3, 2], fw[4, 2], fw[5, 2] = mpy * xz, mpz * xx - mpx * xz, -mpy * xx
-    fw[0, 3], fw[1, 3], fw[2, 3] = dx + g * hx, dy + g * hy, dz + g * hz  # Q = d through M, R = g h
-    fw[3, 3] = mpy * dz - mpz * dy - g * c * xx
-    fw[4, 3] = mpz * dx - mpx * dz
-    fw[5, 3] = mpx * dy - mpy * dx - g * c * xz
+    de = (dx * ex + dy * ey + dz * ez) / l1
+    dh = (dx * hx + dy * hy + dz * hz) / l1
+    me = -am * ey - c
+    mh = -am * hy
+    g = (K0 - 1.0) * dh
     ea, ei, gj = p[_EA_LINK], p[_EI_LINK], p[_GJ_LINK]
     lu = (1.0 - K0) * c
-    up_a, up_b, up_t, up_r, up_k = lu / ea, lu * lu * lu / (3.0 * ei), lu / gj, lu / ei, lu * lu / (2.0 * ei)
+    ua, ub, ut, ur, uk = lu / ea, lu * lu * lu / (3.0 * ei), lu / gj, lu / ei, lu * lu / (2.0 * ei)
     lo = K0 * c
-    lo_ax, lo_lat = lo / ea, lo * lo * lo / (3.0 * ei)
-    spr_ax, spr_lat = l1 / ea_leg + 1.0 / k, l1 * l1 * l1 / (3.0 * ei_leg)
-    phi = work
-    for a in range(4):
-        for b in range(a, 4):
-            phi[a, b] = _bilinear(up_a, up_b, up_t, up_r, up_k, ex, ey, ez, fw[:, a], fw[:, b])
-    phi[0, 0] += lo_ax
-    phi[1, 1] += lo_lat
-    phi[2, 2] += spr_lat
-    phi[3, 3] += g * g * lo_lat + spr_ax
-    for a in range(4):
-        for b in range(a):
-            phi[a, b] = phi[b, a]
-    if not _legs_k.cholesky(phi, 4):
+    lo_lat = lo * lo * lo / (3.0 * ei)
+    # block (f1, f4): f1 = (F (0, 1, 0), M 0); f4 = (F (0, de, dh + g), M (m4, 0, 0))
+    fh4 = dh + g
+    m4 = me * dh - mh * de - g * c
+    p11 = ua + lo / ea
+    p14 = ua * de
+    p44 = (ub * fh4 * fh4 + ua * de * de + ur * m4 * m4 + 2.0 * uk * fh4 * m4 + g * g * lo_lat
+           + l1 / ea_leg + 1.0 / k)
+    # block (f2, f3): f2 = (F (1, 0, 0), M (0, 0, c)); f3 = (F (1, 0, 0), M (0, mh, -me))
+    p22 = ub + ur * c * c - 2.0 * uk * c + lo_lat
+    p23 = ub - ur * c * me + uk * (me - c)
+    p33 = ub + ur * me * me + ut * mh * mh + 2.0 * uk * me + l1 * l1 * l1 / (3.0 * ei_leg)
+    l11 = math.sqrt(p11)
+    l41 = p14 / l11
+    q44 = p44 - l41 * l41
+    l22 = math.sqrt(p22)
+    l32 = p23 / l22
+    q33 = p33 - l32 * l32
+    if not (q44 > 0.0 and q33 > 0.0):
         return 0.0, _legs_k.DEFLECTION_CAP
-    _legs_k.wrench_columns(phi, fw, 4, A, 0)
+    i11 = 1.0 / l11
+    i44 = 1.0 / math.sqrt(q44)
+    i22 = 1.0 / l22
+    i33 = 1.0 / math.sqrt(q33)
+    # columns W L^-T: f1 / l11, (f4 - l41 f1 / l11) / l44; f2 / l22, (f3 - l32 f2 / l22) / l33
+    kk = _legs_k.outer_add(kk, 0.0, i11, 0.0, 0.0, 0.0, 0.0)
+    kk = _legs_k.outer_add(kk, 0.0, (de - l41 * i11) * i44, fh4 * i44, m4 * i44, 0.0, 0.0)
+    kk = _legs_k.outer_add(kk, i22, 0.0, 0.0, 0.0, 0.0, c * i22)
+    t = l32 * i22
+    kk = _legs_k.outer_add(kk, (1.0 - t) * i33, 0.0, 0.0, 0.0, mh * i33, (-me - t * c) * i33)
+    fx, fy, fz = p[_FX], p[_FY], p[_FZ]
+    fxx, fe, fh = fx * xx + fz * xz, fx * ex + fy * ey + fz * ez, fx * hx + fy * hy + fz * hz
     length = max(0.5 * lmax, K0 * c)
-    return _legs_k.platform_response_wrenches(A, p[_FX], p[_FY], p[_FZ], length, work)
+    return _legs_k.response_upper(kk, fxx, fe, fh, length)
 
 
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):

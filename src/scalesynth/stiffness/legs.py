@@ -17,9 +17,13 @@ minimising the strain energy over the joint motions gives the leg stiffness
 equal to the projection K - K J (J^T K J)^-1 J^T K of K = C^-1 on the joint twists J, but without subtraction
 (no cancellation between stiff and soft parts). Legs in parallel add their stiffnesses; a chain meeting another
 one at an intermediate node combines in series (:func:`series_stiffness`). :func:`platform_response` turns the
-platform stiffness into the fields stiffness_min and deflection.
+platform stiffness into the fields stiffness_min and deflection (a 3x3 Schur complement, no 6x6 inverse).
 
-Every routine works on caller-provided small arrays (one scratch allocation per voxel); none writes NaN.
+The general routines (beams, springs, joint twists, constraint wrenches, series) work on caller-provided 6x6
+arrays and allocate a few 3x3 temporaries: fine for a mechanism's generic per-voxel path and for cross-checks. A
+kernel within a few times the kinematic fields' cost writes the same condensation out in closed form for its
+chains (the wrench form K = sum W Phi^-1 W^T, ``Phi`` the chain's flexibility on its wrench basis W) and calls
+:func:`response_upper` on the 21 entries of K (ups-sspr). None writes NaN.
 Units: lengths in the mechanism's unit, EA in N, EI and GJ in N * length^2, a prismatic spring in N / length,
 a revolute spring in N * length / rad. Checked against the NumPy reference solver and a NumPy twin
 (tests/test_stiffness_legs.py).
@@ -32,7 +36,7 @@ import math
 import numpy as np
 from numba import njit
 
-from scalesynth.kernels.conditioning import SIGMA_CAP, sv_3x3
+from scalesynth.kernels.conditioning import SIGMA_CAP
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.stiffness.solve import SINGULAR_RTOL
 
@@ -40,13 +44,6 @@ DEFLECTION_CAP = SIGMA_CAP  # length unit: the per-voxel deflection at a singula
 # a joint twist whose part outside the span of the previous ones is below this (relative, rotations as arc lengths
 # at the characteristic length) adds no free direction (a dependent joint axis, e.g. at a leg's own singularity)
 DEPENDENT_RTOL = 1e-9
-N_SCRATCH = 8  # 6x6 matrices a voxel needs: see scratch()
-
-
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def scratch():
-    """Work space of one voxel: N_SCRATCH 6x6 matrices (one allocation)."""
-    return np.empty((N_SCRATCH, 6, 6))
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -372,175 +369,132 @@ def series_stiffness(Ka, Kb, out, work):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def platform_response(K, fx, fy, fz, length, work):
-    """(stiffness_min, deflection) of a platform of stiffness K (6x6 at its reference point) under the force
-    F = (fx, fy, fz) N: C = K^-1, stiffness_min = 1 / lambda_max(C_t) (C_t its translational block: the stiffness
-    felt by a pure force, N/length) and |C_t F| (length unit). Singular as in the reference solver: the smallest
-    eigenvalue of K with rotations as arc lengths at ``length`` (the longest link) is at most SINGULAR_RTOL times
-    the largest; then (0, DEFLECTION_CAP) for a non-zero load (0 for a zero load); never NaN."""
-    zero = 0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else DEFLECTION_CAP
-    s = work
-    inv = 1.0 / length
-    for i in range(6):
-        si = 1.0 if i < 3 else inv
-        for j in range(6):
-            sj = 1.0 if j < 3 else inv
-            s[i, j] = K[i, j] * si * sj
-    tr = 0.0
-    for i in range(6):
-        tr += s[i, i]
-    scaled = s.copy()
-    if not tr > 0.0 or not cholesky(s, 6):
-        return 0.0, zero
-    x = np.zeros((6, 6))
-    for i in range(6):
-        x[i, i] = 1.0
-    _forward(s, 6, x, 6)
-    _backward(s, 6, x, 6)  # x = K~^-1 (translations unscaled: its tt block is C_t)
-    tri = 0.0
-    for i in range(6):
-        tri += x[i, i]
-    # lambda_max / lambda_min <= tr(K~) tr(K~^-1) <= 36 lambda_max / lambda_min: decide by the eigenvalues
-    # only where the bound cannot
-    if not tr * tri * SINGULAR_RTOL < 1.0:
-        if not math.isfinite(tri):
-            return 0.0, zero
-        w = np.linalg.eigvalsh(scaled)
-        if not w[0] > SINGULAR_RTOL * w[5]:
-            return 0.0, zero
-    lci, cmin, cmax = sv_3x3(x[0, 0], x[0, 1], x[0, 2], x[1, 0], x[1, 1], x[1, 2], x[2, 0], x[2, 1], x[2, 2])
-    if not cmax > 0.0:
-        return 0.0, zero
-    dx = x[0, 0] * fx + x[0, 1] * fy + x[0, 2] * fz
-    dy = x[1, 0] * fx + x[1, 1] * fy + x[1, 2] * fz
-    dz = x[2, 0] * fx + x[2, 1] * fy + x[2, 2] * fz
-    return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def leg_wrench_columns(C, N, n, A, col, work):
-    """The leg of compliance C (6x6 at ref) and constraint wrenches N[:, :n] as columns col..col+n-1 of A:
-    N L^-T with L L^T = N^T C N, so that the leg's stiffness is their outer-product sum (K_leg = N (N^T C N)^-1
-    N^T). Stacking every leg's columns gives the platform stiffness K = A A^T (platform_response_wrenches).
-    Returns the next free column, or -1 if N^T C N is not positive definite."""
-    m = work
-    for a in range(n):
-        for b in range(a, n):
-            s = 0.0
-            for i in range(6):
-                ci = 0.0
-                for j in range(6):
-                    ci += C[i, j] * N[j, b]
-                s += N[i, a] * ci
-            m[a, b] = s
-            m[b, a] = s
-    if not cholesky(m, n):
-        return -1
-    wrench_columns(m, N, n, A, col)
-    return col + n
+def platform_response(K, fx, fy, fz, length):
+    """(stiffness_min, deflection) of a platform of stiffness K (6x6 at its reference point: translations, then
+    rotations) under the force F = (fx, fy, fz) N: the translational stiffness felt by a pure force is the Schur
+    complement S = K_tt - K_tr K_rr^-1 K_rt (= C_t^-1, C_t the translational block of C = K^-1); stiffness_min =
+    1 / lambda_max(C_t) (N/length) and the deflection |C_t F| (length unit). Singular (the per-voxel stand-in for
+    the reference solver's eigenvalue test): K_rr or S not positive definite, or lambda_max(C_t) tr(K~) >=
+    1 / SINGULAR_RTOL, K~ = K with rotations as arc lengths at ``length`` (lambda_max(C_t) <= 1 / lambda_min(K~)
+    and lambda_max(K~) <= tr(K~), so this flags an eigenvalue ratio of K~ of at most SINGULAR_RTOL seen by a
+    force); then (0, DEFLECTION_CAP) for a non-zero load (0 for a zero load). Never NaN."""
+    return _response(K[0, 0], K[0, 1], K[0, 2], K[1, 1], K[1, 2], K[2, 2], K[0, 3], K[0, 4], K[0, 5], K[1, 3],
+                     K[1, 4], K[1, 5], K[2, 3], K[2, 4], K[2, 5], K[3, 3], K[3, 4], K[3, 5], K[4, 4], K[4, 5],
+                     K[5, 5], fx, fy, fz, length)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def wrench_columns(L, W, n, A, col):
-    """A[:, col:col+n] = W L^-T (L the lower Cholesky factor of a leg's flexibility on its wrench basis W[:, :n])."""
-    for i in range(6):
-        for a in range(n):
-            t = W[i, a]
-            for k in range(a):
-                t -= L[a, k] * A[i, col + k]
-            A[i, col + a] = t / L[a, a]
+def outer_add(k, a0, a1, a2, a3, a4, a5):
+    """k + a a^T for the 21 upper entries k of a symmetric 6x6 matrix (a tuple, row-major: 00, 01, ..., 05, 11, ...,
+    55): a kernel sums its legs' wrench columns a into K in scalars and hands k to response_upper."""
+    return (k[0] + a0 * a0, k[1] + a0 * a1, k[2] + a0 * a2, k[3] + a0 * a3, k[4] + a0 * a4, k[5] + a0 * a5,
+            k[6] + a1 * a1, k[7] + a1 * a2, k[8] + a1 * a3, k[9] + a1 * a4, k[10] + a1 * a5,
+            k[11] + a2 * a2, k[12] + a2 * a3, k[13] + a2 * a4, k[14] + a2 * a5,
+            k[15] + a3 * a3, k[16] + a3 * a4, k[17] + a3 * a5, k[18] + a4 * a4, k[19] + a4 * a5, k[20] + a5 * a5)
 
 
-@njit(cache=True, fastmath=FASTMATH)
-def platform_response_wrenches(A, fx, fy, fz, length, work):
-    """(stiffness_min, deflection) as :func:`platform_response` for the platform stiffness K = A A^T, A (6x6) the
-    stacked wrench columns of the legs (a non-redundant mechanism: six in all), without forming K: with rotations
-    as arc lengths at ``length`` (A~ = S A, S = diag(1, 1, 1, 1/length, ...)), X = A~^-1 by LU with partial
-    pivoting, K~^-1 = X^T X and C_t = X[:, :3]^T X[:, :3]. Singular as in the reference solver (eigenvalue ratio of
-    K~ at most SINGULAR_RTOL; decided from tr(K~) tr(K~^-1), which bounds the ratio within a factor 36, and from
-    the eigenvalues where that bound cannot decide); ``work``: a 6x6 scratch. A is overwritten."""
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def response_upper(k, fx, fy, fz, length):
+    """:func:`platform_response` of the symmetric K given by its 21 upper entries k (row-major: 00, 01, ..., 05,
+    11, ..., 55), for kernels that assemble K in scalars."""
+    return _response(k[0], k[1], k[2], k[6], k[7], k[11], k[3], k[4], k[5], k[8], k[9], k[10], k[12], k[13], k[14],
+                     k[15], k[16], k[17], k[18], k[19], k[20], fx, fy, fz, length)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _sym3_inverse(a00, a01, a02, a11, a12, a22):
+    """(ok, inverse entries 00, 01, 02, 11, 12, 22) of a symmetric 3x3 matrix by its adjugate; ok False unless it
+    is positive definite (leading minors > 0)."""
+    m00 = a11 * a22 - a12 * a12
+    m01 = a02 * a12 - a01 * a22
+    m02 = a01 * a12 - a02 * a11
+    det = a00 * m00 + a01 * m01 + a02 * m02
+    if not (a00 > 0.0 and a00 * a11 - a01 * a01 > 0.0 and det > 0.0 and math.isfinite(det)):
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    inv = 1.0 / det
+    return (True, m00 * inv, m01 * inv, m02 * inv, (a00 * a22 - a02 * a02) * inv, (a01 * a02 - a00 * a12) * inv,
+            (a00 * a11 - a01 * a01) * inv)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _response(t00, t01, t02, t11, t12, t22, c00, c01, c02, c10, c11, c12, c20, c21, c22, r00, r01, r02, r11, r12,
+              r22, fx, fy, fz, length):
+    """platform_response from the blocks of K: tt (upper entries), tr (c_ij = K[i, 3 + j]) and rr (upper)."""
     zero = 0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else DEFLECTION_CAP
-    inv = 1.0 / length
-    tr = 0.0
-    for i in range(6):
-        for j in range(6):
-            if i >= 3:
-                A[i, j] *= inv
-            tr += A[i, j] * A[i, j]
-    if not tr > 0.0 or not math.isfinite(tr):
+    tr = t00 + t11 + t22 + (r00 + r11 + r22) / (length * length)
+    ok, i00, i01, i02, i11, i12, i22 = _sym3_inverse(r00, r01, r02, r11, r12, r22)
+    if not ok:
         return 0.0, zero
-    piv = np.empty(6, dtype=np.int64)
-    for j in range(6):  # LU, partial pivoting, in place
-        p = j
-        big = abs(A[j, j])
-        for i in range(j + 1, 6):
-            if abs(A[i, j]) > big:
-                big = abs(A[i, j])
-                p = i
-        piv[j] = p
-        if not big > 0.0:
-            return 0.0, zero
-        if p != j:
-            for k in range(6):
-                A[j, k], A[p, k] = A[p, k], A[j, k]
-        d = 1.0 / A[j, j]
-        for i in range(j + 1, 6):
-            A[i, j] *= d
-            f = A[i, j]
-            for k in range(j + 1, 6):
-                A[i, k] -= f * A[j, k]
-    x = work  # X = A~^-1: solve A~ X = I
-    for c in range(6):
-        for i in range(6):
-            x[i, c] = 0.0
-        x[c, c] = 1.0
-    for j in range(6):  # apply the row swaps to I
-        p = piv[j]
-        if p != j:
-            for c in range(6):
-                x[j, c], x[p, c] = x[p, c], x[j, c]
-    for c in range(6):
-        for i in range(6):
-            t = x[i, c]
-            for k in range(i):
-                t -= A[i, k] * x[k, c]
-            x[i, c] = t
-        for i in range(5, -1, -1):
-            t = x[i, c]
-            for k in range(i + 1, 6):
-                t -= A[i, k] * x[k, c]
-            x[i, c] = t / A[i, i]
-    tri = 0.0
-    for i in range(6):
-        for j in range(6):
-            tri += x[i, j] * x[i, j]
-    if not tr * tri * SINGULAR_RTOL < 1.0:
-        if not math.isfinite(tri):
-            return 0.0, zero
-        # P A~ = L U, so K~ = A~ A~^T has the eigenvalues of (L U)(L U)^T
-        lu = np.zeros((6, 6))
-        for i in range(6):
-            for j in range(6):
-                t = A[i, j] if i <= j else 0.0
-                for k in range(min(i, j + 1)):
-                    t += A[i, k] * A[k, j]
-                lu[i, j] = t
-        w = np.linalg.eigvalsh(lu @ lu.T)
-        if not w[0] > SINGULAR_RTOL * w[5]:
-            return 0.0, zero
-    c00 = c01 = c02 = c11 = c12 = c22 = 0.0
-    for k in range(6):
-        a0, a1, a2 = x[k, 0], x[k, 1], x[k, 2]
-        c00 += a0 * a0
-        c01 += a0 * a1
-        c02 += a0 * a2
-        c11 += a1 * a1
-        c12 += a1 * a2
-        c22 += a2 * a2
-    lci, cmin, cmax = sv_3x3(c00, c01, c02, c01, c11, c12, c02, c12, c22)
-    if not cmax > 0.0:
+    # T = K_tr K_rr^-1, S = K_tt - T K_rt
+    u00 = c00 * i00 + c01 * i01 + c02 * i02
+    u01 = c00 * i01 + c01 * i11 + c02 * i12
+    u02 = c00 * i02 + c01 * i12 + c02 * i22
+    u10 = c10 * i00 + c11 * i01 + c12 * i02
+    u11 = c10 * i01 + c11 * i11 + c12 * i12
+    u12 = c10 * i02 + c11 * i12 + c12 * i22
+    u20 = c20 * i00 + c21 * i01 + c22 * i02
+    u21 = c20 * i01 + c21 * i11 + c22 * i12
+    u22 = c20 * i02 + c21 * i12 + c22 * i22
+    s00 = t00 - (u00 * c00 + u01 * c01 + u02 * c02)
+    s01 = t01 - (u00 * c10 + u01 * c11 + u02 * c12)
+    s02 = t02 - (u00 * c20 + u01 * c21 + u02 * c22)
+    s11 = t11 - (u10 * c10 + u11 * c11 + u12 * c12)
+    s12 = t12 - (u10 * c20 + u11 * c21 + u12 * c22)
+    s22 = t22 - (u20 * c20 + u21 * c21 + u22 * c22)
+    ok, a00, a01, a02, a11, a12, a22 = _sym3_inverse(s00, s01, s02, s11, s12, s22)
+    if not ok:
         return 0.0, zero
-    dx = c00 * fx + c01 * fy + c02 * fz
-    dy = c01 * fx + c11 * fy + c12 * fz
-    dz = c02 * fx + c12 * fy + c22 * fz
+    cmax = sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22)
+    if not (cmax > 0.0 and math.isfinite(cmax)) or not cmax * tr * SINGULAR_RTOL < 1.0:
+        return 0.0, zero
+    dx = a00 * fx + a01 * fy + a02 * fz
+    dy = a01 * fx + a11 * fy + a12 * fz
+    dz = a02 * fx + a12 * fy + a22 * fz
     return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22):
+    """Largest eigenvalue of the symmetric 3x3 matrix [[a00, a01, a02], [a01, a11, a12], [a02, a12, a22]] by the
+    trigonometric solution of its characteristic cubic (well conditioned for the largest root)."""
+    q = (a00 + a11 + a22) / 3.0
+    b00, b11, b22 = a00 - q, a11 - q, a22 - q
+    p2 = b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12)
+    if p2 <= 1e-300:
+        return q
+    p = math.sqrt(p2 / 6.0)
+    inv = 1.0 / p
+    b00 *= inv
+    b11 *= inv
+    b22 *= inv
+    c01, c02, c12 = a01 * inv, a02 * inv, a12 * inv
+    r = 0.5 * (b00 * (b11 * b22 - c12 * c12) - c01 * (c01 * b22 - c12 * c02) + c02 * (c01 * c12 - b11 * c02))
+    if r >= 1.0:
+        return q + 2.0 * p
+    if r <= -1.0:
+        return q + p
+    return q + 2.0 * p * math.cos(math.acos(r) / 3.0)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def tip_bilinear(length, ea, ei, gj, ex, ey, ez, f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z):
+    """w1^T C w2 for two wrenches w = (F, M) at the tip of a round-section cantilever (length, unit axis e from
+    the clamp to the tip; EA, EI, GJ): C's translations (L/EA) e e^T + (L^3/3EI)(I - e e^T), rotations
+    (L/GJ) e e^T + (L/EI)(I - e e^T), coupling (L^2/2EI) e . (F1 x M2 + F2 x M1) (the blocks of
+    add_beam_compliance with EIy = EIz). Zero for a beam of zero length."""
+    if not length > 0.0:
+        return 0.0
+    a = length / ea
+    b = length * length * length / (3.0 * ei)
+    r = length / ei
+    t = length / gj
+    k = length * length / (2.0 * ei)
+    fe1 = f1x * ex + f1y * ey + f1z * ez
+    fe2 = f2x * ex + f2y * ey + f2z * ez
+    me1 = m1x * ex + m1y * ey + m1z * ez
+    me2 = m2x * ex + m2y * ey + m2z * ez
+    ff = f1x * f2x + f1y * f2y + f1z * f2z
+    mm = m1x * m2x + m1y * m2y + m1z * m2z
+    c1 = ex * (f1y * m2z - f1z * m2y) + ey * (f1z * m2x - f1x * m2z) + ez * (f1x * m2y - f1y * m2x)
+    c2 = ex * (f2y * m1z - f2z * m1y) + ey * (f2z * m1x - f2x * m1z) + ez * (f2x * m1y - f2y * m1x)
+    return b * ff + (a - b) * fe1 * fe2 + r * mm + (t - r) * me1 * me2 + k * (c1 + c2)

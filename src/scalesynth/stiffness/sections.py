@@ -110,3 +110,9 @@ def tube_section(options: Mapping[str, Any], group: str, length_unit: str) -> Se
     area = math.pi / 4.0 * (d * d - di * di)
     inertia = math.pi / 64.0 * (d**4 - di**4)
     return Section(EA=e * area, EI=e * inertia, GJ=g * 2.0 * inertia)
+
+
+def check_positive_option(options: dict[str, Any], name: str) -> None:
+    """Validate (and normalise in place) a mechanism's own stiffness option that must be a finite number > 0
+    (e.g. a second actuator stiffness); raise InvalidParameter naming it."""
+    options[name] = _positive(name, options[name])

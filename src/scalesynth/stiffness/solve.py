@@ -190,17 +190,31 @@ def is_singular(K: np.ndarray, dim: int, length: float, rtol: float = SINGULAR_R
     return bool(w[0] <= rtol * w[-1])
 
 
+def _held_rotations(A: np.ndarray, s: int, dim: int, n: int) -> list[int]:
+    """Rotation DOFs (indices into the platform's n DOFs) that the joints alone hold rigidly: no motion satisfying
+    the constraints A u = 0 turns the platform about that axis (e.g. a chain of prismatic joints to the base, seed
+    000's PPaP). Their compliance is exactly 0 and their stiffness infinite, so they are not platform DOFs."""
+    if A.shape[0] == 0 or n == dim:
+        return []
+    _, sv, vt = np.linalg.svd(A)
+    rank = int(np.sum(sv > 1e-12 * sv[0]))
+    rows = vt[rank:, s : s + n]  # platform components of an orthonormal basis of the admissible motions
+    return [i for i in range(dim, n) if np.linalg.norm(rows[:, i]) <= 1e-9]
+
+
 def platform_compliance(model: FrameModel) -> tuple[np.ndarray | None, tuple[str, ...]]:
     """Compliance of the platform DOFs (n, n), None when the structure is a mechanism (singular pose), and the DOF
     names. Solved as the saddle-point system [[K, A^T], [A, 0]] [u; lambda] = [S^T; 0] (u the displacements under
     a unit generalised force on each platform DOF): no condensation by subtraction, so a stiff part in series with a
-    soft one keeps its accuracy."""
+    soft one keeps its accuracy. Platform rotations that the joints hold rigidly (_held_rotations) are left out of
+    the DOFs (a purely translating platform has DOFs x, y, z)."""
     lay = _Layout(model)
     K, A = _assemble(model, lay)
     n_all, m = lay.ndof, A.shape[0]
     body = model.body(model.platform)
     s = lay.start[model.platform]
     n = lay.nd if body.kind == "rigid" else model.dim
+    held = _held_rotations(A, s, model.dim, n)
     M = np.zeros((n_all + m, n_all + m))
     M[:n_all, :n_all] = K
     M[:n_all, n_all:] = A.T
@@ -210,11 +224,13 @@ def platform_compliance(model: FrameModel) -> tuple[np.ndarray | None, tuple[str
     names = ("x", "y", "z")[: model.dim]
     if n > model.dim:
         names = names + (("rz",) if model.dim == 2 else ("rx", "ry", "rz"))
+    keep = [i for i in range(n) if i not in held]
+    names = tuple(names[i] for i in keep)
     try:
-        X = np.linalg.solve(M, rhs)
+        X = np.linalg.solve(M, rhs[:, keep])
     except np.linalg.LinAlgError:
         return None, names
-    C = X[s : s + n]
+    C = X[s : s + n][keep]
     if not np.all(np.isfinite(C)):
         return None, names
     return 0.5 * (C + C.T), names
