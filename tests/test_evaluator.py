@@ -55,7 +55,7 @@ def test_kernel_matches_numpy_twin(group, options, resolution):
     # only at the nodes where J is defined to working precision.
     regular = reach & (lci > 1e-9)
     assert regular.sum() > 0.9 * reach.sum()
-    np.testing.assert_allclose(fields[regular][:, 1:], twin[regular][:, 1:], rtol=1e-7)
+    np.testing.assert_allclose(fields[regular][:, 1:3], twin[regular][:, 1:3], rtol=1e-7)  # slot 3: clearance
     assert (fields[reach & ~regular][:, 2] >= 1e9).all() and (twin[reach & ~regular][:, 2] >= 1e9).all()
     assert (fields[~reach][:, 1:] == 0).all()
     rep = evaluate(M, design, opts, resolution=resolution, band_edges=EDGES)
@@ -165,17 +165,28 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     lo = np.stack([g.lo for g in grids])
     step = np.stack([g.step for g in grids])
     edges = np.array(EDGES)
-    generic = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
+    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
     fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    # the fast path has the three fields lci, sigma_min, sigma_max; the field kernel adds clearance (slot 3)
+    assert M.field_names[3] == "clearance" and full.shape == (16, kgrid.stat_columns(4, 3))
+    head = kgrid.band_column(3, 0)
+    generic = np.hstack([full[:, :head], full[:, kgrid.band_column(4, 0):]])
     assert fast.shape == generic.shape == (16, kgrid.stat_columns(3, 3))
+    # what the evaluator gets (options without link_radius): the fast rows in the four-field layout
+    widened = M.grid_stats(packed, lo, step, grids[0].shape, edges)
+    assert widened.shape == full.shape
+    assert np.array_equal(widened[:, :head], fast[:, :head])
+    assert np.array_equal(widened[:, kgrid.band_column(4, 0):], fast[:, head:])
     assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
     assert np.array_equal(generic[:, kgrid.COL_COUNT], fast[:, kgrid.COL_COUNT])
     bands = [kgrid.band_column(3, b) for b in range(3)]
     assert np.array_equal(generic[:, bands], fast[:, bands])
     # every field's sums (summed in another order: the fast path weights mirrored cells) and extremes. sigma_max is
     # 1/sigma_min(dq/dx): within a few cells of a singular surface its relative rounding error grows like 1/LCI, and
-    # the fast path takes a cell's mirror image for the cell itself, so sigma_max's sums and squares agree to that
-    # conditioning only; they are compared exactly where the design keeps sigma_max below 1e4 (well conditioned).
+    # the fast path takes a cell's mirror image for the cell itself (whose coordinates differ in the last bit) and its
+    # vectorised passes use another algebraic form, so sigma_max's sums and squares agree to that conditioning only;
+    # they are compared exactly where the design keeps sigma_max below 1e4 (well conditioned). Without those two
+    # sources the rows are bitwise equal (next test).
     smax = [kgrid.field_column(2, st) for st in (kgrid.STAT_SUM, kgrid.STAT_SUMSQ, kgrid.STAT_MAX)]
     rest = [c for c in range(generic.shape[1]) if c not in smax]
     np.testing.assert_allclose(fast[:, rest], generic[:, rest], rtol=1e-10, atol=1e-12)
@@ -185,6 +196,36 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     reachable = generic[:, kgrid.COL_COUNT] > 0
     assert reachable.any()
     np.testing.assert_array_equal(fast[reachable, kgrid.COL_MIN] <= fast[reachable, kgrid.COL_MAX], True)
+
+
+@pytest.mark.parametrize("resolution", [24, 56])  # largest sigma_max 1.6e3 and 2.3e5
+def test_fast_seed000_cells_computed_like_the_generic_kernel_give_bitwise_equal_rows(resolution):
+    """Where the fast path evaluates every cell itself with the generic kernel's formula (grids shifted off the
+    mirror planes, so no cell stands for its mirror image; theta limits, so its cells go through kinematic_fields,
+    point_fields' code without the clearance), every column of its rows equals the generic kernel's bitwise,
+    sigma_max's included, also for the designs with sigma_max above 1e3: the sigma_max differences the test above
+    allows come from mirrored cells (lo + (i + 0.5) step is not exactly odd in i, and sigma_max amplifies a
+    coordinate's rounding by about 1/LCI near singular surfaces) and from the vectorised passes' algebraic form."""
+    from scalesynth.mechanisms.pauu_ppap import population_stats_fast
+
+    rng = np.random.default_rng(resolution)
+    opts = M.resolve_options({"theta1_limits": [-1.5, 0.2], "theta2_limits": [-1.5, 0.2]})
+    designs = [
+        M.resolve_design(dict(m=rng.uniform(0.5, 1.5), n=rng.uniform(0.2, 1), l1=rng.uniform(0.5, 1.5),
+                              l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)))
+        for _ in range(16)
+    ]
+    packed = np.stack([M.pack(d, opts) for d in designs])
+    grids = [make_grid(M, d, opts, resolution) for d in designs]
+    step = np.stack([g.step for g in grids])
+    lo = np.stack([g.lo for g in grids]) - np.array([1e-3, 1e-3, 0.0]) * step
+    edges = np.array(EDGES)
+    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
+    generic = np.hstack([full[:, : kgrid.band_column(3, 0)], full[:, kgrid.band_column(4, 0):]])
+    fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
+    assert (generic[:, kgrid.field_column(2, kgrid.STAT_MAX)] > 1e3).any()  # ill-conditioned designs included
+    assert np.array_equal(fast, generic)
 
 
 def test_exact_volume_quadrature_reproduces_spec():

@@ -62,3 +62,28 @@ def segment_distance(px, py, pz, qx, qy, qz, ux, uy, uz, vx, vy, vz):
 def planar_capsule_gap(ax, ay, bx, by, ra, cx, cy, dx, dy, rc):
     """Distance between the planar capsules A-B (radius ra) and C-D (radius rc): segment distance minus radii."""
     return segment_distance(ax, ay, 0.0, bx, by, 0.0, cx, cy, 0.0, dx, dy, 0.0) - ra - rc
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def put_segment(seg, k, ax, ay, az, bx, by, bz):
+    """Row k of a (n, 6) capsule array: the segment (ax, ay, az) -> (bx, by, bz)."""
+    seg[k, 0] = ax
+    seg[k, 1] = ay
+    seg[k, 2] = az
+    seg[k, 3] = bx
+    seg[k, 4] = by
+    seg[k, 5] = bz
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def min_capsule_gap(seg, pairs, radius):
+    """Smallest segment distance minus the two radii over the index pairs (m, 2) of the capsules seg (n, 6) with
+    per-segment radii ``radius`` (n,); +inf without pairs."""
+    gap = math.inf
+    for k in range(pairs.shape[0]):
+        i = pairs[k, 0]
+        j = pairs[k, 1]
+        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
+                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
+        gap = min(gap, d - radius[i] - radius[j])
+    return gap

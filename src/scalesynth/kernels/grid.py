@@ -14,7 +14,7 @@ Each x-slab of each design accumulates into its own statistics row; the rows are
 results do not depend on thread scheduling. Grids are cell-centred: node i of an axis sits at
 ``lo + (i + 0.5) * step``. ``gather_column`` + ``accumulate_cells`` are THE accumulator: the generic kernel and
 every mechanism's fast path (seed 000) gather the reachable cells of each column of an x-slab with their weights,
-then reduce the slab once (long, vectorised loops), so both produce the same statistics.
+then reduce the slab once (one long loop), so both produce the same statistics.
 
 Statistics row layout for ``n_fields`` fields and ``n_bands`` dexterity bands (``stat_columns``)::
 
@@ -139,37 +139,86 @@ def gather_column(buf, wbuf, m, vals, k0, k1, w):
 def accumulate_cells(row, buf, wbuf, m, edges):
     """Add the first m buffered cells to a statistics row; a cell of weight 0 is unreachable and ignored.
 
-    Weighted count, per field the weighted sum and sum of squares (vectorised) and min/max, and band counts of
-    LCI (field 0): band b holds (edges[b], edges[b+1]] (band 0 also its lower edge), from the weighted counts
-    above each inner edge."""
+    Weighted count, per field the weighted sum and sum of squares and min/max, and band counts of LCI (field 0):
+    band b holds (edges[b], edges[b+1]] (band 0 also its lower edge), from the weighted counts above each inner
+    edge. The three fields every mechanism has (LCI, sigma_min, sigma_max) and the first two inner band edges go
+    through one loop: its nine sums and six extremes are independent chains that overlap, where separate passes
+    would each wait on the latency of one or two sequential sums (the sums are not reassociated, see
+    _ACC_FASTMATH, so they do not vectorise).
+    Each chain still sums the cells in index order, so the row does not depend on how the passes are grouped."""
     if m == 0:
         return
-    nf = buf.shape[0]
+    nf = buf.shape[0]  # >= N_BASE_FIELDS: every mechanism has LCI, sigma_min and sigma_max
     nb = edges.shape[0] - 1
     band0 = 1 + 4 * nf
     wv = wbuf[:m]
     lci = buf[0, :m]
-    # count and LCI's sums in one pass
+    xa = buf[1, :m]
+    xb = buf[2, :m]
+    e1 = edges[1] if nb > 1 else 2.0  # LCI <= 1: nothing is above 2
+    e2 = edges[2] if nb > 2 else 2.0
     count = 0.0
     s1 = 0.0
     s2 = 0.0
+    n1 = 0.0
+    n2 = 0.0
+    sa1 = 0.0
+    sa2 = 0.0
+    sb1 = 0.0
+    sb2 = 0.0
+    ca = 1 + N_STATS * FIELD_SIGMA_MIN  # first column of field 1 (field 0's are COL_SUM ...)
+    cb = 1 + N_STATS * FIELD_SIGMA_MAX
+    lo0, hi0 = row[COL_MIN], row[COL_MAX]
+    lo1, hi1 = row[ca + STAT_MIN], row[ca + STAT_MAX]
+    lo2, hi2 = row[cb + STAT_MIN], row[cb + STAT_MAX]
     for i in range(m):
-        count += wv[i]
-        wx = wv[i] * lci[i]
+        w = wv[i]
+        r = w > 0.0
+        v = lci[i]
+        a = xa[i]
+        b = xb[i]
+        count += w
+        wx = w * v
         s1 += wx
-        s2 += wx * lci[i]
+        s2 += wx * v
+        n1 += w if v > e1 else 0.0
+        n2 += w if v > e2 else 0.0
+        wa = w * a
+        sa1 += wa
+        sa2 += wa * a
+        wb = w * b
+        sb1 += wb
+        sb2 += wb * b
+        lo0 = v if r and v < lo0 else lo0
+        hi0 = v if r and v > hi0 else hi0
+        lo1 = a if r and a < lo1 else lo1
+        hi1 = a if r and a > hi1 else hi1
+        lo2 = b if r and b < lo2 else lo2
+        hi2 = b if r and b > hi2 else hi2
     if count == 0.0:
         return
-    row[0] += count
-    row[1] += s1
-    row[2] += s2
-    row[3], row[4] = _extremes(lci, wv, row[3], row[4])
-    # bands: weighted cells with LCI above each inner edge, two edges per pass
+    row[COL_COUNT] += count
+    row[COL_SUM] += s1
+    row[COL_SUMSQ] += s2
+    row[COL_MIN], row[COL_MAX] = lo0, hi0
+    row[ca + STAT_SUM] += sa1
+    row[ca + STAT_SUMSQ] += sa2
+    row[ca + STAT_MIN], row[ca + STAT_MAX] = lo1, hi1
+    row[cb + STAT_SUM] += sb1
+    row[cb + STAT_SUMSQ] += sb2
+    row[cb + STAT_MIN], row[cb + STAT_MAX] = lo2, hi2
+    # bands: weighted cells with LCI above each inner edge; the first two edges counted above, then two per pass
     above = count
     b = 0
+    if nb > 1:
+        row[band0] += count - n1
+        if nb > 2:
+            row[band0 + 1] += n1 - n2
+        above = n2 if nb > 2 else n1
+        b = 2
     while b < nb - 1:
         e1 = edges[b + 1]
-        e2 = edges[b + 2] if b + 2 < nb else 2.0  # LCI <= 1: nothing is above 2
+        e2 = edges[b + 2] if b + 2 < nb else 2.0
         n1 = 0.0
         n2 = 0.0
         for i in range(m):
@@ -181,39 +230,24 @@ def accumulate_cells(row, buf, wbuf, m, edges):
         above = n2 if b + 2 < nb else n1
         b += 2
     row[band0 + nb - 1] += above
-    for f in range(1, nf):
+    # a mechanism's own fields
+    for f in range(N_BASE_FIELDS, nf):
         xs = buf[f, :m]
         s1 = 0.0
         s2 = 0.0
+        lo_, hi_ = row[1 + 4 * f + 2], row[1 + 4 * f + 3]
         for i in range(m):
-            wx = wv[i] * xs[i]
+            w = wv[i]
+            x = xs[i]
+            wx = w * x
             s1 += wx
-            s2 += wx * xs[i]
+            s2 += wx * x
+            lo_ = x if w > 0.0 and x < lo_ else lo_
+            hi_ = x if w > 0.0 and x > hi_ else hi_
         c = 1 + 4 * f
         row[c] += s1
         row[c + 1] += s2
-        row[c + 2], row[c + 3] = _extremes(xs, wv, row[c + 2], row[c + 3])
-
-
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _extremes(xs, wv, vmin, vmax):
-    """(min, max) of xs over the cells of weight > 0, folded into vmin, vmax; two interleaved chains (exact in any
-    order)."""
-    lo0, lo1, hi0, hi1 = vmin, vmin, vmax, vmax
-    n = xs.shape[0]
-    for i in range(0, n - 1, 2):
-        ra = wv[i] > 0.0
-        rb = wv[i + 1] > 0.0
-        a = xs[i]
-        b = xs[i + 1]
-        lo0 = a if ra and a < lo0 else lo0
-        lo1 = b if rb and b < lo1 else lo1
-        hi0 = a if ra and a > hi0 else hi0
-        hi1 = b if rb and b > hi1 else hi1
-    if n % 2 == 1 and wv[n - 1] > 0.0:
-        lo0 = xs[n - 1] if xs[n - 1] < lo0 else lo0
-        hi0 = xs[n - 1] if xs[n - 1] > hi0 else hi0
-    return min(lo0, lo1), max(hi0, hi1)
+        row[c + 2], row[c + 3] = lo_, hi_
 
 
 @njit(cache=True)

@@ -8,6 +8,7 @@ translates the workspace.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -17,6 +18,7 @@ from numba import njit, prange
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import SIGMA_CAP, inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -48,8 +50,20 @@ LINK_RADII = {"base": 0.05, "arm1": 0.03, "arm2": 0.03, "link1": 0.02, "link2": 
 # packed-parameter layout (see PauuPpap.pack)
 _DELTA, _L1, _L2, _E, _S1, _S2 = 0, 1, 2, 3, 4, 5
 _T1LO, _T1HI, _T2LO, _T2HI, _DLO, _DHI, _ZMIN, _HAS_THETA = 6, 7, 8, 9, 10, 11, 12, 13
-N_PACKED = 14
-N_FIELDS = 3  # lci, sigma_min, sigma_max (MECHANISM.fields)
+_M = 14  # m itself (the kinematics need only m - n; the capsules need both)
+_RAD = 15  # capsule radii of the 6 bodies, in LINK_RADII order
+_FREE_ONLY = 21  # 1: poses whose capsules overlap are unreachable
+_CLEARANCE_STATS = 22  # 1: the config asks for clearance statistics (or interference_free): the generic kernel
+N_PACKED = 23
+N_FIELDS = 3  # fields of the fast path population_stats_fast: lci, sigma_min, sigma_max (MECHANISM.fields[:3])
+_F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
+N_KERNEL_FIELDS = 4  # fields of point_fields (MECHANISM.fields)
+
+# capsules of the clearance field, in link_geometry's order: one segment per body, so segment i is body i
+_BODIES = tuple(LINK_RADII)
+_ADJACENT = links.adjacency([("base", "arm1"), ("base", "arm2"), ("arm1", "link1"), ("arm2", "link2"),
+                             ("link1", "platform"), ("link2", "platform")])
+_PAIRS = links.kernel_pairs(_BODIES, _ADJACENT)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -78,9 +92,43 @@ def _angle_in(c, s, lo, hi):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def _clearance(p, x, y, z, c1, s1, c2, s2):
+    """Clearance of link_geometry's capsules at P = (x, y, z) with cos/sin of theta1, theta2: the smallest distance
+    between the axes of non-adjacent bodies minus their radii (length unit). A_i = (+-m, 0, e),
+    C_1 = (m + l1 cos theta1, 0, e - l1 sin theta1), C_2 = (-(m + l1 cos theta2), 0, e - l1 sin theta2),
+    D_i = (x +- n, y, z); segments base A2-A1, arm_i A_i-C_i, link_i C_i-D_i, platform D2-D1."""
+    m = p[_M]
+    n = m - p[_DELTA]
+    l1 = p[_L1]
+    e = p[_E]
+    seg = np.empty((6, 6))
+    put_segment(seg, 0, -m, 0.0, e, m, 0.0, e)
+    put_segment(seg, 1, m, 0.0, e, m + l1 * c1, 0.0, e - l1 * s1)
+    put_segment(seg, 2, -m, 0.0, e, -(m + l1 * c2), 0.0, e - l1 * s2)
+    put_segment(seg, 3, m + l1 * c1, 0.0, e - l1 * s1, x + n, y, z)
+    put_segment(seg, 4, -(m + l1 * c2), 0.0, e - l1 * s2, x - n, y, z)
+    put_segment(seg, 5, x - n, y, z, x + n, y, z)
+    return min_capsule_gap(seg, _PAIRS, p[_RAD : _RAD + 6])
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """Fields at P = (x, y, z) in the packed working mode (kernels.grid contract): LCI (1/kappa_2 of J), sigma_min
-    and sigma_max of J = dx/dq; LCI -1 if unreachable."""
+    and sigma_max of J = dx/dq, clearance of the link capsules (length unit); LCI -1 (and zeros) if unreachable
+    (or, with interference_free, where the capsules overlap)."""
+    _fields(p, x, y, z, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, x, y, z, out):
+    """Slots 0-2 of point_fields (LCI, sigma_min, sigma_max) without the clearance: the fast path's kernel for the
+    cells it does not vectorise (theta limits); ``out`` needs N_FIELDS slots."""
+    _fields(p, x, y, z, out, False)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, x, y, z, out, with_clearance):
+    """point_fields (with_clearance True) or kinematic_fields (False; a constant, so each copy keeps one branch)."""
     if z < p[_ZMIN] or y < p[_DLO] or y > p[_DHI]:
         _grid.write_unreachable(out)
         return
@@ -106,6 +154,10 @@ def point_fields(p, x, y, z, out):
         if not _angle_in(c1, s1, p[_T1LO], p[_T1HI]) or not _angle_in(c2, s2, p[_T2LO], p[_T2HI]):
             _grid.write_unreachable(out)
             return
+    gap = _clearance(p, x, y, z, c1, s1, c2, s2) if with_clearance else 0.0
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
     # w_i = D_i - C_i; chain 2 mirrored in x
     w1x = a1 - l1 * c1
     w1z = b + l1 * s1
@@ -113,6 +165,8 @@ def point_fields(p, x, y, z, out):
     w2z = b + l1 * s2
     if q1 == 0.0 or q2 == 0.0:
         _grid.write_singular(out)  # inverse (type-1) singularity
+        if with_clearance:
+            out[_F_CLEARANCE] = gap
         return
     # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J), sigma(J) = 1 / sigma(M)
     iq1 = 1.0 / q1
@@ -120,6 +174,8 @@ def point_fields(p, x, y, z, out):
     lci, smin, smax = sv_3x3(w1x * iq1, y * iq1, w1z * iq1, w2x * iq2, y * iq2, w2z * iq2, 0.0, 1.0, 0.0)
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    if with_clearance:
+        out[_F_CLEARANCE] = gap
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -151,7 +207,7 @@ def _column_pass1(x, y, k0, k1, lo_z, step_z, p, flag, targ, tq, tp, tc2, td2):
     """Cells k0..k1 of column (x, y), no theta limits: everything of point_fields up to the trigonometric step of
     lci_3x3, written branch-free into scratch arrays so that the compiler can vectorise the loop.
 
-    flag: 1 reachable, 2 reachable but inverse-singular (LCI 0), 0 unreachable; targ: argument of acos; tq, tp: the
+    flag: 1 reachable, 0 reachable but inverse-singular (LCI 0), -1 unreachable; targ: argument of acos; tq, tp: the
     centre and scale of the eigenvalue problem; tc2: sum of the squared 2x2 minors; td2: det^2 (see lci_3x3).
     """
     delta = p[_DELTA]
@@ -226,7 +282,7 @@ def _column_pass1(x, y, k0, k1, lo_z, step_z, p, flag, targ, tq, tp, tc2, td2):
         tp[k] = pp_
         tc2[k] = c2
         td2[k] = det * det
-        flag[k] = 0.0 if not ok else (2.0 if sing else 1.0)
+        flag[k] = -1.0 if not ok else (0.0 if sing else 1.0)
 
 @njit(cache=True, fastmath=FASTMATH)
 def _column_pass2(k0, k1, targ):
@@ -237,10 +293,15 @@ def _column_pass2(k0, k1, targ):
 @njit(cache=True, fastmath=FASTMATH)
 def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, buf, wbuf, m, w):
     """Fields of cells k0..k1 into the slab buffers from index m (as kernels.grid.gather_column: weight w if
-    reachable, else 0), as point_fields, branch-free: LCI from the largest eigenvalue and the sum/product of the
-    other two (as in sv_3x3); of J = M^-1, sigma_min = 1/sqrt(lmax) and sigma_max = 1/(LCI sqrt(lmax))
-    (= 1/sigma_min(M)), capped at SIGMA_CAP; LCI -1 if unreachable. Loops over slices from 0, so that the
-    compiler can drop index wraparound and vectorise."""
+    reachable, else 0), as point_fields: LCI from the largest eigenvalue and the sum/product of the other two (as
+    in sv_3x3); of J = M^-1, sigma_min = 1/sqrt(lmax) and sigma_max = 1/(LCI sqrt(lmax)) (= 1/sigma_min(M)),
+    capped at SIGMA_CAP; LCI -1 if unreachable.
+
+    Loops over slices from 0 (no index wraparound) and is branch-free so that the compiler vectorises it: every
+    value is computed for every cell, and the flag (1 regular, 0 singular, -1 unreachable) selects by arithmetic
+    (min, products with 0 or 1, exact), because a conditional expression becomes a branch that the vectoriser
+    gives up on. Unreachable cells may carry garbage (even NaN): the clamps put the constant first, which Python's
+    and Numba's min/max return when the other argument is NaN, so every output is finite."""
     n = k1 - k0 + 1
     fl = flag[k0 : k1 + 1]
     ta = targ[k0 : k1 + 1]
@@ -254,34 +315,38 @@ def _column_pass3(k0, k1, flag, targ, tq, tp, tc2, td2, buf, wbuf, m, w):
     out_w = wbuf[m : m + n]
     for i in range(n):
         lmax = q_[i] + 2.0 * p_[i] * ta[i]
-        il = 1.0 / max(lmax, 1e-300)
+        il = 1.0 / max(1e-300, lmax)
         prod = d2[i] * il
         s = (c2[i] - prod) * il
-        disc = max(s * s - 4.0 * prod, 0.0)
-        lmid = max(0.5 * (s + math.sqrt(disc)), 1e-300)
-        ratio = min(max(prod / lmid * il, 0.0), 1.0)
+        disc = max(0.0, s * s - 4.0 * prod)
+        lmid = max(1e-300, 0.5 * (s + math.sqrt(disc)))
+        ratio = min(1.0, max(0.0, prod / lmid * il))
         v = math.sqrt(ratio)
         v = v if (s > 0.0) & (prod > 0.0) else 0.0
-        sig_lo = min(math.sqrt(il), SIGMA_CAP)
-        sig_hi = min(sig_lo / max(v, 1e-300), SIGMA_CAP)
+        sig_lo = min(SIGMA_CAP, math.sqrt(il))
+        sig_hi = min(SIGMA_CAP, sig_lo / max(1e-300, v))
         f = fl[i]
-        out_lci[i] = v if f == 1.0 else (0.0 if f == 2.0 else -1.0)
-        out_lo[i] = sig_lo if f == 1.0 else 0.0
-        out_hi[i] = sig_hi if f == 1.0 else (SIGMA_CAP if f == 2.0 else 0.0)
-        out_w[i] = w if f > 0.0 else 0.0
+        ok = max(0.0, f)  # 1 regular, else 0
+        reach = min(1.0, f + 1.0)  # 1 reachable, else 0
+        out_lci[i] = min(v, f)
+        out_lo[i] = sig_lo * ok
+        out_hi[i] = sig_hi * ok + SIGMA_CAP * (reach - ok)
+        out_w[i] = w * reach
 
 
 @njit(cache=True, parallel=True, fastmath=FASTMATH)
 def population_stats_fast(params, lo, step, shape, edges):
-    """Same statistics as kernels.grid.population_stats(point_fields, N_FIELDS, ...), computed faster and fed to the
-    same accumulator (kernels.grid.gather_column, accumulate_cells).
+    """Same statistics as kernels.grid.population_stats(point_fields, ...) for the first N_FIELDS fields (LCI,
+    sigma_min, sigma_max; no clearance, no interference_free), computed faster and fed to the same accumulator
+    (kernels.grid.gather_column, accumulate_cells).
 
     Three savings: (1) for each (x, y) column the reachable z are the intersection of the two chains' annuli
     (spec §1.9), so only the cells of (at most two) z-intervals are visited, widened by one cell and then tested
     cell by cell, so the counted cells are the pointwise ones; (2) LCI is even in y, and in x for the
     mirror-symmetric modes (++, --) with equal theta limits, so a symmetric grid is visited over a half or a
     quarter and weighted; (3) without theta limits the cells of a column go through branch-free passes that the
-    compiler vectorises, with acos/cos alone in a scalar loop (designs with theta limits use point_fields per cell).
+    compiler vectorises, with acos/cos alone in a scalar loop (designs with theta limits use kinematic_fields per
+    cell).
     Every field is invariant under both mirror symmetries (they permute rows and flip signs of columns of J).
     """
     n_designs = params.shape[0]
@@ -360,7 +425,7 @@ def population_stats_fast(params, lo, step, shape, edges):
                     continue
                 if scalar:
                     for k in range(k0, k1 + 1):
-                        point_fields(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
+                        kinematic_fields(p, x, y, lo[d, 2] + (k + 0.5) * step[d, 2], cell)
                         for fi in range(N_FIELDS):
                             vals[fi, k] = cell[fi]
                     m = _grid.gather_column(buf, wbuf, m, vals, k0, k1, w)
@@ -371,6 +436,20 @@ def population_stats_fast(params, lo, step, shape, edges):
                     m += k1 - k0 + 1
         _grid.accumulate_cells(row, buf, wbuf, m, edges)
     return _grid.reduce_partials(partial, n_designs, nx, N_FIELDS)
+
+
+def widen_rows(stats: np.ndarray, n_from: int, n_to: int) -> np.ndarray:
+    """Statistics rows of ``n_from`` fields in the layout of ``n_to`` fields (kernels.grid): the extra fields'
+    columns empty (sum, sum of squares 0, min +inf, max -inf), the band counts moved after them."""
+    n_bands = stats.shape[1] - _grid.stat_columns(n_from, 0)
+    out = np.zeros((stats.shape[0], _grid.stat_columns(n_to, n_bands)))
+    head = _grid.band_column(n_from, 0)
+    out[:, :head] = stats[:, :head]
+    for f in range(n_from, n_to):
+        out[:, _grid.field_column(f, _grid.STAT_MIN)] = math.inf
+        out[:, _grid.field_column(f, _grid.STAT_MAX)] = -math.inf
+    out[:, _grid.band_column(n_to, 0):] = stats[:, head:]
+    return out
 
 
 def _stroke_d(design: Mapping[str, float], options: Mapping[str, Any]) -> float:
@@ -398,6 +477,16 @@ DESIGN_METRICS = (
 )
 
 
+# The clearance field (slot 3). Its statistics cost the generic grid kernel (9 segment distances per voxel, no column
+# intervals or symmetry), several times slower than population_stats_fast, so its metrics are evaluated only for
+# configs that state the link radii (the defaults are illustrative: the paper gives no cross-sections).
+CLEARANCE = dataclasses.replace(
+    links.CLEARANCE_FIELD, needs_options=("link_radius",),
+    description=links.CLEARANCE_FIELD.description + "; its metrics need options.link_radius (the default radii are "
+    "illustrative)",
+)
+
+
 class PauuPpap(Mechanism):
     """Seed-000 mechanism; see module docstring."""
 
@@ -415,6 +504,7 @@ class PauuPpap(Mechanism):
                     raise InvalidParameter(f"options.{name}: expected a finite number or null, got {value!r}")
                 options[name] = float(value)
         links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     def offset_e(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         e = options.get("e")
@@ -438,6 +528,11 @@ class PauuPpap(Mechanism):
         p[_DLO], p[_DHI] = d if d is not None else (-math.inf, math.inf)
         z_min = options.get("z_min")
         p[_ZMIN] = -math.inf if z_min is None else z_min
+        p[_M] = design["m"]
+        p[_RAD : _RAD + len(LINK_RADII)] = list(links.radii(options, LINK_RADII).values())
+        free = bool(options.get("interference_free"))
+        p[_FREE_ONLY] = 1.0 if free else 0.0
+        p[_CLEARANCE_STATS] = 1.0 if (free or options.get("link_radius") is not None) else 0.0
         return p
 
     @property
@@ -448,8 +543,13 @@ class PauuPpap(Mechanism):
         return options["mode"]
 
     def grid_stats(self, packed, lo, step, shape, edges):
-        """Column-interval and symmetry evaluator (population_stats_fast); same numbers as the generic one."""
-        return population_stats_fast(packed, lo, step, shape, edges)
+        """The column-interval and symmetry evaluator (population_stats_fast; the same numbers as the generic one)
+        when no design needs the clearance field's statistics: its rows then carry empty clearance columns
+        (sums 0, min +inf, max -inf), which no metric reads because clearance's metrics need options.link_radius
+        (see CLEARANCE). With link_radius or interference_free: the generic kernel over point_fields."""
+        if np.any(packed[:, _CLEARANCE_STATS] > 0.0):
+            return _grid.population_stats(point_fields, N_KERNEL_FIELDS, packed, lo, step, shape, edges)
+        return widen_rows(population_stats_fast(packed, lo, step, shape, edges), N_FIELDS, N_KERNEL_FIELDS)
 
     def derived_columns(self, design):
         """The model depends on m and n only through m - n (spec §1.1)."""
@@ -794,10 +894,13 @@ MECHANISM = PauuPpap(
         Option("stroke_stiffness", STROKE_STIFFNESS, "stiffness: axial stiffness of the PPaP chain's linear actuator "
                "d, N/m (2e4 N/mm, an assumption)"),
         Option("link_radius", None, "capsule radius of every body, or {body: radius}; null = defaults base 0.05, "
-               "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative)"),
+               "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative); setting it enables the "
+               "clearance metrics"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="m",
-    fields=base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is dimensionless; "
-                       "not rescaled, as in the LCI)"),
+    fields=(*base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is "
+                         "dimensionless; not rescaled, as in the LCI)"), CLEARANCE),
     design_metrics=DESIGN_METRICS,
 )
+assert MECHANISM.n_fields == N_KERNEL_FIELDS and MECHANISM.field_names[_F_CLEARANCE] == "clearance"

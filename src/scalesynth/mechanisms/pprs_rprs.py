@@ -33,6 +33,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import put_segment as _put_seg
 from scalesynth.kernels.clearance import segment_distance
 from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
@@ -154,16 +155,6 @@ def _sv_6x6(a):
 def _lci_6x6(a):
     """sigma_min / sigma_max of the 6x6 matrix ``a`` (overwritten); see _sv_6x6."""
     return _sv_6x6(a)[0]
-
-
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _put_seg(seg, k, ax, ay, az, bx, by, bz):
-    seg[k, 0] = ax
-    seg[k, 1] = ay
-    seg[k, 2] = az
-    seg[k, 3] = bx
-    seg[k, 4] = by
-    seg[k, 5] = bz
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")

@@ -38,7 +38,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
-from scalesynth.kernels.clearance import segment_distance
+from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -194,36 +194,21 @@ def _clearance(p, y0, z, st, ct, sp, cp, sf, cf, pairs, tx, ty, tz, r_tool):
     b2x, b2y, b2z = h * vx, y0 + h * vy, z + h * vz
     b3x, b3y, b3z = c * ux, y0 + c * uy, z + c * uz
     seg = np.empty((10, 6))
-    _put_seg(seg, 0, 0.0, -g, 0.0, 0.0, g, 0.0)
-    _put_seg(seg, 1, 0.0, g, 0.0, e, 0.0, 0.0)
-    _put_seg(seg, 2, e, 0.0, 0.0, 0.0, -g, 0.0)
-    _put_seg(seg, 3, 0.0, -g, 0.0, b1x, b1y, b1z)
-    _put_seg(seg, 4, 0.0, g, 0.0, b2x, b2y, b2z)
-    _put_seg(seg, 5, e, 0.0, 0.0, b3x, b3y, b3z)
-    _put_seg(seg, 6, b1x, b1y, b1z, b2x, b2y, b2z)
-    _put_seg(seg, 7, b2x, b2y, b2z, b3x, b3y, b3z)
-    _put_seg(seg, 8, b3x, b3y, b3z, b1x, b1y, b1z)
-    _put_seg(seg, 9, 0.0, y0, z, tx, ty, tz)
-    gap = math.inf
-    for k in range(pairs.shape[0]):
-        i = pairs[k, 0]
-        j = pairs[k, 1]
-        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
-                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
-        ri = r_tool if i == 9 else p[_RAD + _SEGMENT_BODY[i]]
-        rj = r_tool if j == 9 else p[_RAD + _SEGMENT_BODY[j]]
-        gap = min(gap, d - ri - rj)
-    return gap
-
-
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _put_seg(seg, k, ax, ay, az, bx, by, bz):
-    seg[k, 0] = ax
-    seg[k, 1] = ay
-    seg[k, 2] = az
-    seg[k, 3] = bx
-    seg[k, 4] = by
-    seg[k, 5] = bz
+    put_segment(seg, 0, 0.0, -g, 0.0, 0.0, g, 0.0)
+    put_segment(seg, 1, 0.0, g, 0.0, e, 0.0, 0.0)
+    put_segment(seg, 2, e, 0.0, 0.0, 0.0, -g, 0.0)
+    put_segment(seg, 3, 0.0, -g, 0.0, b1x, b1y, b1z)
+    put_segment(seg, 4, 0.0, g, 0.0, b2x, b2y, b2z)
+    put_segment(seg, 5, e, 0.0, 0.0, b3x, b3y, b3z)
+    put_segment(seg, 6, b1x, b1y, b1z, b2x, b2y, b2z)
+    put_segment(seg, 7, b2x, b2y, b2z, b3x, b3y, b3z)
+    put_segment(seg, 8, b3x, b3y, b3z, b1x, b1y, b1z)
+    put_segment(seg, 9, 0.0, y0, z, tx, ty, tz)
+    radius = np.empty(10)
+    for i in range(9):
+        radius[i] = p[_RAD + _SEGMENT_BODY[i]]
+    radius[9] = r_tool
+    return min_capsule_gap(seg, pairs, radius)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")

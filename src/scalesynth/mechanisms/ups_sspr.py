@@ -29,7 +29,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
-from scalesynth.kernels.clearance import segment_distance
+from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -188,16 +188,6 @@ def point_fields(p, alpha, beta, yy, out):
         out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _put_seg(seg, k, ax, ay, az, bx, by, bz):
-    seg[k, 0] = ax
-    seg[k, 1] = ay
-    seg[k, 2] = az
-    seg[k, 3] = bx
-    seg[k, 4] = by
-    seg[k, 5] = bz
-
-
 @njit(cache=True, fastmath=FASTMATH)
 def _clearance(p, sa, ca, sb, cb, px, py, pz):
     """Smallest gap (mm) between the capsules of link_geometry that share no joint at the pose with P = B1 =
@@ -214,25 +204,21 @@ def _clearance(p, sa, ca, sb, cb, px, py, pz):
     b3y = b2y
     b3z = pz - sb * bx + cb * sa * by
     seg = np.empty((11, 6))
-    _put_seg(seg, 0, 0.0, 2.0 * am, 0.0, -ax, -am, 0.0)
-    _put_seg(seg, 1, -ax, -am, 0.0, ax, -am, 0.0)
-    _put_seg(seg, 2, ax, -am, 0.0, 0.0, 2.0 * am, 0.0)
-    _put_seg(seg, 3, 0.0, 0.0, 0.0, 0.0, -am, 0.0)
-    _put_seg(seg, 4, 0.0, -am, 0.0, K0 * px, K0 * py, K0 * pz)
-    _put_seg(seg, 5, -ax, -am, 0.0, b2x, b2y, b2z)
-    _put_seg(seg, 6, ax, -am, 0.0, b3x, b3y, b3z)
-    _put_seg(seg, 7, 0.0, 0.0, 0.0, px, py, pz)
-    _put_seg(seg, 8, px, py, pz, b2x, b2y, b2z)
-    _put_seg(seg, 9, b2x, b2y, b2z, b3x, b3y, b3z)
-    _put_seg(seg, 10, b3x, b3y, b3z, px, py, pz)
-    gap = math.inf
-    for k in range(_PAIRS.shape[0]):
-        i = _PAIRS[k, 0]
-        j = _PAIRS[k, 1]
-        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
-                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
-        gap = min(gap, d - p[_RAD + _SEGMENT_BODY[i]] - p[_RAD + _SEGMENT_BODY[j]])
-    return gap
+    put_segment(seg, 0, 0.0, 2.0 * am, 0.0, -ax, -am, 0.0)
+    put_segment(seg, 1, -ax, -am, 0.0, ax, -am, 0.0)
+    put_segment(seg, 2, ax, -am, 0.0, 0.0, 2.0 * am, 0.0)
+    put_segment(seg, 3, 0.0, 0.0, 0.0, 0.0, -am, 0.0)
+    put_segment(seg, 4, 0.0, -am, 0.0, K0 * px, K0 * py, K0 * pz)
+    put_segment(seg, 5, -ax, -am, 0.0, b2x, b2y, b2z)
+    put_segment(seg, 6, ax, -am, 0.0, b3x, b3y, b3z)
+    put_segment(seg, 7, 0.0, 0.0, 0.0, px, py, pz)
+    put_segment(seg, 8, px, py, pz, b2x, b2y, b2z)
+    put_segment(seg, 9, b2x, b2y, b2z, b3x, b3y, b3z)
+    put_segment(seg, 10, b3x, b3y, b3z, px, py, pz)
+    radius = np.empty(11)
+    for i in range(11):
+        radius[i] = p[_RAD + _SEGMENT_BODY[i]]
+    return min_capsule_gap(seg, _PAIRS, radius)
 
 
 @njit(cache=True, fastmath=FASTMATH)
