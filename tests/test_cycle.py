@@ -25,7 +25,11 @@ FIVEBAR = load_config(ROOT / "configs" / "fivebar_packing.yaml")
 PPRS = load_config(ROOT / "configs" / "pprs_rprs.yaml")
 SEED000 = load_config(ROOT / "configs" / "paper_2pauu_ppap.yaml")
 TOOL = load_config(ROOT / "configs" / "rps_upu_tool.yaml")
-CASES = {"planar-fivebar": FIVEBAR, "pprs-rprs": PPRS, "2pauu-ppap": SEED000, "rps-upu-tool": TOOL}
+RPS = load_config(ROOT / "configs" / "rps_upu.yaml")  # task axes (z, theta, psi): mm and rad
+UPS = load_config(ROOT / "configs" / "ups_sspr.yaml")  # task axes (alpha, beta, Y): rad and mm
+CASES = {"planar-fivebar": FIVEBAR, "pprs-rprs": PPRS, "2pauu-ppap": SEED000, "rps-upu-tool": TOOL, "rps-upu": RPS,
+         "ups-sspr": UPS}
+CYCLE_CONFIGS = sorted(p.name for p in (ROOT / "configs").glob("*.yaml") if "cycle" in yaml.safe_load(p.read_text()))
 
 
 def run(cfg, **changes):
@@ -109,16 +113,26 @@ def test_rates_match_finite_differences_of_ik_positions(name, law):
 
 @pytest.mark.parametrize("name", CASES)
 def test_power_balance_at_every_sample(name):
+    """sum force_i qd_i (W) = m (a - g) . v of the payload point at every sample; in mixed units (rps-upu, ups-sspr)
+    also = F . x_dot with F in N along length axes and N m about angle axes, x_dot in m/s and rad/s."""
     cfg = CASES[name]
-    res = run(cfg, payload=2.5, gravity=[1.0, -3.0, -9.0][-len(cfg.mech.task_axes):])
+    cartesian = all(u == "length" for u in cfg.mech.task_units)
+    gravity = [1.0, -3.0, -9.0][-len(cfg.mech.task_axes):] if cartesian else [1.0, -3.0, -9.0]
+    res = run(cfg, payload=2.5, gravity=gravity)
     m = METRES_PER_UNIT[cfg.units.length]
     joint_si = np.array([m if u == "length" else 1.0 for u in cfg.mech.joint_units])
+    task_si = np.array([m if u == "length" else 1.0 for u in cfg.mech.task_units])
     actuator_power = np.sum(res.force * res.qd * joint_si, axis=1)
-    task_power = np.sum(res.task_force * res.traj.pd * m, axis=1)
-    assert np.abs(task_power).max() > 0.1  # W: the check is not 0 = 0
-    np.testing.assert_allclose(actuator_power, task_power, rtol=0, atol=1e-9 * np.abs(task_power).max())
-    # F = m (a - g) exactly
-    np.testing.assert_allclose(res.task_force, 2.5 * (res.traj.pdd * m - res.gravity), rtol=1e-12)
+    payload_power = np.sum(2.5 * (res.payload_accel * m - res.gravity) * res.payload_velocity * m, axis=1)
+    task_power = np.sum(res.task_force * res.traj.pd * task_si, axis=1)
+    assert np.abs(payload_power).max() > 0.1  # W: the check is not 0 = 0
+    np.testing.assert_allclose(actuator_power, payload_power, rtol=0, atol=1e-9 * np.abs(payload_power).max())
+    np.testing.assert_allclose(task_power, payload_power, rtol=0, atol=1e-9 * np.abs(payload_power).max())
+    if cartesian:  # F = m (a - g) exactly
+        np.testing.assert_allclose(res.task_force, 2.5 * (res.traj.pdd * m - res.gravity), rtol=1e-12)
+    # the gravity part of the forces: what the actuators exert holding the payload still at the same poses
+    still = run(cfg, payload=2.5, gravity=gravity, cycles_per_minute=1e-6 * cfg.cycle.cycles_per_minute)
+    np.testing.assert_allclose(res.force_gravity, still.force, rtol=0, atol=1e-6 * np.abs(res.force).max())
 
 
 @pytest.mark.parametrize("name", CASES)
@@ -131,7 +145,9 @@ def test_doubling_the_rate_doubles_speeds_and_quadruples_accelerations(name):
     np.testing.assert_allclose(fast.qd, 2 * slow.qd, rtol=1e-9, atol=1e-9 * np.abs(slow.qd).max())
     np.testing.assert_allclose(fast.qdd, 4 * slow.qdd, rtol=1e-6, atol=1e-6 * np.abs(slow.qdd).max())
     # inertial forces quadruple, gravity's part stays: tau(2x) - tau_g = 4 (tau(1x) - tau_g)
-    tau_g = np.einsum("nik,k->ni", slow.force_map, -slow.payload * slow.gravity)
+    tau_g = slow.force_gravity
+    if all(u == "length" for u in cfg.mech.task_units):
+        np.testing.assert_allclose(tau_g, np.einsum("nik,k->ni", slow.force_map, -slow.payload * slow.gravity))
     np.testing.assert_allclose(fast.force - tau_g, 4 * (slow.force - tau_g), rtol=1e-6,
                                atol=1e-6 * np.abs(slow.force).max())
 
@@ -263,7 +279,7 @@ def test_cycle_command_writes_csv_json_and_plots(tmp_path):
     info = json.loads(res.stdout)
     header = (tmp_path / "cycle.csv").read_text().splitlines()[0].split(",")
     assert header == ["t", "p_x", "pd_x", "pdd_x", "p_y", "pd_y", "pdd_y", "q1", "qd1", "qdd1", "force1",
-                      "q2", "qd2", "qdd2", "force2", "lci", "clearance"]
+                      "q2", "qd2", "qdd2", "force2", "lci", "clearance", "deflection"]  # the five-bar has stiffness
     units = json.loads((tmp_path / "cycle.json").read_text())["units"]
     assert units["pdd_x"] == "mm/s^2" and units["qd1"] == "rad/s" and units["force2"] == "N m"
     assert info["metrics"]["cycle_feasible"] == 1.0
@@ -297,7 +313,13 @@ def _write(tmp_path, cfg, **cycle):
     ("fivebar_packing.yaml", {"law": "cubic"}, "error: cycle.law: unknown motion law 'cubic'"),
     ("fivebar_packing.yaml", {"payload": -2.0}, "error: cycle.payload: must be a finite number > 0"),
     ("fivebar_packing.yaml", {"direction": [1.0, 1.0]}, "error: cycle.direction: must be perpendicular to gravity"),
-    ("rps_upu.yaml", {"preset": "adept", "start": [40, 0, 0], "cycles_per_minute": 30},
+    ("fivebar_packing.yaml", {"preset": None, "start": None, "direction": None, "path": [[0, -700], [1e13, -700]]},
+     "error: cycle.path.1: 1e+13 is beyond +-1e+12"),
+    ("fivebar_packing.yaml", {"preset": None, "start": None, "direction": None, "path": [[0, -700], [0, -700]]},
+     "error: cycle.path: all points coincide"),
+    ("fivebar_packing.yaml", {"payload": 2e12}, "error: cycle.payload: 2e+12 is beyond +-1e+12"),
+    ("fivebar_packing.yaml", {"gravity": [0.0, -1e13]}, "error: cycle.gravity.1: -1e+13 is beyond +-1e+12"),
+    ("rps_upu.yaml", {"path": None, "preset": "adept", "start": [40, 0, 0], "cycles_per_minute": 30},
      "error: cycle.preset: adept needs two Cartesian task axes; rps-upu has z, theta, psi"),
 ])
 def test_bad_cycle_input_one_line_exit_2_nothing_written(tmp_path, cfg, change, message):
@@ -322,9 +344,13 @@ def test_numba_segment_distance_matches_the_numpy_version():
         assert jit_distance(*p1, *q1, *p2, *q2) == pytest.approx(float(segment_distance(p1, q1, p2, q2)), abs=1e-12)
 
 
-@pytest.mark.parametrize("name, radius", [("planar-fivebar", None), ("planar-fivebar", 150.0),  # field kernels
-                                          ("pprs-rprs", None), ("pprs-rprs", 30.0)])
-def test_clearance_field_matches_numpy_link_geometry(name, radius):
+@pytest.mark.parametrize("name, radius, extra", [
+    ("planar-fivebar", None, {}), ("planar-fivebar", 150.0, {}), ("pprs-rprs", None, {}), ("pprs-rprs", 30.0, {}),
+    ("rps-upu", None, {}), ("rps-upu", 25.0, {}), ("rps-upu", 25.0, {"model": "C"}),
+    ("rps-upu", 25.0, {"model": "C", "c3_variant": "upu"}), ("rps-upu-tool", None, {}), ("rps-upu-tool", 20.0, {}),
+    ("ups-sspr", None, {}), ("ups-sspr", 30.0, {}),
+])
+def test_clearance_field_matches_numpy_link_geometry(name, radius, extra):
     """The field kernel's clearance at every reachable node of a grid against cycle.clearance of the mechanism's
     link_geometry (NumPy, the cycle's code path), and interference_free = reachable and clearance >= 0."""
     from scalesynth.evaluate import make_grid
@@ -333,7 +359,7 @@ def test_clearance_field_matches_numpy_link_geometry(name, radius):
     cfg = CASES[name]
     mech = cfg.mech
     design = cfg.resolved_design()
-    options = mech.resolve_options({**cfg.options, "link_radius": radius})
+    options = mech.resolve_options({**cfg.options, "link_radius": radius, **extra})
     g = make_grid(mech, design, options, 31 if mech.planar else 9)
     slot = mech.field_names.index("clearance")
     fields = kgrid.sample_fields(mech.field_kernel, mech.n_fields, mech.pack(design, options), g.lo, g.step, g.shape)
@@ -394,26 +420,80 @@ def test_bad_link_options_are_one_line_errors(tmp_path):
         assert not (tmp_path / "out").exists()
 
 
-def test_cycle_on_a_mechanism_with_angular_task_axes_is_refused(tmp_path):
-    """rps-upu's task axes are (z, theta, psi): m (a - g) has no meaning there; one line, exit 2."""
-    path = _write(tmp_path, "rps_upu.yaml", path=[[40, 0, 0], [50, 0, 0]], cycles_per_minute=30)
-    res = CliRunner().invoke(app, ["cycle", str(path), "--out", str(tmp_path / "out")])
-    assert res.exit_code == 2
-    assert res.stderr.startswith("error: cycle: ") and len(res.stderr.strip().splitlines()) == 1
+def _payload_fd(cfg, res, point):
+    """Velocity and acceleration of the payload point (callable pose -> 3-D point) by central differences in time
+    along the motion law (independent of the analysis' Jacobian), at the samples inside the segments."""
+    traj = res.traj
+    seg = np.diff(traj.vertices, axis=0)
+    durations = np.diff(traj.vertex_times)
+    law = traj.law[0]
+    out = []
+    for s in range(0, len(traj.t) - 1, 5):
+        k = traj.segment[s]
+        tau = (traj.t[s] - traj.vertex_times[k]) / durations[k]
+        if not 0.02 < tau < 0.98:
+            continue
+        h = 1e-4
+        c_m, c_0, c_p = (point(traj.vertices[k] + trajectory.law_profile(law, tau + j * h)[0] * seg[k])
+                         for j in (-1, 0, 1))
+        dt = h * durations[k]
+        out.append((s, (c_p - c_m) / (2 * dt), (c_p - 2 * c_0 + c_m) / dt**2))
+    assert len(out) >= 10
+    return out
 
 
-@pytest.mark.parametrize("config", ["paper_2pauu_ppap.yaml", "rps_upu_tool.yaml", "pprs_rprs.yaml"])
+def test_rps_upu_cycle_in_mixed_task_axes(tmp_path):
+    """rps-upu's task axes are (z, theta, psi); the payload sits at O' = (0, 0, z) in the P-model, so the generalised
+    force is exactly (m (z_ddot - g_z), 0, 0): N along z, no torque about the angles (a point mass on the rotation
+    axes). The command writes its cycle with mm and rad columns."""
+    res = run(RPS, samples=100)
+    m = 1e-3
+    np.testing.assert_allclose(res.task_force[:, 0], RPS.cycle.payload * (res.traj.pdd[:, 0] * m + 9.80665),
+                               rtol=1e-9)
+    np.testing.assert_allclose(res.task_force[:, 1:], 0.0, atol=1e-12)
+    np.testing.assert_allclose(res.payload_velocity, np.column_stack([0 * res.traj.t, 0 * res.traj.t,
+                                                                      res.traj.pd[:, 0]]), atol=1e-9)
+    out = tmp_path / "out"
+    cli = CliRunner().invoke(app, ["cycle", str(ROOT / "configs" / "rps_upu.yaml"), "--set", "cycle.samples=60",
+                                   "--out", str(out), "--json"])
+    assert cli.exit_code == 0, cli.output
+    units = json.loads((out / "cycle.json").read_text())["units"]
+    assert (units["p_z"], units["pd_theta"], units["pdd_psi"], units["force1"]) == ("mm", "rad/s", "rad/s^2", "N")
+
+
+def test_ups_sspr_payload_motion_against_finite_differences():
+    """ups-sspr carries its payload at B1 = (sin(beta) rho, Y, cos(beta) rho), rho = sqrt(c^2 - Y^2) (spec §3.1,
+    written out here independently of the mechanism): the analysis' payload velocity and acceleration equal
+    central differences in time of that point along the cycle."""
+    c = UPS.resolved_design()["c"]
+
+    def b1(x):
+        rho = math.sqrt(c * c - x[2] ** 2)
+        return np.array([math.sin(x[1]) * rho, x[2], math.cos(x[1]) * rho])
+
+    res = run(UPS, samples=120)
+    for s, v, a in _payload_fd(UPS, res, b1):
+        np.testing.assert_allclose(res.payload_velocity[s], v, rtol=0, atol=1e-6 * np.abs(res.payload_velocity).max())
+        np.testing.assert_allclose(res.payload_accel[s], a, rtol=0, atol=2e-4 * np.abs(res.payload_accel).max())
+
+
+@pytest.mark.parametrize("config", CYCLE_CONFIGS)
 def test_cycle_runs_on_the_configs_with_a_cycle(tmp_path, config):
-    """`scalesynth cycle` on each shipped config with a cycle (fewer samples for speed): feasible, clearance >= 0,
-    and the power balance of its CSV columns."""
+    """`scalesynth cycle` on each shipped config with a cycle (fewer samples for speed): exit 0, feasible, clearance
+    >= 0, and the power balance of its CSV columns (force_i qd_i against m (a - g) . v of the payload)."""
+    out = tmp_path / "out"
+    cli = CliRunner().invoke(app, ["cycle", str(ROOT / "configs" / config), "--set", "cycle.samples=60",
+                                   "--out", str(out), "--json"])
+    assert cli.exit_code == 0, cli.output
     cfg = load_config(ROOT / "configs" / config, ["cycle.samples=60"])
     res = run(cfg, samples=60)
     m = analysis.result_metrics(res, cfg.cycle)
     assert m["cycle_feasible"] == 1.0 and m["cycle_min_clearance"] >= 0, m
+    assert json.loads(cli.stdout)["metrics"] == pytest.approx(m, rel=1e-12)
     lu = METRES_PER_UNIT[cfg.units.length]
     joint_si = np.array([lu if u == "length" else 1.0 for u in cfg.mech.joint_units])
-    np.testing.assert_allclose(np.sum(res.force * res.qd * joint_si, axis=1),
-                               np.sum(res.task_force * res.traj.pd * lu, axis=1), atol=1e-9)
+    payload = cfg.cycle.payload * (res.payload_accel * lu - res.gravity) * res.payload_velocity * lu
+    np.testing.assert_allclose(np.sum(res.force * res.qd * joint_si, axis=1), payload.sum(axis=1), atol=1e-9)
 
 
 def test_pprs_rail_input_follows_x_exactly():
@@ -424,3 +504,106 @@ def test_pprs_rail_input_follows_x_exactly():
     np.testing.assert_allclose(res.qd[:, 0], res.traj.pd[:, 0], atol=1e-9)
     np.testing.assert_allclose(res.qdd[:, 0], res.traj.pdd[:, 0], atol=1e-6 * np.abs(res.traj.pdd).max())
     assert np.abs(res.qd[:, 0]).max() == pytest.approx(150.0, rel=1e-4)
+
+
+# ----- deflection along the cycle -----------------------------------------------------------------------------
+STIFF = load_config(ROOT / "configs" / "fivebar_stiffness.yaml")
+
+
+@pytest.mark.parametrize("cfg, samples", [(STIFF, (0, 13, 31, 47)), (UPS, (5, 29)), (PPRS, (3, 40))])
+def test_deflection_along_the_cycle_equals_the_pose_level_stiffness_command(cfg, samples):
+    """At sample poses, the cycle's deflection column equals `scalesynth stiffness MECH --pose P --load F` (the
+    frame model solved by the NumPy reference, ideal joints) with F = m (g - a) the force the payload exerts on the
+    platform at that sample (N; its weight at rest)."""
+    res = run(cfg, samples=60)
+    assert res.deflection is not None and np.all(res.deflection > 0)
+    m = METRES_PER_UNIT[cfg.units.length]
+    design = cfg.resolved_design()
+    sets = [f"{k}={v}" for k, v in design.items()]
+    for s in samples:
+        load = cfg.cycle.payload * (res.gravity - res.payload_accel[s] * m)
+        cli = CliRunner().invoke(app, ["stiffness", cfg.mech.name, "--pose", ",".join(f"{v:.17g}" for v in
+                                 res.traj.p[s]), "--load", ",".join(f"{v:.17g}" for v in load), "--json",
+                                 *[a for kv in sets for a in ("--set", kv)],
+                                 *[a for k, v in cfg.options.items() for a in ("--set", f"{k}={json.dumps(v)}")]])
+        assert cli.exit_code == 0, cli.output
+        ref = json.loads(cli.stdout)["deflection_norm"]
+        assert res.deflection[s] == pytest.approx(ref, rel=1e-7), s
+    assert analysis.result_metrics(res, cfg.cycle)["cycle_max_deflection"] == pytest.approx(res.deflection.max())
+
+
+def test_mechanisms_without_a_stiffness_model_report_no_deflection():
+    """rps-upu has a pose-level stiffness model but no per-voxel deflection field yet: no deflection column."""
+    res = run(RPS)
+    assert res.deflection is None and "deflection" not in res.columns()
+    assert "cycle_max_deflection" not in analysis.result_metrics(res, RPS.cycle)
+
+
+def test_seed001_square_stays_in_one_assembly_mode_and_a_larger_square_is_refused():
+    """Seed 001's square (the old drive_curves checks, now on the cycle): Newton FK of each sample's actuators from
+    the previous sample's pose lands back on the sample (one assembly mode along the whole loop); the 40 mm square
+    centred at (-30, -30) leaves the workspace at z = 200 mm, a one-line CycleError naming the sample."""
+    from scalesynth.mechanisms.pprs_rprs import Geometry, newton_fk, sigma_vector
+
+    res = run(PPRS, law="constant", period=1.0, cycles_per_minute=None, samples=100)
+    design, options = PPRS.resolved_design(), PPRS.resolved_options()
+    geo = Geometry.of(design, options)
+    poses = np.column_stack([res.traj.p, np.tile(options["orientation"], (len(res.traj.t), 1))])
+    fk, conv = newton_fk(geo, sigma_vector(options["sigma"]), res.q[1:], poses[:-1])
+    assert conv.all()
+    np.testing.assert_allclose(fk, poses[1:], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(res.q[-1], res.q[0], atol=1e-12)  # back at E: back to the start values
+    big = [[-50, -50, 200], [-10, -50, 200], [-10, -10, 200], [-50, -10, 200]]
+    with pytest.raises(analysis.CycleError, match=r"^cycle\.path\[\d\]: .* is outside the workspace"):
+        run(PPRS, path=big)
+
+
+# ----- fast path: vectorised kinematics and kernel clearance against the per-pose reference ---------------------
+@pytest.mark.parametrize("name", CASES)
+def test_fast_cycle_analysis_equals_the_reference_analysis(name):
+    """analyse() (Mechanism.cycle_kinematics, vectorised where a mechanism overrides it; clearance from the field
+    kernel where it has one) against analyse(reference=True) (inverse_kinematics, velocity_map and link_geometry
+    per pose): every column and metric equal to rounding."""
+    cfg = CASES[name]
+    fast, ref = run(cfg, samples=80), None
+    cyc = cfg.cycle.model_copy(update={"samples": 80})
+    ref = analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cyc, cfg.units.length,
+                           reference=True)
+    for key, col in ref.columns().items():
+        scale = max(np.abs(col).max(), 1e-300)
+        np.testing.assert_allclose(fast.columns()[key], col, rtol=0, atol=1e-9 * scale, err_msg=key)
+    assert fast.min_clearance_pair == ref.min_clearance_pair
+    assert analysis.result_metrics(fast, cyc) == pytest.approx(analysis.result_metrics(ref, cyc), rel=1e-9)
+
+
+@pytest.mark.parametrize("name", [n for n in CASES if type(CASES[n].mech).cycle_kinematics
+                                  is not analysis.Mechanism.cycle_kinematics])
+def test_vectorised_cycle_kinematics_equal_the_per_pose_loop(name):
+    """Each override of cycle_kinematics against the base class's loop at the cycle's samples and at a pose far
+    beyond the workspace (NaN rows wherever the loop finds no branch, in both)."""
+    cfg = CASES[name]
+    mech, design, options = cfg.mech, cfg.resolved_design(), cfg.resolved_options()
+    res = run(cfg, samples=40)
+    lo, hi = mech.bounding_box(design, options)
+    k = len(mech.task_axes)
+    far = np.array(hi[:k]) + 3.0 * (np.array(hi[:k]) - np.array(lo[:k])) + 1.0
+    poses = np.vstack([res.traj.p, far[None, :]])
+    label = mech.kernel_branch(options)
+    q, a = mech.cycle_kinematics(design, options, poses, label)
+    q_ref, a_ref = analysis.Mechanism.cycle_kinematics(mech, design, options, poses, label)
+    assert np.array_equal(np.isnan(q), np.isnan(q_ref)) and not np.isnan(q[:-1]).any()
+    live = ~np.isnan(q_ref).any(axis=1)
+    ang = np.array([u == "angle" for u in mech.joint_units])
+    dq = q[live] - q_ref[live]
+    dq[:, ang] = wrap_angle(dq[:, ang])
+    np.testing.assert_allclose(dq, 0.0, atol=1e-9)
+    np.testing.assert_allclose(a[live], a_ref[live], rtol=1e-9, atol=1e-12 * np.abs(a_ref[live]).max())
+
+
+@pytest.mark.parametrize("name", ["rps-upu", "ups-sspr", "rps-upu-tool"])
+def test_vectorised_payload_points_equal_payload_point(name):
+    cfg = CASES[name]
+    mech, design, options = cfg.mech, cfg.resolved_design(), cfg.resolved_options()
+    poses = run(cfg, samples=30).traj.p
+    np.testing.assert_allclose(mech.payload_points(design, options, poses),
+                               [mech.payload_point(design, options, p) for p in poses], rtol=0, atol=1e-12)

@@ -21,7 +21,6 @@ from scalesynth.mechanisms.pprs_rprs import (
     Geometry,
     _lci_6x6,
     chain_state,
-    drive_curves,
     newton_fk,
     normalise_euler,
     sigma_vector,
@@ -482,36 +481,6 @@ def test_pose_jacobian_matches_central_differences(pose, branch):
 
 
 # ----- drive curves (paper §5) -----------------------------------------------------------------------------
-SQUARE = [(-50.0, -35.0, 200.0), (-30.0, -35.0, 200.0), (-30.0, -15.0, 200.0), (-50.0, -15.0, 200.0)]
-
-
-def test_drive_curves_closed_square():
-    curves = drive_curves(D, OPT, SQUARE, 101)
-    assert curves.q.shape == (101, 6) and curves.points.shape == (101, 3)
-    np.testing.assert_allclose(curves.points[0], SQUARE[0])
-    np.testing.assert_allclose(curves.q[-1], curves.q[0], atol=1e-12)  # back at E, back to the start values
-    np.testing.assert_allclose(curves.t[[0, 25, 50, 100]], (0.0, 0.25, 0.5, 1.0))
-    np.testing.assert_allclose(curves.points[25], SQUARE[1], atol=1e-12)  # F after a quarter of the loop
-    lims = M.joint_limits(OPT)
-    assert np.all((curves.q >= lims[:, 0]) & (curves.q <= lims[:, 1]))
-    # E -> F moves along x only: w1 = x + r rises by the side length, s1 (depends on y, z only) stays
-    np.testing.assert_allclose(curves.q[25, 0] - curves.q[0, 0], 20.0, atol=1e-12)
-    np.testing.assert_allclose(curves.q[:26, 3], curves.q[0, 3], atol=1e-12)
-    assert curves.fk_error <= 1e-9
-    assert np.all(curves.lci > 0)
-    for k in (0, 37, 80):
-        np.testing.assert_allclose(curves.q[k], q_of(curves.points[k]), atol=1e-12)
-
-
-def test_drive_curves_reject_a_path_leaving_the_workspace():
-    # the brief's first guess, a 40 mm square centred at (-30, -30), leaves the workspace at z = 200 mm
-    square = [(-50.0, -50.0, 200.0), (-10.0, -50.0, 200.0), (-10.0, -10.0, 200.0), (-50.0, -10.0, 200.0)]
-    with pytest.raises(InvalidPose, match=r"^path: sample \d+ .* outside the limits"):
-        drive_curves(D, OPT, square, 200)
-    with pytest.raises(InvalidPose, match="^path_points"):
-        drive_curves(D, OPT, [(0.0, 0.0)], 10)
-    with pytest.raises(InvalidPose, match="^samples"):
-        drive_curves(D, OPT, SQUARE, 1)
 
 
 def test_drives_command(tmp_path):

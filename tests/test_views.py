@@ -275,7 +275,8 @@ def test_show_colours_by_any_field_of_the_kernel(tmp_path):
 
 def test_show_draws_the_robot_from_its_link_geometry(tmp_path):
     """Five-bar at a chosen pose: the drawn arms and forearms have the design's lengths and meet at the pose; the
-    pose must be reachable; ups-sspr (no link geometry yet) says so and still shows its workspace."""
+    pose must be reachable. ups-sspr: its SR link is c long, the platform legs b, and the drawn actuators have the
+    IK's lengths (l1 from M to B0 = (2/3) B1 on the link)."""
     cfg = load_config(ROOT / "configs" / "fivebar_packing.yaml")
     d = cfg.resolved_design()
     res = runner.invoke(app, ["show", str(ROOT / "configs" / "fivebar_packing.yaml"), "--resolution", "16",
@@ -293,9 +294,22 @@ def test_show_draws_the_robot_from_its_link_geometry(tmp_path):
     assert res.exit_code == 0 and json.loads(res.stdout)["robot"]["missing"] == "the pose is out of reach"
     res = runner.invoke(app, ["show", str(ROOT / "configs" / "fivebar_packing.yaml"), "--pose=1,2,3"])
     assert res.exit_code == 2 and "--pose: expected 2 finite numbers (x, y)" in res.stderr
+    ups = load_config(ROOT / "configs" / "ups_sspr.yaml")
+    d = ups.resolved_design()
     res = runner.invoke(app, ["show", str(ROOT / "configs" / "ups_sspr.yaml"), "--resolution", "8",
-                              "--out", str(tmp_path / "u")])
-    assert res.exit_code == 0 and "robot not drawn: mechanism: ups-sspr has no link geometry" in res.stdout
+                              "--pose=0.2,-0.1,10", "--out", str(tmp_path / "u"), "--json"])
+    assert res.exit_code == 0, res.output
+    robot = json.loads(res.stdout)["robot"]
+    seg = {s["name"]: (np.array(s["a"]), np.array(s["b"])) for s in robot["segments"]}
+    (ik,) = ups.mech.inverse_kinematics(d, ups.resolved_options(), (0.2, -0.1, 10.0))
+    for i, name in enumerate(("leg1", "leg2", "leg3")):
+        assert np.linalg.norm(seg[name][1] - seg[name][0]) == pytest.approx(ik.values[i], rel=1e-12)
+    assert np.linalg.norm(seg["link"][1] - seg["link"][0]) == pytest.approx(d["c"], rel=1e-12)
+    np.testing.assert_allclose(seg["leg1"][1], 2 / 3 * seg["link"][1], atol=1e-12)
+    np.testing.assert_allclose(seg["link"][1][1], 10.0)  # B1's y is the task coordinate Y
+    for side in ("platform12", "platform31"):
+        assert np.linalg.norm(seg[side][1] - seg[side][0]) == pytest.approx(d["b"], rel=1e-12)
+    assert robot["branch"] == "Z+" and (tmp_path / "u" / "robot.png").is_file()
 
 
 def test_plane_sampling_equals_the_full_grid_slice():

@@ -104,18 +104,9 @@ class TaskConfig(_Strict):
     @field_validator("path")
     @classmethod
     def _path_ok(cls, v):
-        if v is None:
-            return v
-        if len(v) < 2:
-            raise ValueError("need at least two points")
-        dims = {len(p) for p in v}
-        if len(dims) != 1 or dims.pop() not in (2, 3):
-            raise ValueError("every point needs the same 2 or 3 coordinates")
-        if not all(math.isfinite(c) for p in v for c in p):
-            raise ValueError("coordinates must be finite")
-        for i, p in enumerate(v):
-            _magnitude(str(i), *p)
-        return v
+        from scalesynth.paths import check_polyline
+
+        return None if v is None else check_polyline(v, dims=(2, 3))
 
 
 class ObjectiveConfig(_Strict):

@@ -211,7 +211,7 @@ def _cycle_values(ctx: EvalContext) -> dict[str, np.ndarray]:
 
 
 def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
-    from scalesynth.cycle.analysis import CYCLE_PENALTY
+    from scalesynth.cycle.analysis import CYCLE_PENALTY, has_deflection
 
     def entry(name, unit, rng, better, worst, needs, description, plain=False):
         def compute(ctx: EvalContext, name=name) -> np.ndarray:
@@ -246,6 +246,10 @@ def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
         entry("cycle_min_clearance", lu, (-CYCLE_PENALTY, math.inf), "max", None,
               ("cycle",), f"smallest distance between non-adjacent link capsules along the cycle ({lu}; < 0: "
               f"interference; -{CYCLE_PENALTY:g} if the cycle cannot be followed)"),
+        *([entry("cycle_max_deflection", lu, (0.0, CYCLE_PENALTY), "min", CYCLE_PENALTY, ("cycle",),
+                 f"largest deflection of the payload point along the cycle under the payload's weight and inertia "
+                 f"m (g - a) ({lu}; stiffness model with ideal joints, docs/cycles.md){failed}")]
+          if has_deflection(mech) else []),
         entry("max_cycles_per_minute", "1/min", (0.0, math.inf), "max", None, ("cycle", "cycle.limits"),
               "highest cycle rate within the actuator speed and force limits of the cycle section (cycles per "
               "minute; 0 if gravity alone exceeds a force limit or the cycle cannot be followed)", plain=True),

@@ -1,10 +1,37 @@
-"""Task paths: polylines of task points sampled evenly by arc length (plain NumPy)."""
+"""Task paths: polylines of task points, their validation (task.path, cycle.path) and sampling by arc length."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
+
+
+def check_polyline(points: list[list[float]], dims: tuple[int, ...] | None = None, closed: bool = False
+                   ) -> list[list[float]]:
+    """The one validator of a polyline config value (task.path, cycle.path); raise ValueError with the message a
+    pydantic field validator turns into '<field>: <message>'. At least 2 points, all with the same number of
+    coordinates (one of ``dims`` if given), finite and within +-MAX_MAGNITUDE (the entry named by its index);
+    ``closed`` (a cycle): not all points equal, so the loop has a length."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
+    if len(points) < 2:
+        raise ValueError(f"need at least 2 points, got {len(points)}")
+    n = {len(p) for p in points}
+    if len(n) != 1 or (dims is not None and next(iter(n)) not in dims):
+        allowed = "" if dims is None else " " + " or ".join(str(d) for d in dims)
+        raise ValueError(f"every point needs the same{allowed} number of coordinates")
+    for i, p in enumerate(points):
+        for c in p:
+            if not math.isfinite(c):
+                raise ValueError(f"{i}: coordinates must be finite, got {c}")
+            if abs(c) > MAX_MAGNITUDE:
+                raise ValueError(f"{i}: {c:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth "
+                                 "computes with (products of such values overflow)")
+    if closed and all(p == points[0] for p in points):
+        raise ValueError("all points coincide: the path has no length")
+    return points
 
 
 def sample_path(points: Sequence[Sequence[float]], samples: int) -> np.ndarray:

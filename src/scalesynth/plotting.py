@@ -402,12 +402,14 @@ def cycle_actuator_figure(t, series: Sequence[tuple[str, Sequence[tuple[str, np.
     return fig
 
 
-def cycle_path_figure(lci, extent, path: np.ndarray, vertices: np.ndarray, band_edges, xlabel, ylabel, title):
-    """The cycle's path drawn on an LCI section of the workspace (unreachable cells blank), vertices numbered."""
+def cycle_path_figure(lci, extent, path: np.ndarray, vertices: np.ndarray, band_edges, xlabel, ylabel, title,
+                      equal: bool = True):
+    """The cycle's path drawn on an LCI section of the workspace (unreachable cells blank), vertices numbered;
+    ``equal`` False for axes of different units (mm against rad), which are then not drawn to equal scale."""
     fig, ax = plt.subplots(figsize=(7.0, 5.5))
     data = np.ma.masked_less(np.asarray(lci).T, 0.0)
     norm = BoundaryNorm(np.linspace(0, 1, 21), 256)
-    im = ax.imshow(data, origin="lower", extent=extent, cmap="viridis", norm=norm, aspect="equal")
+    im = ax.imshow(data, origin="lower", extent=extent, cmap="viridis", norm=norm, aspect="equal" if equal else "auto")
     ax.plot(path[:, 0], path[:, 1], "-", c="k", lw=1.5, label="cycle path")
     for k, (x, y) in enumerate(vertices[:-1]):
         ax.annotate(str(k + 1), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8, color="k")
@@ -422,15 +424,21 @@ def cycle_path_figure(lci, extent, path: np.ndarray, vertices: np.ndarray, band_
     return fig
 
 
-def cycle_quality_figure(t, lci, clearance, vertex_times, clearance_label, title):
-    """LCI and link clearance over the cycle (clearance 0 = capsules touching, drawn red)."""
-    fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+def cycle_quality_figure(t, lci, clearance, vertex_times, clearance_label, title, deflection=None,
+                         deflection_label=""):
+    """LCI and link clearance over the cycle (clearance 0 = capsules touching, drawn red), and the deflection when
+    the mechanism has a stiffness model."""
+    rows = 2 if deflection is None else 3
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 2.5 * rows), sharex=True)
     axes[0].plot(t, lci, c="C0")
     axes[0].set_ylabel("LCI")
     axes[1].plot(t, clearance, c="C2")
     axes[1].axhline(0.0, c="C3", lw=1)
     axes[1].set_ylabel(clearance_label)
-    axes[1].set_xlabel("t (s)")
+    if deflection is not None:
+        axes[2].plot(t, deflection, c="C1")
+        axes[2].set_ylabel(deflection_label)
+    axes[-1].set_xlabel("t (s)")
     for ax in axes:
         ax.grid(alpha=0.3)
         _mark_segments(ax, vertex_times)

@@ -10,15 +10,22 @@ Along the sampled trajectory (``cycle.trajectory``), in the configured working m
 * q from the closed-form IK; q_dot = A x_dot with the mechanism's velocity map A (inverse Jacobian);
   q_ddot = A x_ddot + A_dot x_dot, where A_dot x_dot is the derivative of A along the motion, taken by a
   central difference of A over a displacement of 1e-6 of the mechanism's size (IK re-solved in the branch);
-* actuator forces for the payload, quasi-static plus payload inertia: the payload is a point mass m at the
-  task point, the links are massless and joint friction is ignored, so A_SI^T tau = [F; 0] with
-  F = m (a - g) (N), tau in N for prismatic and N m for revolute actuators (SI units, whatever the config's
-  length unit). This is what the actuators must exert on the payload, gravity included: sum tau_i q_dot_i
-  equals F . x_dot at every sample (power balance);
+* actuator forces for the payload, quasi-static plus payload inertia: the payload is a point mass m, the
+  links are massless and joint friction is ignored, so A_SI^T tau = [F; 0] with F the generalised force on
+  the task axes, tau in N for prismatic and N m for revolute actuators (SI units, whatever the config's
+  length unit). With Cartesian task axes the payload sits at the task point and F = m (a - g) (N). With an
+  angular task axis (rps-upu, ups-sspr) it sits at the mechanism's ``payload_point`` c(x) (3-D, mechanism
+  frame): c_dot = J_c x_dot, c_ddot = J_c x_ddot + (d J_c/dt) x_dot, and F = J_c^T m (c_ddot - g), i.e.
+  tau = A_SI^-T [J_c^T m (c_ddot - g); 0]: N along a length axis, N m about an angle axis (J_c and its
+  derivative by central differences of c). Either way sum tau_i q_dot_i = F . x_dot = m (c_ddot - g) . c_dot
+  (W) at every sample (power balance);
 * the LCI from the point kernel and the clearance of the link capsules (``cycle.clearance``).
 
-Deflection along the cycle (stiffness, issue 12) goes into ``CycleResult.deflection`` when a mechanism provides
-a compliance model; it is None until then.
+* the deflection (``CycleResult.deflection``, where the mechanism has a per-voxel ``deflection`` field and a
+  ``load`` option: planar-fivebar, pprs-rprs, ups-sspr): at every sample the magnitude of the payload point's deflection
+  under the force the payload exerts on the platform, m (g - c_ddot) (N; at rest its weight), from the
+  mechanism's stiffness model with ideal joints (its field kernel re-packed with that load; the same model as
+  the pose-level ``scalesynth stiffness`` command, tested against it). None for the other mechanisms.
 """
 
 from __future__ import annotations
@@ -37,6 +44,8 @@ from scalesynth.mechanisms.base import Mechanism, wrap_angle
 
 # relative displacement (of the mechanism's size) for the directional derivative of the velocity map
 _DERIV_STEP = 1e-6
+# relative displacement for the second difference of the payload point along the motion (rounding ~ 1e-16 / step^2)
+_SECOND_STEP = 1e-4
 
 
 class CycleError(InvalidPose):
@@ -46,9 +55,12 @@ class CycleError(InvalidPose):
 @dataclass(frozen=True)
 class CycleResult:
     """One design's cycle. Arrays per sample (n rows): q, qd, qdd (n, n_joints) in the length unit or rad
-    (per s, per s^2); force (n, n_joints) in N or N m; task_force (n, k) the force F on the payload (N);
-    lci (n,); clearance (n,) in the length unit (< 0: interference) and clearance_pair the two segments at it.
-    ``deflection``: hook for the stiffness model, None until a mechanism provides one."""
+    (per s, per s^2); force (n, n_joints) in N or N m, force_gravity (n, n_joints) its part due to gravity
+    alone; task_force (n, k) the generalised force F on the task axes (N along a length axis, N m about an
+    angle axis); payload_velocity, payload_accel (n, 3 or k) the payload point's velocity and acceleration
+    (length unit per s, per s^2; payload axes, ``cycle.config.payload_axes``); lci (n,); clearance (n,) in the
+    length unit (< 0: interference) and min_clearance_pair the two segments at its minimum. ``deflection``: hook for the
+    stiffness model, None until a mechanism provides one; see ``deflection_along``."""
 
     traj: trajectory.Trajectory
     q: np.ndarray
@@ -58,7 +70,7 @@ class CycleResult:
     task_force: np.ndarray
     lci: np.ndarray
     clearance: np.ndarray
-    clearance_pair: tuple[tuple[str, str] | None, ...]
+    min_clearance_pair: tuple[str, str] | None  # the two segments at the smallest clearance
     task_axes: tuple[str, ...]
     task_units: tuple[str, ...]
     joints: tuple[str, ...]
@@ -67,6 +79,9 @@ class CycleResult:
     payload: float
     gravity: np.ndarray
     force_map: np.ndarray  # (n, n_joints, k): force = force_map @ F
+    force_gravity: np.ndarray
+    payload_velocity: np.ndarray
+    payload_accel: np.ndarray
     deflection: np.ndarray | None = None
 
     def columns(self) -> dict[str, np.ndarray]:
@@ -84,6 +99,8 @@ class CycleResult:
             out[f"force{i + 1}"] = self.force[:, i]
         out["lci"] = self.lci
         out["clearance"] = self.clearance
+        if self.deflection is not None:
+            out["deflection"] = self.deflection
         return out
 
     def units(self) -> dict[str, str]:
@@ -98,6 +115,8 @@ class CycleResult:
             out.update({f"q{i}": base, f"qd{i}": f"{base}/s", f"qdd{i}": f"{base}/s^2",
                         f"force{i}": "N" if u == "length" else "N m"})
         out.update({"lci": "1", "clearance": lu})
+        if self.deflection is not None:
+            out["deflection"] = lu
         return out
 
 
@@ -110,17 +129,6 @@ def _where(mech: Mechanism, traj, k: int) -> str:
     pos = ", ".join(f"{v:.6g}" for v in traj.p[k])
     axes = ", ".join(mech.task_axes)
     return f"sample {k} (t = {traj.t[k]:.4g} s, segment {traj.segment[k] + 1}) at ({axes}) = ({pos})"
-
-
-def _branches(mech: Mechanism, design, options, pose) -> dict[str, np.ndarray]:
-    return {s.label: s.values for s in mech.inverse_kinematics(design, options, pose)}
-
-
-def _unwrap(q: np.ndarray, ref: np.ndarray, angular: np.ndarray) -> np.ndarray:
-    """q with its angles moved by whole turns to lie within pi of ref."""
-    out = np.array(q, dtype=float)
-    out[angular] = ref[angular] + wrap_angle(out[angular] - ref[angular])
-    return out
 
 
 def check_vertices(mech: Mechanism, design, options, verts: np.ndarray, what: str) -> None:
@@ -138,6 +146,25 @@ def check_vertices(mech: Mechanism, design, options, verts: np.ndarray, what: st
         )
 
 
+def _kinematics_source(mech: Mechanism, design, options, label: str, reference: bool):
+    """poses (n, k) -> (q (n, nj) with NaN rows out of reach in the branch, A (n, nj, nj)): the mechanism's
+    (possibly vectorised) ``cycle_kinematics``, or with ``reference`` the base class's per-pose loop over
+    inverse_kinematics and velocity_map (the obviously correct twin the tests compare with)."""
+    if reference:
+        return lambda poses: Mechanism.cycle_kinematics(mech, design, options, poses, label)
+    return lambda poses: mech.cycle_kinematics(design, options, poses, label)
+
+
+def _unwrap_along(q: np.ndarray, angular: np.ndarray) -> np.ndarray:
+    """q (n, nj) with its angle columns moved by whole turns so that each sample lies within pi of the previous
+    one (q[s] = q[s - 1] + wrap(q[s] - q[s - 1]))."""
+    out = np.array(q, dtype=float)
+    if np.any(angular) and len(out) > 1:
+        steps = wrap_angle(np.diff(out[:, angular], axis=0))
+        out[1:, angular] = out[0, angular] + np.cumsum(steps, axis=0)
+    return out
+
+
 def analyse(
     mech: Mechanism,
     design: Mapping[str, float],
@@ -146,9 +173,15 @@ def analyse(
     length_unit: str,
     *,
     rate_scale: float = 1.0,
+    reference: bool = False,
 ) -> CycleResult:
     """The cycle of one design (module docstring). ``rate_scale`` multiplies the cycle rate (2 = twice as many
-    cycles per minute). Raises CycleError where the cycle cannot be followed."""
+    cycles per minute). Raises CycleError where the cycle cannot be followed.
+
+    The per-sample kinematics come from ``Mechanism.cycle_kinematics`` (vectorised over the samples where the
+    mechanism provides it) and the clearance from the field kernel's ``clearance`` slot where the mechanism has
+    one; ``reference=True`` takes both from the per-pose NumPy methods instead (inverse_kinematics, velocity_map,
+    link_geometry), the slow twin the tests hold the fast path to."""
     from scalesynth.kernels.grid import points_lci
 
     design = mech.resolve_design(design)
@@ -158,35 +191,40 @@ def analyse(
     traj = trajectory.build(verts, cyc.law, cyc.cycle_time / rate_scale, cyc.samples)
     n, k = traj.p.shape
     nj = len(mech.joints)
-    lci = points_lci(mech.point_kernel, mech.pack(design, options), np.pad(traj.p, ((0, 0), (0, 3 - k))))
+    packed = mech.pack(design, options)
+    pts = np.pad(traj.p, ((0, 0), (0, 3 - k)))
+    lci = points_lci(mech.point_kernel, packed, pts)
     outside = np.nonzero(lci < 0)[0]
     if outside.size:
         raise CycleError(f"cycle: {_where(mech, traj, int(outside[0]))} is outside the workspace")
     label = mech.kernel_branch(options)
+    kin = _kinematics_source(mech, design, options, label, reference)
     angular = np.array([u == "angle" for u in mech.joint_units])
     size = _size(mech, design, options)
     joint_scale = np.where(angular, size, 1.0)
-    q = np.empty((n, nj))
-    A = np.empty((n, nj, nj))
-    for s in range(n):
-        sols = _branches(mech, design, options, traj.p[s])
-        if label not in sols:
-            raise CycleError(f"cycle: {_where(mech, traj, s)} is out of reach in working mode {label}")
-        q[s] = sols[label] if s == 0 else _unwrap(sols[label], q[s - 1], angular)
-        A[s] = mech.velocity_map(design, options, traj.p[s], q[s])
-        if s > 0 and np.all(np.isfinite(A[s - 1 : s + 1])):
-            # branch continuity: the step in q must be the one the velocity map predicts for the step in x (to
-            # first order; the trapezoidal rule's error is second order), else the branch jumped
-            dx = np.zeros(nj)
-            dx[:k] = traj.p[s] - traj.p[s - 1]
-            predicted = 0.5 * (A[s] + A[s - 1]) @ dx
-            if np.linalg.norm((q[s] - q[s - 1] - predicted) * joint_scale) > 0.5 * np.linalg.norm(
-                predicted * joint_scale
-            ) + 1e-9 * size:
-                raise CycleError(
-                    f"cycle: branch {label} jumps between sample {s - 1} and {_where(mech, traj, s)} (a singularity "
-                    "or a branch point on the path; more cycle.samples may resolve it)"
-                )
+    q_raw, A = kin(traj.p)
+    reach = np.all(np.isfinite(q_raw), axis=1)
+    first_out = int(np.argmin(reach)) if not reach.all() else n
+    q = _unwrap_along(np.where(reach[:, None], q_raw, 0.0)[:first_out], angular)
+    # branch continuity: the step in q must be the one the velocity map predicts for the step in x (to first
+    # order; the trapezoidal rule's error is second order), else the branch jumped
+    m = q.shape[0]
+    if m > 1:
+        dx = np.zeros((m - 1, nj))
+        dx[:, :k] = np.diff(traj.p[:m], axis=0)
+        with np.errstate(invalid="ignore"):
+            predicted = np.einsum("sij,sj->si", 0.5 * (A[1:m] + A[: m - 1]), dx)
+            miss = np.linalg.norm((np.diff(q, axis=0) - predicted) * joint_scale, axis=1)
+            finite = np.all(np.isfinite(A[1:m]), axis=(1, 2)) & np.all(np.isfinite(A[: m - 1]), axis=(1, 2))
+            jumps = np.nonzero(finite & (miss > 0.5 * np.linalg.norm(predicted * joint_scale, axis=1) + 1e-9 * size))[0]
+        if jumps.size:
+            s = int(jumps[0]) + 1
+            raise CycleError(
+                f"cycle: branch {label} jumps between sample {s - 1} and {_where(mech, traj, s)} (a singularity "
+                "or a branch point on the path; more cycle.samples may resolve it)"
+            )
+    if first_out < n:
+        raise CycleError(f"cycle: {_where(mech, traj, first_out)} is out of reach in working mode {label}")
     det = np.linalg.det(A)
     sign = np.sign(det)
     bad = np.nonzero(~np.isfinite(det) | (sign == 0) | (lci <= 0))[0]
@@ -200,43 +238,58 @@ def analyse(
     pdd_full = np.zeros((n, nj))
     pdd_full[:, :k] = traj.pdd
     qd = np.einsum("nij,nj->ni", A, pd_full)
-    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(mech, design, options, traj, q, label, angular, size)
+    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(kin, mech, traj, size)
     g = ccfg.gravity_vector(cyc, mech)
-    force, task_force, force_map = _forces(mech, A, traj, cyc.payload, g, length_unit)
-    gaps, pairs = [], []
-    for s in range(n):
-        c = clearance(mech.link_geometry(design, options, traj.p[s], q[s]))
-        gaps.append(c.value)
-        pairs.append(c.pair)
+    m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
+    vel, acc, jc = _payload_motion(mech, design, options, traj, size)
+    force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
+    gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)
+    at = int(np.argmin(gaps))
     return CycleResult(
-        traj=traj, q=q, qd=qd, qdd=qdd, force=force, task_force=task_force, lci=lci, clearance=np.array(gaps),
-        clearance_pair=tuple(pairs), task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
+        traj=traj, q=q, qd=qd, qdd=qdd, force=force, task_force=task_force, lci=lci, clearance=gaps,
+        min_clearance_pair=clearance(mech.link_geometry(design, options, traj.p[at], q[at])).pair,
+        task_axes=mech.task_axes, task_units=mech.task_units, joints=mech.joints,
         joint_units=mech.joint_units, length_unit=length_unit, payload=cyc.payload, gravity=g,
-        force_map=force_map,
+        force_map=force_map, force_gravity=force_gravity, payload_velocity=vel, payload_accel=acc,
+        deflection=deflection_along(mech, design, options, traj.p, cyc.payload * (g[None, :] - acc * m_per_unit)),
     )
 
 
-def _a_dot_xdot(mech, design, options, traj, q, label, angular, size) -> np.ndarray:
-    """(dA/dt) x_dot per sample by a central difference of A along x_dot (IK re-solved in the branch)."""
+def _clearance_along(mech: Mechanism, design, options, packed, poses: np.ndarray, q: np.ndarray,
+                     reference: bool) -> np.ndarray:
+    """Clearance (n,) at each sample: the field kernel's clearance slot (one compiled call for all samples) where
+    the mechanism has that field, else (and with ``reference``) cycle.clearance of link_geometry per sample."""
+    if "clearance" in mech.field_names and not reference:
+        from scalesynth.kernels.grid import population_points_fields
+
+        pts = np.pad(poses, ((0, 0), (0, 3 - poses.shape[1])))
+        fields = population_points_fields(mech.field_kernel, mech.n_fields, packed[None, :], pts)[0]
+        return fields[:, mech.field_names.index("clearance")]
+    return np.array([clearance(mech.link_geometry(design, options, poses[s], q[s])).value
+                     for s in range(len(poses))])
+
+
+def _a_dot_xdot(kin, mech: Mechanism, traj, size) -> np.ndarray:
+    """(dA/dt) x_dot per sample by a central difference of A along x_dot (IK re-solved in the branch, all
+    moving samples in two calls of the kinematics source)."""
     n, k = traj.p.shape
-    nj = q.shape[1]
+    nj = len(mech.joints)
     out = np.zeros((n, nj))
-    for s in range(n):
-        v = traj.pd[s]
-        speed = float(np.linalg.norm(v))
-        if speed == 0.0:
-            continue
-        eps = _DERIV_STEP * size / speed  # a time step: the pose moves by _DERIV_STEP * size
-        mats = []
-        for sign in (1.0, -1.0):
-            pose = traj.p[s] + sign * eps * v
-            sols = _branches(mech, design, options, pose)
-            if label not in sols:
-                raise CycleError(f"cycle: {_where(mech, traj, s)} lies on the boundary of the workspace")
-            mats.append(mech.velocity_map(design, options, pose, _unwrap(sols[label], q[s], angular)))
-        vfull = np.zeros(nj)
-        vfull[:k] = v
-        out[s] = (mats[0] - mats[1]) @ vfull / (2.0 * eps)
+    speed = np.linalg.norm(traj.pd, axis=1)
+    moving = np.nonzero(speed > 0.0)[0]
+    if not moving.size:
+        return out
+    v = traj.pd[moving]
+    eps = _DERIV_STEP * size / speed[moving]  # a time step: the pose moves by _DERIV_STEP * size
+    q_plus, a_plus = kin(traj.p[moving] + eps[:, None] * v)
+    q_minus, a_minus = kin(traj.p[moving] - eps[:, None] * v)
+    lost = ~(np.all(np.isfinite(q_plus), axis=1) & np.all(np.isfinite(q_minus), axis=1))
+    if lost.any():
+        raise CycleError(f"cycle: {_where(mech, traj, int(moving[np.argmax(lost)]))} lies on the boundary of the "
+                         "workspace")
+    vfull = np.zeros((len(moving), nj))
+    vfull[:, :k] = v
+    out[moving] = np.einsum("sij,sj->si", a_plus - a_minus, vfull) / (2.0 * eps[:, None])
     return out
 
 
@@ -251,18 +304,93 @@ def si_velocity_map(mech: Mechanism, A: np.ndarray, length_unit: str) -> np.ndar
     return A * row[:, None] * col[None, :]
 
 
-def _forces(mech, A, traj, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Actuator forces (n, n_joints), the payload force F = m (a - g) (n, k) and the map between them
-    (n, n_joints, k), SI."""
-    if any(u != "length" for u in mech.task_units):
-        axes = ", ".join(mech.task_axes)
-        raise CycleError(f"cycle: payload forces need Cartesian task axes; {mech.name} has {axes}")
+def has_deflection(mech: Mechanism) -> bool:
+    """Whether the cycle analysis reports a deflection for ``mech`` (a per-voxel deflection field and a load)."""
+    return "deflection" in mech.field_names and "load" in mech.option_names
+
+
+def deflection_along(mech: Mechanism, design, options, poses: np.ndarray, loads: np.ndarray) -> np.ndarray | None:
+    """Deflection magnitude (length unit) of the platform at each pose (n, k) under its load (n, 2 or 3; N, the
+    mechanism's load axes), from the field kernel's ``deflection`` slot with ``options['load']`` replaced per
+    sample; None when the mechanism has no deflection field."""
+    if not has_deflection(mech):
+        return None
+    from scalesynth.kernels.paired import paired_points_fields
+
+    loads = np.asarray(loads, dtype=float)
+    params = _packed_with_loads(mech, design, options, loads)
+    pts = np.pad(np.asarray(poses, dtype=float), ((0, 0), (0, 3 - poses.shape[1])))
+    return paired_points_fields(mech.field_kernel, mech.n_fields, params, pts)[:, mech.field_names.index("deflection")]
+
+
+def _packed_with_loads(mech: Mechanism, design, options, loads: np.ndarray) -> np.ndarray:
+    """One packed vector per load (n, k_packed): the design packed once, the load's entries found by packing the
+    unit loads (each must set exactly one entry to 1) and overwritten per row; a mechanism that packs its load
+    otherwise is packed once per load."""
+    def pack(load):
+        return mech.pack(design, {**options, "load": [float(v) for v in load]})
+
+    dim = loads.shape[1]
+    zero = pack(np.zeros(dim))
+    slots = []
+    for a in range(dim):
+        diff = np.nonzero(pack(np.eye(dim)[a]) != zero)[0]
+        if diff.size != 1 or pack(np.eye(dim)[a])[diff[0]] != 1.0 or zero[diff[0]] != 0.0:
+            return np.stack([pack(f) for f in loads])
+        slots.append(int(diff[0]))
+    out = np.tile(zero, (len(loads), 1))
+    out[:, slots] = loads
+    return out
+
+
+def _payload_motion(mech, design, options, traj, size) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The payload point's velocity and acceleration (n, 3) in the length unit per s (s^2) and its Jacobian
+    J_c = dc/dx (n, 3, k; length unit per task unit) for a mechanism with an angular task axis; with Cartesian
+    task axes the payload is the task point: (pd, pdd, None), exactly.
+
+    J_c by central differences of ``payload_point`` along each task axis (step _DERIV_STEP times the size for a
+    length axis, _DERIV_STEP rad for an angle); (d J_c/dt) x_dot = c''[x_dot, x_dot] by the second difference
+    of c along x_dot with the pose moving by _SECOND_STEP (size or rad)."""
+    if ccfg.cartesian_task(mech):
+        return traj.pd, traj.pdd, None
     n, k = traj.p.shape
+    scale = np.array([size if u == "length" else 1.0 for u in mech.task_units])
+    x, v = traj.p, traj.pd
+    steps = np.eye(k) * (_DERIV_STEP * scale)  # one row per task axis
+    reach = np.max(np.abs(v) / scale, axis=1)
+    eps = np.where(reach > 0.0, _SECOND_STEP / np.where(reach > 0.0, reach, 1.0), 0.0)  # the pose moves by
+    # _SECOND_STEP of its scale along x_dot in the time step eps
+    poses = np.concatenate([x[:, None, :] + steps[None], x[:, None, :] - steps[None],
+                            np.stack([x + eps[:, None] * v, x, x - eps[:, None] * v], axis=1)], axis=1)
+    c = mech.payload_points(design, options, poses.reshape(-1, k)).reshape(n, 2 * k + 3, 3)
+    jc = np.transpose((c[:, :k] - c[:, k : 2 * k]) / (2.0 * _DERIV_STEP * scale)[None, :, None], (0, 2, 1))
+    vel = np.einsum("nck,nk->nc", jc, v)
+    acc = np.einsum("nck,nk->nc", jc, traj.pdd)
+    moving = reach > 0.0
+    second = c[:, 2 * k] - 2.0 * c[:, 2 * k + 1] + c[:, 2 * k + 2]
+    acc[moving] += second[moving] / (eps[moving] ** 2)[:, None]
+    return vel, acc, jc
+
+
+def _forces(mech, A, jc, acc, mass, g, length_unit) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Actuator forces (n, n_joints), their gravity part (n, n_joints), the generalised payload force F on the
+    task axes (n, k) and the map from F to the forces (n, n_joints, k), SI. F = m (a - g) with Cartesian task
+    axes (``jc`` None), else J_c^T m (c_ddot - g) with J_c in metres per task unit."""
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
-    F = mass * (traj.pdd * m_per_unit - g[None, :])
+    cart = mass * (acc * m_per_unit - g[None, :])  # the force the payload needs, payload axes (N)
+    weight = np.broadcast_to(-mass * g, cart.shape)
+    if jc is None:
+        F, F_g = cart, weight
+    else:
+        # m per task unit: mm/mm columns are m/m already, mm/rad columns scale to m/rad
+        jc_si = jc * np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])
+        F = np.einsum("nck,nc->nk", jc_si, cart)
+        F_g = np.einsum("nck,nc->nk", jc_si, weight)
+    k = F.shape[1]
     A_si = si_velocity_map(mech, A, length_unit)
     force_map = np.linalg.inv(np.transpose(A_si, (0, 2, 1)))[:, :, :k]
-    return np.einsum("nik,nk->ni", force_map, F), F, force_map
+    return (np.einsum("nik,nk->ni", force_map, F), np.einsum("nik,nk->ni", force_map, F_g), np.asarray(F),
+            force_map)
 
 
 # ----- design-level metrics (catalogue: cycle_*) ------------------------------------------------------------
@@ -280,7 +408,7 @@ def max_rate_scale(res: CycleResult, speed_limits, force_limits) -> float:
         with np.errstate(divide="ignore"):
             k2 = min(k2, float(np.min((speed_limits / peak) ** 2)))
     if force_limits is not None:
-        tau_g = np.einsum("nik,k->ni", res.force_map, -res.payload * res.gravity)
+        tau_g = res.force_gravity
         tau_a = res.force - tau_g
         if np.any(np.abs(tau_g) > force_limits):
             return 0.0
@@ -307,6 +435,8 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
         bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
                 "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
                 "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
+        if has_deflection(mech):
+            bad["cycle_max_deflection"] = CYCLE_PENALTY
         if cyc.speed_limits is not None or cyc.force_limits is not None:
             bad["max_cycles_per_minute"] = 0.0
         return bad
@@ -328,6 +458,8 @@ def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:
         "cycle_min_lci": float(np.min(res.lci)),
         "cycle_min_clearance": float(min(np.min(res.clearance), CYCLE_PENALTY)),
     }
+    if res.deflection is not None:
+        out["cycle_max_deflection"] = float(min(np.max(res.deflection), CYCLE_PENALTY))
     if speed is not None or force is not None:
         out["max_cycles_per_minute"] = 60.0 / cyc.cycle_time * scale
     return out

@@ -2,7 +2,7 @@
 
 ```yaml
 cycle:
-  path: [[x, y], ...]        # closed polyline in task axes (joined back to the first point), or:
+  path: [[x, y], ...]        # closed polyline in task axes (joined back to the first point; angles in rad), or:
   preset: adept              # 25 mm up, 305 mm across, 25 mm down and back (mechanisms with 2 Cartesian axes)
   start: [x, y]              # adept: start point (task coordinates, the config's length unit)
   direction: [1, 0]          # adept: the 'across' direction (task axes; default: the first Cartesian axis
@@ -10,7 +10,8 @@ cycle:
   law: poly345               # or modified_trapezoid, constant, or one law per segment
   cycles_per_minute: 60      # or period: 1.0 (s); exactly one of the two
   payload: 1.0               # kg, > 0
-  gravity: null              # m/s^2 per task axis; null = 9.81 down the last Cartesian task axis
+  gravity: null              # m/s^2 per task axis (angular task axes: per x, y, z of the mechanism frame);
+                             # null = 9.81 down the last Cartesian task axis (angular task axes: down -z)
   samples: 400               # time intervals over one cycle
   speed_limits: null         # per actuator (or one number): |qd| limit, length unit/s or rad/s
   force_limits: null         # per actuator (or one number): |force| limit, N or N m
@@ -35,6 +36,17 @@ ADEPT_ACROSS_MM = 305.0
 METRES_PER_UNIT = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001}
 
 
+def _within_magnitude(*values: float) -> None:
+    """ValueError for a value beyond +-MAX_MAGNITUDE (as every other number of a config)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
+    for i, v in enumerate(values):
+        if abs(v) > MAX_MAGNITUDE:
+            where = f"{i}: " if len(values) > 1 else ""
+            raise ValueError(f"{where}{v:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth computes "
+                             "with (products of such values overflow)")
+
+
 class CycleConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
@@ -54,17 +66,9 @@ class CycleConfig(BaseModel):
     @field_validator("path")
     @classmethod
     def _path_ok(cls, v):
-        if v is None:
-            return v
-        if len(v) < 2:
-            raise ValueError(f"need at least 2 points, got {len(v)}")
-        if len({len(p) for p in v}) != 1:
-            raise ValueError("every point needs the same number of coordinates")
-        if not all(math.isfinite(c) for p in v for c in p):
-            raise ValueError("coordinates must be finite")
-        if all(p == v[0] for p in v):
-            raise ValueError("all points coincide: the path has no length")
-        return v
+        from scalesynth.paths import check_polyline
+
+        return None if v is None else check_polyline(v, closed=True)
 
     @field_validator("preset")
     @classmethod
@@ -88,6 +92,8 @@ class CycleConfig(BaseModel):
     def _positive(cls, v):
         if v is not None and not (math.isfinite(v) and v > 0):
             raise ValueError(f"must be a finite number > 0, got {v}")
+        if v is not None:
+            _within_magnitude(v)
         return v
 
     @field_validator("start", "direction", "gravity")
@@ -95,6 +101,8 @@ class CycleConfig(BaseModel):
     def _finite(cls, v):
         if v is not None and not all(math.isfinite(c) for c in v):
             raise ValueError("must be finite")
+        if v is not None:
+            _within_magnitude(*v)
         return v
 
     @field_validator("speed_limits", "force_limits")
@@ -103,6 +111,7 @@ class CycleConfig(BaseModel):
         for x in [] if v is None else [v] if isinstance(v, (int, float)) else v:
             if not (math.isfinite(x) and x > 0):
                 raise ValueError(f"limits must be finite numbers > 0, got {x}")
+            _within_magnitude(x)
         return v
 
     @model_validator(mode="after")
@@ -128,14 +137,26 @@ def _cartesian(mech) -> list[int]:
     return [a for a, u in enumerate(mech.task_units) if u == "length"]
 
 
+def cartesian_task(mech) -> bool:
+    """Whether every task axis is a length (the payload then sits at the task point)."""
+    return all(u == "length" for u in mech.task_units)
+
+
+def payload_axes(mech) -> tuple[str, ...]:
+    """Axes of the payload's position and of ``gravity``: the task axes when they are all Cartesian, else the
+    mechanism frame's x, y, z (the payload sits at ``mech.payload_point``, z up)."""
+    return tuple(mech.task_axes) if cartesian_task(mech) else ("x", "y", "z")
+
+
 def gravity_vector(cyc: CycleConfig, mech) -> np.ndarray:
-    """Gravity (m/s^2) per task axis; default -9.80665 along the last Cartesian task axis (0 without one)."""
+    """Gravity (m/s^2) per payload axis (``payload_axes``); default -9.80665 along the last Cartesian task axis,
+    or along -z of the mechanism frame when a task axis is an angle."""
     if cyc.gravity is not None:
         return np.asarray(cyc.gravity, dtype=float)
+    if not cartesian_task(mech):
+        return np.array([0.0, 0.0, -G0])
     g = np.zeros(len(mech.task_axes))
-    axes = _cartesian(mech)
-    if axes:
-        g[axes[-1]] = -G0
+    g[_cartesian(mech)[-1]] = -G0
     return g
 
 
@@ -171,23 +192,21 @@ def check(cyc: CycleConfig, mech) -> None:
 
     k = len(mech.task_axes)
     axes = ", ".join(mech.task_axes)
-    if cyc.preset is not None and len(_cartesian(mech)) < 2:
+    if cyc.preset is not None and (len(_cartesian(mech)) < 2 or not cartesian_task(mech)):
         raise ValueError(
             f"cycle.preset: {cyc.preset} needs two Cartesian task axes; {mech.name} has {axes} "
             f"({', '.join(mech.task_units)})"
         )
-    for method in ("link_geometry", "velocity_map"):
+    needed = ("link_geometry", "velocity_map") + (() if cartesian_task(mech) else ("payload_point",))
+    for method in needed:
         if getattr(type(mech), method) is getattr(Mechanism, method):
             raise ValueError(f"cycle: {mech.name} has no {method.replace('_', ' ')} yet (cycles need it)")
-    if any(u != "length" for u in mech.task_units):
-        raise ValueError(
-            f"cycle: the payload force m (a - g) needs Cartesian task axes; {mech.name} has {axes} "
-            f"({', '.join(mech.task_units)})"
-        )
     if cyc.path is not None and len(cyc.path[0]) != k:
         raise ValueError(f"cycle.path: points need {k} coordinates ({axes}) for {mech.name}")
-    if cyc.gravity is not None and len(cyc.gravity) != k:
-        raise ValueError(f"cycle.gravity: need {k} components ({axes})")
+    g_axes = payload_axes(mech)
+    if cyc.gravity is not None and len(cyc.gravity) != len(g_axes):
+        frame = "" if cartesian_task(mech) else " of the mechanism frame (the task axes include an angle)"
+        raise ValueError(f"cycle.gravity: need {len(g_axes)} components ({', '.join(g_axes)}){frame}")
     n = len(mech.joints)
     for name in ("speed_limits", "force_limits"):
         v = getattr(cyc, name)
@@ -242,6 +261,7 @@ CYCLE_METRICS = (
     "cycle_max_actuator_force",
     "cycle_min_lci",
     "cycle_min_clearance",
+    "cycle_max_deflection",
     "max_cycles_per_minute",
 )
 

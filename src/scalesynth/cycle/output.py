@@ -5,7 +5,7 @@
 * ``cycle.json``: design, cycle settings, units of every column, the catalogue metrics and where the minimum
   clearance occurs;
 * ``actuators.png`` (q, qd, qdd, force of every actuator over t, the vertices marked), ``path.png`` (the path on
-  an LCI section of the workspace), ``quality.png`` (LCI and clearance over t).
+  an LCI section of the workspace), ``quality.png`` (LCI, clearance and, with a stiffness model, the deflection over t).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def summary(res: CycleResult, metrics: dict[str, float], design: dict[str, float
         "vertices": res.traj.vertices.tolist(),
         "vertex_times_s": res.traj.vertex_times.tolist(),
         "metrics": metrics,
-        "min_clearance_at": {"t_s": float(res.traj.t[k]), "segments": list(res.clearance_pair[k] or [])},
+        "min_clearance_at": {"t_s": float(res.traj.t[k]), "segments": list(res.min_clearance_pair or [])},
         "units": res.units(),
         "model": "forces: quasi-static plus payload inertia (point mass at the task point, massless links, no "
         "friction): A^T tau = [m (a - g); 0]",
@@ -56,7 +56,8 @@ def _section(cfg, design, options, res: CycleResult):
     if k == 2:
         axes, normal = (0, 1), None
     else:
-        normal = int(np.argmin(np.ptp(p, axis=0)))
+        # the axis along which the path spreads least, relative to the box (axes of different units compare)
+        normal = int(np.argmin(np.ptp(p, axis=0) / np.maximum(hi - lo, 1e-300)))
         axes = tuple(a for a in range(3) if a != normal)[:2]
     n = PATH_SECTION_RESOLUTION
     glo, step = np.zeros(3), np.ones(3)
@@ -68,7 +69,8 @@ def _section(cfg, design, options, res: CycleResult):
     if normal is not None:
         value = float(np.mean(p[:, normal]))
         glo[normal] = value - 0.5
-        label = f", section {mech.task_axes[normal]} = {value:.4g} {cfg.units.length}"
+        unit = cfg.units.length if mech.task_units[normal] == "length" else "rad"
+        label = f", section {mech.task_axes[normal]} = {value:.4g} {unit}"
     lci = sample_grid(mech.point_kernel, mech.pack(design, options), glo, step, shape)
     lci = lci.reshape(tuple(shape))
     lci2 = lci[:, :, 0] if normal in (None, 2) else (lci[:, 0, :] if normal == 1 else lci[0, :, :])
@@ -96,10 +98,13 @@ def write_plots(out_dir: Path, cfg, design, options, res: CycleResult) -> list[P
     names = [f"{cfg.mech.task_axes[a]} ({units['p_' + cfg.mech.task_axes[a]]})" for a in axes]
     figs.append(("path.png", plotting.cycle_path_figure(
         lci, extent, res.traj.p[:, list(axes)], res.traj.vertices[:, list(axes)], cfg.dexterity.band_edges,
-        names[0], names[1], f"{cfg.mech.name}: cycle path on the workspace LCI{label}")))
+        names[0], names[1], f"{cfg.mech.name}: cycle path on the workspace LCI{label}",
+        equal=cfg.mech.task_units[axes[0]] == cfg.mech.task_units[axes[1]])))
+    deflected = res.deflection is not None
     figs.append(("quality.png", plotting.cycle_quality_figure(
         res.traj.t, res.lci, res.clearance, res.traj.vertex_times, f"clearance ({res.length_unit})",
-        f"{cfg.mech.name}: LCI and link clearance along the cycle")))
+        f"{cfg.mech.name}: LCI, link clearance{' and deflection' if deflected else ''} along the cycle",
+        res.deflection, f"deflection ({res.length_unit})")))
     paths = []
     for name, fig in figs:
         rio.save_figure(fig, out_dir / name, dpi=110)

@@ -237,6 +237,31 @@ class Mechanism(ABC):
         forward Jacobian; actuator forces of a task-space force F follow from A^T tau = [F; 0]."""
         raise InvalidParameter(f"mechanism: {self.name} has no velocity map yet (cycle analysis needs it)")
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """IK in branch ``label`` and the velocity map at many poses (n, k): q (n, n_joints), NaN rows where the
+        branch does not exist, and A (n, n_joints, n_joints) (NaN there). This default loops over
+        inverse_kinematics and velocity_map (the reference); a mechanism may override it with a vectorised twin
+        that must agree with it (tests/test_cycle.py)."""
+        n, nj = len(poses), len(self.joints)
+        q = np.full((n, nj), np.nan)
+        a = np.full((n, nj, nj), np.nan)
+        for s, pose in enumerate(poses):
+            sols = {sol.label: sol.values for sol in self.inverse_kinematics(design, options, pose)}
+            if label in sols:
+                q[s] = sols[label]
+                a[s] = self.velocity_map(design, options, pose, q[s])
+        return q, a
+
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        """payload_point at many poses (n, k) -> (n, 3); this default loops, a mechanism may vectorise it."""
+        return np.array([self.payload_point(design, options, pose) for pose in poses], dtype=float).reshape(-1, 3)
+
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """Where a cycle's payload (a point mass) sits at a pose: a 3-D point of the mechanism frame (length unit).
+        Needed only by mechanisms with an angular task axis (with Cartesian task axes the payload is at the task
+        point); the cycle analysis differentiates it to get the payload's velocity and acceleration."""
+        raise InvalidParameter(f"mechanism: {self.name} has no payload point yet (cycles on its task axes need it)")
+
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
         """Statistics rows of every field for many designs (layout in kernels.grid). A mechanism may override this
         with a faster kernel that feeds the same accumulator (kernels.grid.gather_column, accumulate_cells)."""

@@ -718,6 +718,36 @@ class PauuPpap(Mechanism):
         with np.errstate(divide="ignore", invalid="ignore"):
             return jac["Jx"] / np.diag(jac["Jq"])[:, None]
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: inverse_kinematics' closed form in branch ``label`` and
+        velocity_map's A = Jq^-1 Jx at poses (n, 3) in NumPy; NaN rows out of reach."""
+        pts = np.asarray(poses, dtype=float)
+        x, y, z = pts[:, 0], pts[:, 1], pts[:, 2]
+        delta, l1, l2, e = self._chains(design, options)
+        b = z - e
+        n = len(pts)
+        q = np.empty((n, 3))
+        a = np.zeros((n, 3, 3))
+        ok = np.ones(n, dtype=bool)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for i, (side, sign) in enumerate(((1.0, label[0]), (-1.0, label[1]))):
+                u = side * x - delta
+                r = np.hypot(u, b)
+                k = (r * r + y * y + l1 * l1 - l2 * l2) / (2.0 * l1 * r)
+                ok &= (r != 0.0) & (np.abs(k) <= 1.0 + 1e-12)
+                g = np.arccos(np.clip(k, -1.0, 1.0))
+                t = wrap_angle(np.arctan2(-b, u) + (g if sign == "+" else -g))
+                q[:, i] = t
+                jq = -l1 * (u * np.sin(t) + b * np.cos(t))
+                a[:, i, 0] = side * (u - l1 * np.cos(t)) / jq
+                a[:, i, 1] = y / jq
+                a[:, i, 2] = (b + l1 * np.sin(t)) / jq
+            q[:, 2] = y
+            a[:, 2, 1] = 1.0
+        q[~ok] = np.nan
+        a[~ok] = np.nan
+        return q, a
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of paper §1 for the G-K counts, each parallelogram Pa counted as one 1-DOF joint:

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -895,6 +895,18 @@ class PprsRprs(Mechanism):
         orientation's angular velocity omega (rad/s) is 0 along a constant-orientation cycle (spec §1.5)."""
         return self.jacobians(design, options, pose, q)["Jt"]
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: chain_state of branch ``label`` at every pose (n, 3) at
+        the options' orientation and its twist Jacobian J_t (velocity_map); NaN rows where a link cannot reach."""
+        pts = np.asarray(poses, dtype=float)
+        X = np.concatenate([pts, np.tile(np.asarray(options["orientation"], dtype=float), (len(pts), 1))], axis=1)
+        geo = Geometry.of(design, options)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            st = chain_state(geo, X, sigma_vector(label))
+            jt = twist_jacobian(geo, st)
+        ok = np.asarray(st.ok, dtype=bool)
+        return np.where(ok[:, None], st.q, np.nan), np.where(ok[:, None, None], jt, np.nan)
+
     def joint_limits(self, options: Mapping[str, Any]) -> np.ndarray:
         """Limits (6, 2) of (w1, w2, beta, s1, s2, s3), mm and rad."""
         return np.array([options["w_limits"]] * 2 + [options["beta_limits"]] + [options["s_limits"]] * 3)
@@ -1027,75 +1039,6 @@ def _finite(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
         raise InvalidParameter(f"{name}: expected a finite number, got {value!r}")
     return float(value)
-
-
-# ----- drive-displacement curves (paper §5, Fig. 7) --------------------------------------------------------
-@dataclass(frozen=True)
-class DriveCurves:
-    """Actuator values along a closed path: t in [0, 1] (constant speed), points (n, 3) mm, q (n, 6) in
-    (w1, w2, beta, s1, s2, s3) mm and rad, the LCI per sample, and the worst continuation-FK error (mm)."""
-
-    t: np.ndarray
-    points: np.ndarray
-    q: np.ndarray
-    lci: np.ndarray
-    fk_error: float
-
-
-def drive_curves(
-    design: Mapping[str, float], options: Mapping[str, Any], path_points: Sequence[Sequence[float]], samples: int
-) -> DriveCurves:
-    """Walk the closed polyline ``path_points`` (x, y, z in mm; closed back to its first point) at the options'
-    orientation and branch, with ``samples`` points evenly spaced by arc length (first and last both at the
-    start). Each sample's actuators come from the closed-form IK; continuation FK (Newton from the previous
-    sample's pose) must land back on the sample, which confirms that the path stays in one assembly mode.
-
-    Raises InvalidPose naming the first sample that is out of reach, outside a limit or where continuation
-    fails (a singularity on the way).
-    """
-    from scalesynth.kernels.grid import points_lci
-    from scalesynth.paths import sample_path
-
-    mech = MECHANISM
-    design = mech.resolve_design(design)
-    options = mech.resolve_options(options)
-    pts = np.asarray(path_points, dtype=float)
-    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] < 2 or not np.all(np.isfinite(pts)):
-        raise InvalidPose(f"path_points: expected two or more finite (x, y, z) points, got shape {pts.shape}")
-    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
-        raise InvalidPose(f"samples: expected an integer >= 2, got {samples!r}")
-    if np.any(pts[-1] != pts[0]):
-        pts = np.vstack([pts, pts[:1]])
-    if np.all(pts == pts[0]):
-        raise InvalidPose("path_points: all points coincide; the path has no length")
-    path = sample_path(pts, int(samples))
-    n = path.shape[0]
-    poses = np.concatenate([path, np.tile(options["orientation"], (n, 1))], axis=1)
-    geo = Geometry.of(design, options)
-    sigma = sigma_vector(options["sigma"])
-    st = chain_state(geo, poses, sigma)
-    q = st.q
-    lims = mech.joint_limits(options)
-    outside = ~st.ok | np.any((q < lims[:, 0]) | (q > lims[:, 1]), axis=1)
-    if np.any(outside):
-        k = int(np.argmax(outside))
-        where = f"path: sample {k} at ({', '.join(f'{v:.6g}' for v in path[k])})"
-        if not st.ok[k]:
-            raise InvalidPose(f"{where} is out of reach")
-        raise InvalidPose(f"{where} puts {', '.join(mech.limit_violations(options, q[k]))} outside the limits")
-    lci = points_lci(mech.point_kernel, mech.pack(design, options), path)
-    # continuation: FK of each sample's q by Newton from the previous sample's pose
-    fk, conv = newton_fk(geo, sigma, q[1:], poses[:-1])
-    err = np.max(np.abs(fk - poses[1:]) * np.array([1, 1, 1, geo.r, geo.r, geo.r]), axis=1)
-    failed = np.nonzero(~conv | (err > 1e-6))[0]
-    if failed.size:
-        k = int(failed[0]) + 1
-        raise InvalidPose(
-            f"path: continuation FK leaves the assembly mode at sample {k} "
-            f"({', '.join(f'{v:.6g}' for v in path[k])}); a singularity lies on the path"
-        )
-    t = np.linspace(0.0, 1.0, n)
-    return DriveCurves(t=t, points=path, q=q, lci=lci, fk_error=float(np.max(err, initial=0.0)))
 
 
 MECHANISM = PprsRprs(

@@ -38,6 +38,7 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
@@ -60,9 +61,22 @@ MODELS = ("P", "C")
 C3_VARIANTS = ("plane", "upu")
 BRANCH = "+++"  # the only IK branch: every leg length is the positive root q_i = |A_i B_i|
 
-# packed-parameter layout (see RpsUpu.pack)
+# packed-parameter layout (see RpsUpu.pack); _RAD: capsule radii of base, leg1, leg2, leg3, platform (LINK_RADII
+# order); _FREE_ONLY 1: poses whose capsules overlap are unreachable
 _G, _H, _C, _E, _MODEL_C, _UPU, _QLO, _QHI, _INV_L = range(9)
-N_PACKED = 9
+_RAD = 9
+_FREE_ONLY = 14
+N_PACKED = 15
+_F_CLEARANCE = 3  # slot of the clearance field in the field kernels' out (its index in ``fields``), both workspaces
+
+# capsules of the clearance field in link_geometry's order (base12, base23, base31, leg1..3, platform12, 23, 31,
+# then the tool of rps-upu-tool) and their bodies (index into TOOL_RADII: base, leg1..3, platform, tool)
+_SEGMENT_BODY = np.array([0, 0, 0, 1, 2, 3, 4, 4, 4, 5], dtype=np.int64)
+_BODY_NAMES = ("base", "leg1", "leg2", "leg3", "platform", "tool")
+_ADJACENT = links.adjacency([("base", "leg1"), ("base", "leg2"), ("base", "leg3"), ("leg1", "platform"),
+                             ("leg2", "platform"), ("leg3", "platform"), ("tool", "platform")])
+_PAIRS = links.kernel_pairs([_BODY_NAMES[b] for b in _SEGMENT_BODY[:9]], _ADJACENT)
+_PAIRS_TOOL = links.kernel_pairs([_BODY_NAMES[b] for b in _SEGMENT_BODY], _ADJACENT)
 
 # a parametrisation is degenerate below these (dimensionless) values: yaw undefined (cos psi = 0 with
 # sin theta sin psi = 0), or, for the upu variant, R[2, 2] = cos theta cos psi = 0 (y0 unbounded)
@@ -96,13 +110,14 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
 
     Every leg vector d_i = B_i - A_i is differentiated by the chain rule through the parasitic yaw (its sine
     and cosine sf = N/n, cf = M/n with N = sin theta sin psi, M = cos psi, n = |(N, M)| = R[1, 1]) and y0; the
-    row is d_i . dB_i/dx. Returns ok = False where the parametrisation is degenerate.
+    row is d_i . dB_i/dx. Returns ok = False where the parametrisation is degenerate; then y0, sin and cos of the
+    yaw (for the platform's placement).
     """
     nn = st * sp
     mm = cp
     n2 = nn * nn + mm * mm
     if n2 < _YAW_EPS2:
-        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0
     n = math.sqrt(n2)
     sf = nn / n
     cf = mm / n
@@ -119,7 +134,7 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     if upu:
         r22 = ct * cp
         if abs(r22) < _R22_EPS:
-            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0
         r12 = sf * st * cp - cf * sp
         r12_t = sf_t * st * cp + sf * ct * cp - cf_t * sp
         r12_p = sf_p * st * cp - sf * st * sp - cf_p * sp - cf * cp
@@ -157,7 +172,43 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     r31 = d3y * y0_z + d3z
     r32 = d3x * c * (cf_t * ct - cf * st) + d3y * (y0_t + c * r10_t) + d3z * (-c * ct)
     r33 = d3x * c * cf_p * ct + d3y * (y0_p + c * r10_p)
-    return True, q1s, q2s, q3s, r11, r12_, r13, r21, r22_, r23, r31, r32, r33
+    return True, q1s, q2s, q3s, r11, r12_, r13, r21, r22_, r23, r31, r32, r33, y0, sf, cf
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _clearance(p, y0, z, st, ct, sp, cp, sf, cf, pairs, tx, ty, tz, r_tool):
+    """Smallest gap (mm) between the capsules of link_geometry that share no joint, at the platform pose
+    p = (0, y0, z), R = Rz(phi) Ry(theta) Rx(psi) (sf, cf: sine and cosine of the yaw phi; P-model 0, 1). With the
+    tool pairs (rps-upu-tool) the 10th capsule is the tool O' -> T = (tx, ty, tz) of radius r_tool."""
+    g = p[_G]
+    h = p[_H]
+    c = p[_C]
+    e = p[_E]
+    ux = cf * ct  # R x
+    uy = sf * ct
+    uz = -st
+    vx = cf * st * sp - sf * cp  # R y
+    vy = sf * st * sp + cf * cp
+    vz = ct * sp
+    b1x, b1y, b1z = -h * vx, y0 - h * vy, z - h * vz
+    b2x, b2y, b2z = h * vx, y0 + h * vy, z + h * vz
+    b3x, b3y, b3z = c * ux, y0 + c * uy, z + c * uz
+    seg = np.empty((10, 6))
+    put_segment(seg, 0, 0.0, -g, 0.0, 0.0, g, 0.0)
+    put_segment(seg, 1, 0.0, g, 0.0, e, 0.0, 0.0)
+    put_segment(seg, 2, e, 0.0, 0.0, 0.0, -g, 0.0)
+    put_segment(seg, 3, 0.0, -g, 0.0, b1x, b1y, b1z)
+    put_segment(seg, 4, 0.0, g, 0.0, b2x, b2y, b2z)
+    put_segment(seg, 5, e, 0.0, 0.0, b3x, b3y, b3z)
+    put_segment(seg, 6, b1x, b1y, b1z, b2x, b2y, b2z)
+    put_segment(seg, 7, b2x, b2y, b2z, b3x, b3y, b3z)
+    put_segment(seg, 8, b3x, b3y, b3z, b1x, b1y, b1z)
+    put_segment(seg, 9, 0.0, y0, z, tx, ty, tz)
+    radius = np.empty(10)
+    for i in range(9):
+        radius[i] = p[_RAD + _SEGMENT_BODY[i]]
+    radius[9] = r_tool
+    return min_capsule_gap(seg, pairs, radius)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -171,7 +222,8 @@ def _leg_ok(qs, lo, hi):
 def point_fields(p, x, y, z, out):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
     length leaves the stroke limits or the parametrisation is degenerate (C-model). Fields (kernels.grid contract):
-    LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless)."""
+    LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless); 3 clearance (mm) of the link capsules
+    (with interference_free, overlapping capsules make the pose unreachable)."""
     g = p[_G]
     h = p[_H]
     c = p[_C]
@@ -180,8 +232,9 @@ def point_fields(p, x, y, z, out):
     ct = math.cos(y)
     sp = math.sin(z)
     cp = math.cos(z)
+    y0, sf, cf = 0.0, 0.0, 1.0  # P-model: O' on the z axis, no yaw
     if p[_MODEL_C] > 0.0:
-        ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33 = _c_model_rows(
+        ok, q1s, q2s, q3s, a11, a12, a13, a21, a22, a23, a31, a32, a33, y0, sf, cf = _c_model_rows(
             g, h, c, e, p[_UPU] > 0.0, x, st, ct, sp, cp
         )
         if not ok:
@@ -197,8 +250,13 @@ def point_fields(p, x, y, z, out):
     if not (ok1 and ok2 and ok3):
         _grid.write_unreachable(out)
         return
+    gap = _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0)
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0:
         _grid.write_singular(out)  # inverse singularity: a leg of zero length has no direction
+        out[_F_CLEARANCE] = gap
         return
     # row i of dq/dx is (q_i dq_i/dx) / q_i; the angle columns are divided by L (homogenisation)
     i1 = 1.0 / q1
@@ -212,6 +270,7 @@ def point_fields(p, x, y, z, out):
     )  # fmt: skip
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    out[_F_CLEARANCE] = gap
 
 
 # ----- NumPy kinematics (vectorised over poses; CLI, FK and tests) ----------------------------------------
@@ -575,6 +634,7 @@ class RpsUpu(Mechanism):
                 raise InvalidParameter(f"options.characteristic_length: must be > 0, got {length:g}")
             options["characteristic_length"] = float(length)
         links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     @staticmethod
     def _check_limits(options: dict[str, Any]) -> None:
@@ -601,6 +661,9 @@ class RpsUpu(Mechanism):
         stroke = options.get("stroke_limits")
         p[_QLO], p[_QHI] = stroke if stroke is not None else (-math.inf, math.inf)
         p[_INV_L] = 1.0 / self.characteristic_length(design, options)
+        rad = links.radii(options, LINK_RADII)
+        p[_RAD : _RAD + 5] = [rad[body] for body in LINK_RADII]
+        p[_FREE_ONLY] = 1.0 if options.get("interference_free") else 0.0
         return p
 
     @property
@@ -768,6 +831,27 @@ class RpsUpu(Mechanism):
             return np.full((3, 3), np.inf)
         return jac["dq_dx"]
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: leg lengths and dq/d(z, theta, psi) (velocity_map) at
+        poses (n, 3) from the vectorised _legs; NaN rows where the branch or the C-model parametrisation fails."""
+        x = np.asarray(poses, dtype=float)
+        valid, q, jx = _legs(self._geom(design), options["model"], options["c3_variant"], x)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = np.where(np.all(q > 0.0, axis=1)[:, None, None], jx / q[:, :, None], np.inf)
+        ok = valid & (label == BRANCH)
+        return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a, np.nan)
+
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """The cycle's payload sits at the platform origin O' = (0, y0, z) (mm; y0 = 0 in the P-model)."""
+        return self._joint_points(design, options, pose)[2]
+
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        """Vectorised payload_point: O' at poses (n, 3) from the vectorised _platform; NaN where the C-model
+        parametrisation is degenerate."""
+        valid, p, _, _, _ = _platform(self._geom(design), options["model"], options["c3_variant"],
+                                      np.asarray(poses, dtype=float))
+        return np.where(valid[:, None], p, np.nan)
+
     # ----- mobility (scalesynth.mobility) -------------------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §2.2: chains RPS, RPS and UPU; n = 8 (base, platform, two links per chain),
@@ -904,7 +988,8 @@ DESIGN_METRICS = (
         lambda d, o: enclosing_circle_radius([(0.0, -d["g"]), (0.0, d["g"]), (d["e"], 0.0)]),
     ),
 )
-FIELDS = base_fields("1", "J = dx/dq, x = (z, L theta, L psi) homogenised by the characteristic length L (mm/mm)")
+FIELDS = (*base_fields("1", "J = dx/dq, x = (z, L theta, L psi) homogenised by the characteristic length L (mm/mm)"),
+          links.CLEARANCE_FIELD)
 
 MECHANISM = RpsUpu(
     name="rps-upu",
@@ -933,6 +1018,7 @@ MECHANISM = RpsUpu(
         *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
     fields=FIELDS,
@@ -942,8 +1028,8 @@ MECHANISM = RpsUpu(
 
 # ----- optional second workspace: the tool point T = O' + R (0, 0, -d) over (x, y, z) (spec §2.8) ---------
 # packed layout of the tool kernel (see RpsUpuTool.pack): the first N_PACKED entries as above, then
-_D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI = range(N_PACKED, N_PACKED + 7)
-N_PACKED_TOOL = N_PACKED + 7
+_D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI, _RAD_TOOL = range(N_PACKED, N_PACKED + 8)
+N_PACKED_TOOL = N_PACKED + 8
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -954,7 +1040,8 @@ def tool_point_fields(p, x, y, z, out):
 
     Pose from T (spec §2.8): sin psi = T_y/d, sin theta = -T_x/(d cos psi), z0 = T_z + d cos theta cos psi; then
     dq/dT = dq/d(z0, theta, psi) . d(z0, theta, psi)/dT with the closed-form inverse of dT/d(z0, theta, psi).
-    Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dT/dq (dimensionless).
+    Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dT/dq (dimensionless); 3 clearance (mm) of the
+    link capsules and the tool O' -> T (with interference_free, overlapping capsules make the pose unreachable).
     """
     d = p[_D]
     sp = y / d
@@ -987,8 +1074,13 @@ def tool_point_fields(p, x, y, z, out):
     if not (ok1 and ok2 and ok3):
         _grid.write_unreachable(out)
         return
+    gap = _clearance(p, 0.0, z0, st, ct, sp, cp, 0.0, 1.0, _PAIRS_TOOL, x, y, z, p[_RAD_TOOL])
+    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+        _grid.write_unreachable(out)
+        return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0 or ct <= 1e-12:
         _grid.write_singular(out)  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
+        out[_F_CLEARANCE] = gap
         return
     # d(z0, theta, psi)/dT, rows z0, theta, psi; columns T_x, T_y, T_z
     inv = 1.0 / (d * ct * cp)
@@ -1008,6 +1100,7 @@ def tool_point_fields(p, x, y, z, out):
     )  # fmt: skip
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
+    out[_F_CLEARANCE] = gap
 
 
 def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -1042,6 +1135,7 @@ class RpsUpuTool(RpsUpu):
             raise InvalidParameter(f"options.tool_offset: expected a length > 0 (mm), got {d!r}")
         options["tool_offset"] = float(d)
         links.check_radius_option(options, TOOL_RADII)
+        links.check_flag_option(options, "interference_free")
 
     @staticmethod
     def _p(options: Mapping[str, Any]) -> dict[str, Any]:
@@ -1051,6 +1145,7 @@ class RpsUpuTool(RpsUpu):
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.empty(N_PACKED_TOOL)
         p[:N_PACKED] = super().pack(design, self._p(options))
+        p[_RAD_TOOL] = links.radii(options, TOOL_RADII)["tool"]
         p[_D] = options["tool_offset"]
         p[_ZLO], p[_ZHI] = options["z_range"]
         p[_TLO], p[_THI] = options["theta_range"]
@@ -1167,6 +1262,39 @@ class RpsUpuTool(RpsUpu):
         jac = self.jacobians(design, options, pose, q)
         return np.full((3, 3), np.inf) if jac["dq_dT"] is None else jac["dq_dT"]
 
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics for the kernel's branch '++' (cos theta, cos psi > 0):
+        the pose of each tool point in closed form (poses_of_tool_point), its legs and dq/dT = dq/dx (dT/dx)^-1
+        (velocity_map); other branches take the per-pose loop."""
+        if label != "++":
+            return Mechanism.cycle_kinematics(self, design, options, poses, label)
+        t = np.asarray(poses, dtype=float)
+        d = options["tool_offset"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ps = np.arcsin(np.clip(t[:, 1] / d, -1.0, 1.0))
+            cp = np.cos(ps)
+            ok = (np.abs(t[:, 1]) <= d) & (np.abs(cp) > 1e-12) & (np.abs(t[:, 0]) <= d * np.abs(cp))
+            th = np.arcsin(np.clip(-t[:, 0] / (d * cp), -1.0, 1.0))
+            ct, st, sp = np.cos(th), np.sin(th), np.sin(ps)
+            x = np.column_stack([t[:, 2] + d * ct * cp, wrap_angle(th), wrap_angle(ps)])
+            _, q, jx = _legs(self._geom(design), "P", "plane", np.where(ok[:, None], x, 0.0))
+            dt_dx = np.zeros((len(t), 3, 3))
+            dt_dx[:, 0, 1], dt_dx[:, 0, 2] = -d * ct * cp, d * st * sp
+            dt_dx[:, 1, 2] = d * cp
+            dt_dx[:, 2, 0], dt_dx[:, 2, 1], dt_dx[:, 2, 2] = 1.0, d * st * cp, d * ct * sp
+            regular = ok & (np.abs(ct * cp) > 0.0)
+            safe = np.where(regular[:, None, None], dt_dx, np.eye(3))
+            jx_t = np.transpose(np.linalg.solve(np.transpose(safe, (0, 2, 1)), np.transpose(jx, (0, 2, 1))), (0, 2, 1))
+            a = np.where((regular & np.all(q > 0.0, axis=1))[:, None, None], jx_t / q[:, :, None], np.inf)
+        return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a, np.nan)
+
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """The payload sits at the tool point T = pose (mm)."""
+        return self.check_vector("pose", pose, 3)
+
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        return np.asarray(poses, dtype=float).reshape(-1, 3)
+
     def lci(self, design, options, pose, q) -> float:
         """LCI = sigma_min / sigma_max of dq/dT with NumPy's SVD (0 at any singularity)."""
         jac = self.jacobians(design, options, pose, q)
@@ -1250,8 +1378,9 @@ TOOL_MECHANISM = RpsUpuTool(
         *STIFFNESS_OPTIONS,
         Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
                "leg1/leg2/leg3 5, platform 6, tool 4 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
-    fields=base_fields("1", "J = dT/dq of the tool point (mm/mm)"),
+    fields=(*base_fields("1", "J = dT/dq of the tool point (mm/mm)"), links.CLEARANCE_FIELD),
     design_metrics=DESIGN_METRICS,
 )

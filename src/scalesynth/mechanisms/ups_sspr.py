@@ -29,8 +29,10 @@ from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
     Field,
@@ -55,6 +57,16 @@ SQRT3_2 = math.sqrt(3.0) / 2.0
 INV_SQRT2 = 1.0 / math.sqrt(2.0)
 Y_OPEN = 0.999  # default Y box = +-0.999 c: Y = +-c (rho = 0) is singular (spec §3.5)
 IK_LABEL = "Z+"  # the only IK branch: leg lengths are positive square roots, the SR link above the base
+# default capsule radii (mm), illustrative (the paper gives no cross-sections)
+LINK_RADII = {"base": 6.0, "leg1": 5.0, "leg2": 5.0, "leg3": 5.0, "link": 6.0, "platform": 6.0}
+# bodies sharing a joint: U/S of each leg on the base, S of the SR link at A0, S of the legs on the platform, the
+# SPR revolute at B0 on the link, the revolute at B1 between link and platform
+ADJACENT = (("base", "leg1"), ("base", "leg2"), ("base", "leg3"), ("base", "link"), ("leg1", "link"),
+            ("leg2", "platform"), ("leg3", "platform"), ("link", "platform"))
+# the clearance field's capsules in link_geometry's order (base12, base23, base31, strut, leg1, leg2, leg3, link,
+# platform12, platform23, platform31) and their bodies (index into LINK_RADII)
+_SEGMENT_BODY = np.array([0, 0, 0, 0, 1, 2, 3, 4, 5, 5, 5], dtype=np.int64)
+_PAIRS = links.kernel_pairs([tuple(LINK_RADII)[b] for b in _SEGMENT_BODY], links.adjacency(ADJACENT))
 
 # packed-parameter layout (see UpsSspr.pack)
 _C, _AM, _AX, _BX, _BY, _INV_L = 0, 1, 2, 3, 4, 5
@@ -63,8 +75,12 @@ _ALO, _AHI, _BLO, _BHI, _YLO, _YHI = 12, 13, 14, 15, 16, 17
 # stiffness (point_fields slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N mm^2), GJ (N mm^2) of the 'leg' and
 # 'link' groups, actuator stiffness (N/mm), load (N)
 _EA_LEG, _EI_LEG, _GJ_LEG, _EA_LINK, _EI_LINK, _GJ_LINK, _KACT, _FX, _FY, _FZ = 18, 19, 20, 21, 22, 23, 24, 25, 26, 27
-N_PACKED = 28
+# capsule radii of base, leg1, leg2, leg3, link, platform (LINK_RADII order); 1 = interference-free poses only
+_RAD = 28
+_FREE_ONLY = 34
+N_PACKED = 35
 _F_STIFFNESS_MIN, _F_DEFLECTION = 3, 4  # slots of the stiffness fields in the field kernel's out
+_F_CLEARANCE = 5  # slot of the clearance field
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -157,13 +173,52 @@ def kinematic_fields(p, alpha, beta, yy, out):
 def point_fields(p, alpha, beta, yy, out):
     """Fields at task point (alpha [rad], beta [rad], Y [mm]) (kernels.grid contract): slots 0-2 LCI, sigma_min,
     sigma_max of J = dx/dq, x = (L alpha, L beta, Y) (dimensionless); _F_STIFFNESS_MIN (N/mm) and _F_DEFLECTION
-    (mm) under the packed load (ideal joints, docs/stiffness.md); LCI -1 (and zeros) outside the workspace box or
-    the actuator limits."""
+    (mm) under the packed load (ideal joints, docs/stiffness.md); _F_CLEARANCE (mm) of link_geometry's capsules;
+    LCI -1 (and zeros) outside the workspace box or the actuator limits, or, with interference_free, where the
+    capsules overlap (an exact singular pose, a zero-length leg, has clearance 0)."""
     ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
     if ok:
+        gap = _clearance(p, sa, ca, sb, cb, px, yy, pz)
+        if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+            _grid.write_unreachable(out)
+            return
         out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+        out[_F_CLEARANCE] = gap
     elif out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
         out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _clearance(p, sa, ca, sb, cb, px, py, pz):
+    """Smallest gap (mm) between the capsules of link_geometry that share no joint at the pose with P = B1 =
+    (px, py, pz) and R = Ry(beta) Rx(alpha) (sines and cosines given); negative where two of them overlap."""
+    am = p[_AM]
+    ax = p[_AX]
+    bx = p[_BX]
+    by = p[_BY]
+    # B2, B3 = P + R (-+bx, by, 0)
+    b2x = px - cb * bx + sb * sa * by
+    b2y = py + ca * by
+    b2z = pz + sb * bx + cb * sa * by
+    b3x = px + cb * bx + sb * sa * by
+    b3y = b2y
+    b3z = pz - sb * bx + cb * sa * by
+    seg = np.empty((11, 6))
+    put_segment(seg, 0, 0.0, 2.0 * am, 0.0, -ax, -am, 0.0)
+    put_segment(seg, 1, -ax, -am, 0.0, ax, -am, 0.0)
+    put_segment(seg, 2, ax, -am, 0.0, 0.0, 2.0 * am, 0.0)
+    put_segment(seg, 3, 0.0, 0.0, 0.0, 0.0, -am, 0.0)
+    put_segment(seg, 4, 0.0, -am, 0.0, K0 * px, K0 * py, K0 * pz)
+    put_segment(seg, 5, -ax, -am, 0.0, b2x, b2y, b2z)
+    put_segment(seg, 6, ax, -am, 0.0, b3x, b3y, b3z)
+    put_segment(seg, 7, 0.0, 0.0, 0.0, px, py, pz)
+    put_segment(seg, 8, px, py, pz, b2x, b2y, b2z)
+    put_segment(seg, 9, b2x, b2y, b2z, b3x, b3y, b3z)
+    put_segment(seg, 10, b3x, b3y, b3z, px, py, pz)
+    radius = np.empty(11)
+    for i in range(11):
+        radius[i] = p[_RAD + _SEGMENT_BODY[i]]
+    return min_capsule_gap(seg, _PAIRS, radius)
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -314,6 +369,8 @@ class UpsSspr(Mechanism):
                 raise InvalidParameter(f"options.characteristic_length: expected a number > 0 or null, got {value!r}")
             options["characteristic_length"] = float(value)
         check_stiffness_options(options, 3, LINK_GROUPS)
+        links.check_radius_option(options, LINK_RADII)
+        links.check_flag_option(options, "interference_free")
 
     def characteristic_length(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         """L in mm (default c): the angle columns of Jx are divided by L before conditioning."""
@@ -355,6 +412,9 @@ class UpsSspr(Mechanism):
             p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
         p[_KACT] = options["actuator_stiffness"]
         p[_FX], p[_FY], p[_FZ] = options["load"]
+        rad = links.radii(options, LINK_RADII)
+        p[_RAD : _RAD + 6] = [rad[body] for body in LINK_RADII]
+        p[_FREE_ONLY] = 1.0 if options["interference_free"] else 0.0
         return p
 
     @property
@@ -553,6 +613,92 @@ class UpsSspr(Mechanism):
             out.append(Solution(label, np.array([alpha, beta, yy])))
         return out
 
+    # ----- link geometry, velocity map, payload point (scalesynth.cycle) ----------------------------------
+    def joint_points(self, design, options, pose) -> dict[str, np.ndarray]:
+        """Joint centres (mm, base frame A0-xyz of spec §3.1) at a pose (alpha, beta, Y) with |Y| < c: A0 (origin),
+        A1, A2, A3, M (base), B0 = k0 B1 (SPR revolute on the link), B1 = P, B2, B3 (platform)."""
+        alpha, beta, yy = self.check_vector("pose", pose, 3)
+        a, b, c = design["a"], design["b"], design["c"]
+        if not abs(yy) < c:
+            raise InvalidPose(f"pose: |Y| = {abs(yy):g} must be below c = {c:g}")
+        rho = math.sqrt(c * c - yy * yy)
+        sa, ca, sb, cb = math.sin(alpha), math.cos(alpha), math.sin(beta), math.cos(beta)
+        rot = np.array([[cb, sb * sa, sb * ca], [0.0, ca, -sa], [-sb, cb * sa, cb * ca]])  # Ry(beta) Rx(alpha)
+        p = np.array([sb * rho, yy, cb * rho])
+        bxy = b * INV_SQRT2
+        return {
+            "A0": np.zeros(3), "A1": np.array([0.0, a, 0.0]), "A2": np.array([-SQRT3_2 * a, -a / 2.0, 0.0]),
+            "A3": np.array([SQRT3_2 * a, -a / 2.0, 0.0]), "M": np.array([0.0, -a / 2.0, 0.0]), "B0": K0 * p,
+            "B1": p, "B2": p + rot @ np.array([-bxy, bxy, 0.0]), "B3": p + rot @ np.array([bxy, bxy, 0.0]),
+        }
+
+    def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
+        """Capsules (mm) at a pose (alpha, beta, Y): the base triangle A1 A2 A3 (its side A2A3 holds M) and the
+        strut A0 -> M; leg1 the SPR actuator M -> B0, leg2/leg3 the UPS actuators A_i -> B_i (cylinder and rod as
+        one capsule); link the SR link A0 -> B1 (B0 on it); platform the triangle B1 B2 B3. Adjacent: base with
+        leg1, leg2, leg3 and link; leg1-link (revolute at B0); leg2/leg3-platform; link-platform (revolute at B1).
+        q is not needed (the legs follow from the pose). Radii: option ``link_radius``, defaults LINK_RADII."""
+        j = self.joint_points(design, options, pose)
+        rad = links.radii(options, LINK_RADII)
+        parts = [("base12", "base", "A1", "A2"), ("base23", "base", "A2", "A3"), ("base31", "base", "A3", "A1"),
+                 ("strut", "base", "A0", "M"), ("leg1", "leg1", "M", "B0"), ("leg2", "leg2", "A2", "B2"),
+                 ("leg3", "leg3", "A3", "B3"), ("link", "link", "A0", "B1"), ("platform12", "platform", "B1", "B2"),
+                 ("platform23", "platform", "B2", "B3"), ("platform31", "platform", "B3", "B1")]
+        segments = tuple(links.Segment(n, body, j[a], j[b], rad[body]) for n, body, a, b in parts)
+        return links.LinkGeometry(segments, links.adjacency(ADJACENT))
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """Jx = dl/d(alpha, beta, Y) (mm/rad, mm/rad, mm/mm): l_dot = Jx x_dot (Jq = I); infinite where Jx is
+        undefined (|Y| = c or a zero-length leg)."""
+        jx = self.jacobians(design, options, pose)["Jx"]
+        return np.where(np.isfinite(jx), jx, np.inf)
+
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """Vectorised twin of Mechanism.cycle_kinematics: _legs' leg lengths and rows of Jx (velocity_map) at poses
+        (n, 3) in NumPy; NaN rows where |Y| > c (no Z > 0 assembly) or for another branch label."""
+        x = np.asarray(poses, dtype=float)
+        a, b, c = design["a"], design["b"], design["c"]
+        alpha, beta, yy = x[:, 0], x[:, 1], x[:, 2]
+        am, ax, bxy = a / 2.0, SQRT3_2 * a, b * INV_SQRT2
+        n = len(x)
+        q = np.empty((n, 3))
+        jx = np.empty((n, 3, 3))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rho = np.sqrt(np.maximum(c * c - yy * yy, 0.0))
+            sa, ca, sb, cb = np.sin(alpha), np.cos(alpha), np.sin(beta), np.cos(beta)
+            px, pz = sb * rho, cb * rho
+            q[:, 0] = np.sqrt(np.maximum(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy, 0.0))
+            jx[:, 0, :2] = 0.0
+            jx[:, 0, 2] = np.where(q[:, 0] > 0.0, K0 * am / q[:, 0], np.inf)
+            for i, sx in ((1, -1.0), (2, 1.0)):
+                rbx = cb * sx * bxy + sb * sa * bxy
+                rby = ca * bxy
+                rbz = -sb * sx * bxy + cb * sa * bxy
+                d0, d1, d2 = px + rbx - sx * ax, yy + rby + am, pz + rbz
+                ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                q[:, i] = ln
+                rows = np.stack([(d0 * sb * ca * bxy - d1 * sa * bxy + d2 * cb * ca * bxy) / ln,
+                                 (d0 * (pz + rbz) - d2 * (px + rbx)) / ln,
+                                 (d1 - (d0 * sb + d2 * cb) * yy / rho) / ln], axis=-1)
+                jx[:, i] = np.where(((ln > 0.0) & (rho > 0.0))[:, None], rows, np.nan)
+        a_map = np.where(np.isfinite(jx), jx, np.inf)
+        ok = (np.abs(yy) <= c) & (label == IK_LABEL)
+        return np.where(ok[:, None], q, np.nan), np.where(ok[:, None, None], a_map, np.nan)
+
+    def payload_points(self, design, options, poses) -> np.ndarray:
+        """Vectorised payload_point: B1 = (sin(beta) rho, Y, cos(beta) rho) at poses (n, 3); NaN where |Y| >= c."""
+        x = np.asarray(poses, dtype=float)
+        c = design["c"]
+        with np.errstate(invalid="ignore"):
+            rho = np.sqrt(c * c - x[:, 2] ** 2)
+        out = np.column_stack([np.sin(x[:, 1]) * rho, x[:, 2], np.cos(x[:, 1]) * rho])
+        return np.where((np.abs(x[:, 2]) < c)[:, None], out, np.nan)
+
+    def payload_point(self, design, options, pose) -> np.ndarray:
+        """The cycle's payload sits at B1 = P = (sin(beta) rho, Y, cos(beta) rho) (mm), the platform's reference
+        point (where the stiffness model's load acts)."""
+        return self.joint_points(design, options, pose)["B1"]
+
     # ----- mobility (scalesynth.mobility) ---------------------------------------------------------
     def topology(self, design, options):
         """Joint list of spec §3.2: chains UPS, UPS and the hybrid (S+SPR)R (S at A0 on the link A0B1, the
@@ -684,6 +830,9 @@ MECHANISM = UpsSspr(
             None,
             "L in mm homogenising the Jacobian (angle columns / L) for the LCI, null = c",
         ),
+        Option("link_radius", None, "capsule radius (mm) of every body, or {body: radius}; null = defaults base 6, "
+               "leg1/leg2/leg3 5, link 6, platform 6 (illustrative)"),
+        Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
         *stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness of each linear actuator, N/mm (an assumption)",
                            [0.0, 0.0, -150.0], "default 150 N along -z, the gravity direction (z up)"),
     ),
@@ -694,6 +843,7 @@ MECHANISM = UpsSspr(
               "under a pure force (ideal joints, Euler-Bernoulli links, actuator springs; docs/stiffness.md)", "max"),
         Field("deflection", "{length}", "magnitude of the deflection of B1 under options.load (default 150 N along "
               "-z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP)),
+        links.CLEARANCE_FIELD,
     ),
     design_metrics=(
         DesignMetric(
