@@ -454,11 +454,13 @@ def _targets(data: dict) -> list[str]:
     if "compile_commands" in data:
         mechs = data["compile_commands"]["result"]["mechanisms"]
         n2 = sum(r["round2"]["compiled"] for m in mechs for r in m["commands"])
-        worst = max(next(r for r in m["commands"] if r["command"] == "evaluate")["round2"]["cpu_s"] for m in mechs)
+        firsts = [next(r for r in m["commands"] if r["command"] == "evaluate")["round2"].get("first_grid_cpu_s")
+                  for m in mechs]
         rows.append(("second process compiles nothing, every mechanism and command",
                      f"{n2} compilations in {sum(len(m['commands']) for m in mechs)} second processes", n2 == 0))
-        rows.append(("second-process `evaluate` (whole process) under 1 s CPU, every mechanism",
-                     f"{worst:.2f} s CPU (worst)", worst < 1.0))
+        if all(f is not None for f in firsts):
+            rows.append(("second process reaches its first evaluation in < 1 s (CPU, from the process start), "
+                         "every mechanism", f"{max(firsts):.2f} s CPU (worst)", max(firsts) < 1.0))
     if "synthesis" in data:
         cfgs = [c for c in data["synthesis"]["result"]["configs"] if "error" not in c["loop"]]
         fast = [c["config"] for c in cfgs if c["loop"]["projected_loop_s"] <= synthesis.GOAL_LOOP_S]

@@ -9,7 +9,9 @@ the event), so a process whose cache is complete records none.
 REPORT.json gets one entry per command: ``compiled`` (qualified names, in order, nested callees included),
 ``compile_s`` (wall seconds inside outermost compilations), ``jit_s`` (wall seconds inside outermost
 ``Dispatcher.compile`` calls: compilations and disk-cache loads, what JIT costs the command), ``wall_s`` /
-``cpu_s`` of the command (the first command's include the process start and the imports) and ``exit_code``.
+``cpu_s`` of the command (the first command's include the process start and the imports), ``exit_code``, and
+``first_grid_s`` / ``first_grid_cpu_s``: wall and CPU seconds from the process start to the end of the process's
+first workspace-grid evaluation (``Mechanism.grid_stats``; None if the command made none).
 Used by tests/test_compile_cache.py and by benchmarks/compile_once.py, which both run ``commands()``.
 """
 
@@ -41,6 +43,26 @@ def _timed_compile(self, sig):
 
 
 dispatcher.Dispatcher.compile = _timed_compile
+FIRST_GRID: dict[str, float] = {}
+
+
+def _watch_grid_stats() -> None:
+    """Record when the first Mechanism.grid_stats call of the process returns (every registered class)."""
+    from scalesynth.mechanisms import available, get
+
+    classes = {c for name in available() for c in type(get(name)).__mro__ if "grid_stats" in c.__dict__}
+    for cls in classes:
+        original = cls.__dict__.get("grid_stats")
+        if original is None:
+            continue
+
+        def timed(self, *args, _original=original, **kwargs):
+            out = _original(self, *args, **kwargs)
+            if not FIRST_GRID:
+                FIRST_GRID.update(wall=time.perf_counter() - T0, cpu=time.process_time() - C0)
+            return out
+
+        cls.grid_stats = timed
 
 
 class CompileRecorder(event.Listener):
@@ -123,6 +145,9 @@ def main(argv: list[str]) -> None:
         event.register("numba:compile", rec)
         from scalesynth.cli import main as cli_main  # the first command's record includes the imports
 
+        if not results:
+            _watch_grid_stats()
+
         code = 0
         try:
             cli_main(args)
@@ -131,7 +156,8 @@ def main(argv: list[str]) -> None:
         event.unregister("numba:compile", rec)
         t1, c1 = time.perf_counter(), time.process_time()
         results.append({"args": args, "exit_code": code, "compiled": rec.compiled, "compile_s": rec.compile_s,
-                        "jit_s": JIT["s"], "wall_s": t1 - t0, "cpu_s": c1 - c0})
+                        "jit_s": JIT["s"], "wall_s": t1 - t0, "cpu_s": c1 - c0,
+                        "first_grid_s": FIRST_GRID.get("wall"), "first_grid_cpu_s": FIRST_GRID.get("cpu")})
         t0, c0 = t1, c1
     with open(report, "w", encoding="utf-8") as fh:
         json.dump(results, fh, indent=1)
