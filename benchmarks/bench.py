@@ -8,6 +8,9 @@
     python benchmarks/bench.py compile      # JIT: first call (empty cache) vs second process (cache)
     python benchmarks/bench.py stiffness    # five-bar stiffness fields vs the kinematic fields alone, per voxel
     python benchmarks/bench.py fastpath     # seed 000's fast path: this tree vs a baseline git ref (default 2524d65)
+    python benchmarks/bench.py compile_commands  # every CLI command per mechanism: second process compiles nothing
+    python benchmarks/bench.py synthesis    # every config: ms/design, projected 200 x 200 NSGA-II loop, peak memory
+    python benchmarks/bench.py show         # `scalesynth show` at resolution 96: wall, CPU and JIT seconds per process
 
 Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
 Speed targets are compared as ratios measured in one run; absolute times are stated with the machine.
@@ -33,6 +36,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import adaptive as adaptive_bench  # noqa: E402  (benchmarks/adaptive.py: issue-15 parts)
+import compile_once  # noqa: E402  (benchmarks/compile_once.py: issue 15, compile once per command)
+import show_speed  # noqa: E402  (benchmarks/show_speed.py: issue 14, show of a 3-D design)
+import synthesis  # noqa: E402  (benchmarks/synthesis.py: issue 15, per-config paper-scale table and memory)
 
 from scalesynth.config import load_config  # noqa: E402
 from scalesynth.evaluate import evaluate_population, make_grid  # noqa: E402
@@ -333,7 +339,9 @@ def bench_fastpath(baseline: str = FASTPATH_BASELINE, rounds: int = 3) -> dict:
 
 PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": bench_paper, "growth": bench_growth,
          "compile": bench_compile, "fastpath": bench_fastpath, "stiffness": bench_stiffness,
-         "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all}
+         "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all,
+         "compile_commands": compile_once.bench_compile_commands, "synthesis": synthesis.bench_synthesis,
+         "show": show_speed.bench_show}
 
 
 def write_results_md() -> None:
@@ -343,13 +351,21 @@ def write_results_md() -> None:
         if path.exists():
             data[name] = json.loads(path.read_text())
     lines = ["# Benchmark results", "",
-             "Rebuilt by `python benchmarks/bench.py all` (or one part: `evaluator`, `accuracy`, `paper`, `growth`,",
-             "`compile`, `fastpath`, `stiffness`). Each section states the machine and date it was measured on.", ""]
+             "Rebuilt by `python benchmarks/bench.py all` (or one part: " + ", ".join(f"`{p}`" for p in PARTS) + ").",
+             "Each section states the machine and date it was measured on.", ""]
     lines += _targets(data)
     for part, title in (("compile_all", "Issue 15: compile once, per mechanism"),
                         ("adaptive", "Issue 15: adaptive evaluator against uniform grids at equal accuracy")):
         if part in data:
             lines += _header(title, data[part]) + adaptive_bench.markdown({part: data[part]})
+    for part, title, module in (
+            ("compile_commands", "Issue 15: compile once, every command of every mechanism", compile_once),
+            ("synthesis", "Issue 15: every config at paper scale (200 x 200): time per design, NSGA-II loop, "
+             "peak memory", synthesis),
+            ("show", "Issue 14: `scalesynth show` of a 3-D design at resolution 96 (target: within 10 s with a warm "
+             "cache)", show_speed)):
+        if part in data and "result" in data[part]:
+            lines += _header(title, data[part]) + module.markdown(data[part])
     if "evaluator" in data:
         d = data["evaluator"]
         lines += _header("Evaluator throughput: Numba vs NumPy twin (same process, Table-4 designs)", d)
@@ -480,6 +496,26 @@ def _targets(data: dict) -> list[str]:
         c = data["compile"]["result"]
         rows.append(("second process reuses compiled code", f"{c['empty_cache']['first_evaluate_s']:.1f} s -> "
                      f"{c['cached']['first_evaluate_s']:.2f} s", c["cached"]["first_evaluate_s"] < c["empty_cache"]["first_evaluate_s"] / 5))
+    if "compile_commands" in data:
+        mechs = data["compile_commands"]["result"]["mechanisms"]
+        n2 = sum(r["round2"]["compiled"] for m in mechs for r in m["commands"])
+        firsts = [next(r for r in m["commands"] if r["command"] == "evaluate")["round2"].get("first_grid_cpu_s")
+                  for m in mechs]
+        rows.append(("second process compiles nothing, every mechanism and command",
+                     f"{n2} compilations in {sum(len(m['commands']) for m in mechs)} second processes", n2 == 0))
+        if all(f is not None for f in firsts):
+            rows.append(("second process reaches its first evaluation in < 1 s (CPU, from the process start), "
+                         "every mechanism", f"{max(firsts):.2f} s CPU (worst)", max(firsts) < 1.0))
+    if "synthesis" in data:
+        cfgs = [c for c in data["synthesis"]["result"]["configs"] if "error" not in c["loop"]]
+        fast = [c["config"] for c in cfgs if c["loop"]["projected_loop_s"] <= synthesis.GOAL_LOOP_S]
+        small = [c["config"] for c in cfgs if c["loop"]["peak_rss_mib"] <= synthesis.GOAL_PEAK_MIB]
+        worst = max(c["loop"]["peak_rss_mib"] for c in cfgs) if cfgs else float("nan")
+        n = len(data["synthesis"]["result"]["configs"])
+        rows.append(("200 x 200 NSGA-II loop <= 30 s, every config (projected)", f"{len(fast)} of {n} configs",
+                     len(fast) == n))
+        rows.append(("paper-scale run peak memory <= 1 GiB, every config", f"{len(small)} of {n} configs "
+                     f"(worst {worst:.0f} MiB)", len(small) == n))
     if "stiffness" in data:
         srows = _stiffness_rows(data["stiffness"]["result"])
         worst = max(r["ratio"] for r in srows)
