@@ -463,6 +463,9 @@ def write_results_md() -> None:
         if stale:
             lines += [f"Measured before the multi-field kernels ({MULTI_FIELD_DATE} UTC) and pending re-measurement "
                       "on an idle machine: " + ", ".join(stale) + ".", ""]
+    # sections written by hand from standalone scripts (e.g. benchmarks/cycle_speed.py), kept verbatim
+    for note in sorted((ROOT / "benchmarks" / "notes").glob("*.md")):
+        lines += [note.read_text().rstrip("\n"), ""]
     (ROOT / "benchmarks" / "RESULTS.md").write_text("\n".join(lines) + "\n")
 
 
