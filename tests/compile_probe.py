@@ -85,7 +85,7 @@ class CompileRecorder(event.Listener):
 
 # a reachable pose of the mechanism's default design for `scalesynth stiffness` (task coordinates, those of
 # tests/test_stiffness*.py); a mechanism not listed gets its config design's best-LCI cell of a coarse grid
-STIFFNESS_POSE = {"planar-fivebar": "0,-725", "ups-sspr": "0.5,0.25,47.6"}
+STIFFNESS_POSE = {"planar-fivebar": "0,-725", "ups-sspr": "0.5,0.25,47.6", "rps-upu-tool": "0.19,0,4"}
 
 
 def commands(config: Path, out: Path, small: bool = False) -> list[tuple[str, list[str]]]:
