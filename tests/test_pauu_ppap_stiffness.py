@@ -52,10 +52,12 @@ def test_slots_and_layout():
 @pytest.mark.parametrize(("design", "opts"), CASES)
 def test_fields_equal_the_reference_solver_at_random_reachable_poses(design, opts):
     """12 random reachable poses per design in its bounding box: stiffness_min (N/m) and deflection (m) equal the
-    reference solver on stiffness_model's frame to 1e-7 relative (measured <= 2e-11); unreachable poses write 0."""
+    reference solver on stiffness_model's frame to 1e-7 relative (measured <= 2e-11); unreachable poses write 0, and
+    so do all poses without options.stiffness_metrics."""
     design = M.resolve_design(design)
-    opt = M.resolve_options(opts)
+    opt = M.resolve_options({**opts, "stiffness_metrics": True})
     p = M.pack(design, opt)
+    off = M.pack(design, M.resolve_options(opts))
     lo, hi = M.bounding_box(design, opt)
     rng = np.random.default_rng(len(CASES) + int(1e3 * design["m"]))
     checked = 0
@@ -65,6 +67,9 @@ def test_fields_equal_the_reference_solver_at_random_reachable_poses(design, opt
         if out[0] < 0:
             assert out[KMIN] == 0.0 and out[DEFL] == 0.0
             continue
+        # without options.stiffness_metrics the stiffness slots are written as 0, the other slots unchanged
+        without = fields_at(off, pose)
+        assert without[KMIN] == 0.0 and without[DEFL] == 0.0 and np.array_equal(without[:KMIN], out[:KMIN])
         res = solve(M.stiffness_model(design, opt, pose))
         assert not res.singular and res.dofs == ("x", "y", "z")
         assert out[KMIN] == pytest.approx(res.stiffness_min, rel=1e-7), pose
@@ -155,7 +160,7 @@ def test_near_the_forward_singularity_the_deflection_grows_with_the_reference_an
     without deforming anything: the deflection under a load with an x component grows without bound, in step with
     the reference solver, while the kernel stays finite and never NaN; stiffness_min -> 0."""
     design = M.resolve_design({})
-    opt = M.resolve_options({"load": [50.0, 0.0, -150.0]})
+    opt = M.resolve_options({"load": [50.0, 0.0, -150.0], "stiffness_metrics": True})
     p = M.pack(design, opt)
 
     def det_jx(z):

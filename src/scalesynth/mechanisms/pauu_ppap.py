@@ -200,26 +200,39 @@ def _stiffness(p, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2):
         p[_FX], p[_FX + 1], p[_FX + 2])
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_stiffness(p, out, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2):
+    """Slots _F_STIFFNESS_MIN, _F_DEFLECTION of a reachable pose: _stiffness when the packed options ask for it
+    (options.stiffness_metrics), else 0 (written: the grid kernels reuse ``out``)."""
+    if p[_STIFFNESS_STATS] > 0.0:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2)
+    else:
+        out[_F_STIFFNESS_MIN] = 0.0
+        out[_F_DEFLECTION] = 0.0
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """Fields at P = (x, y, z) in the packed working mode (kernels.grid contract): LCI (1/kappa_2 of J), sigma_min
     and sigma_max of J = dx/dq, clearance of the link capsules (length unit), stiffness_min (N/m) and deflection
-    (m) under the packed load (ideal joints, docs/stiffness.md; _stiffness); LCI -1 (and zeros) if unreachable
+    (m) under the packed load (ideal joints, docs/stiffness.md; _stiffness; 0 unless options.stiffness_metrics);
+    LCI -1 (and zeros) if unreachable
     (or, with interference_free, where the capsules overlap)."""
-    _fields(p, x, y, z, out, True)
+    _fields(p, x, y, z, out, True, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def kinematic_fields(p, x, y, z, out):
     """Slots 0-2 of point_fields (LCI, sigma_min, sigma_max) without the clearance and stiffness: the fast path's
     kernel for the cells it does not vectorise (theta limits); ``out`` needs N_FIELDS slots."""
-    _fields(p, x, y, z, out, False)
+    _fields(p, x, y, z, out, False, False)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, with_clearance):
-    """point_fields (with_clearance True: every field, clearance and stiffness included) or kinematic_fields
-    (False; a constant, so each copy keeps one branch)."""
+def _fields(p, x, y, z, out, with_clearance, with_stiffness):
+    """point_fields (both True) or kinematic_fields (both False; constants, so each copy keeps its branches). The
+    stiffness fields are computed only when the packed options ask for them (options.stiffness_metrics), so that
+    the generic kernel run for the clearance metrics alone does not pay for them (they stay 0 otherwise)."""
     if z < p[_ZMIN] or y < p[_DLO] or y > p[_DHI]:
         _grid.write_unreachable(out)
         return
@@ -258,7 +271,8 @@ def _fields(p, x, y, z, out, with_clearance):
         _grid.write_singular(out)  # inverse (type-1) singularity; the structure's stiffness stays finite
         if with_clearance:
             out[_F_CLEARANCE] = gap
-            out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
+        if with_stiffness:
+            _put_stiffness(p, out, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
         return
     # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J), sigma(J) = 1 / sigma(M)
     iq1 = 1.0 / q1
@@ -268,7 +282,8 @@ def _fields(p, x, y, z, out, with_clearance):
     out[1], out[2] = inverse_singular_values(smin, smax)
     if with_clearance:
         out[_F_CLEARANCE] = gap
-        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
+    if with_stiffness:
+        _put_stiffness(p, out, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -579,8 +594,8 @@ CLEARANCE = dataclasses.replace(
     "illustrative)",
 )
 
-# The stiffness fields (slots 4, 5). Like the clearance they need the generic grid kernel, so their metrics are
-# evaluated only for configs that ask for them (options.stiffness_metrics: true); the field kernel always writes them.
+# The stiffness fields (slots 4, 5). Like the clearance they need the generic grid kernel, so they are computed and
+# their metrics evaluated only for configs that ask for them (options.stiffness_metrics: true; else they are 0).
 STIFFNESS_FIELDS = (
     Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at P (ideal "
           "joints, Euler-Bernoulli links, actuator springs, the PPaP chain rigid; docs/stiffness.md); its metrics "
@@ -980,8 +995,9 @@ MECHANISM = PauuPpap(
                "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative); setting it enables the "
                "clearance metrics"),
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
-        Option("stiffness_metrics", False, "stiffness: true evaluates the statistics of the per-voxel fields "
-               "stiffness_min and deflection (their metrics need it: the generic kernel, slower than the fast path)"),
+        Option("stiffness_metrics", False, "stiffness: true computes the per-voxel fields stiffness_min and "
+               "deflection (0 otherwise) and enables their metrics; grid statistics then use the generic kernel, "
+               "slower than the fast path"),
     ),
     default_length_unit="m",
     fields=(*base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is "
@@ -989,4 +1005,4 @@ MECHANISM = PauuPpap(
     design_metrics=DESIGN_METRICS,
 )
 assert MECHANISM.n_fields == N_KERNEL_FIELDS and MECHANISM.field_names[_F_CLEARANCE] == "clearance"
-assert MECHANISM.field_names[_F_STIFFNESS_MIN] == "stiffness_min" and MECHANISM.field_names[_F_DEFLECTION] == "deflection"
+assert MECHANISM.field_names[_F_STIFFNESS_MIN :] == ("stiffness_min", "deflection")
