@@ -205,3 +205,36 @@ def test_translational_response_singular_and_zero_load_never_nan():
     assert legs.response_translational(*K[np.triu_indices(3)], 0.0, 0.0, 0.0) == (0.0, 0.0)
     assert legs.response_translational(math.nan, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0) == (0.0,
                                                                                               legs.DEFLECTION_CAP)
+
+
+def test_a_synthesis_with_a_deflection_constraint_runs_and_its_task_statistic_is_the_cells_maximum(tmp_path):
+    """A small NSGA-II run of seed 000 maximising volume and task_min_stiffness_min under task_max_deflection <= 0.5 m
+    (the default slender tubes): the results carry the stiffness columns, every feasible design meets the constraint, and the config
+    design's task_max_deflection is the largest deflection of the reference solver over the task grid's reachable
+    cells (the uniform task grid)."""
+    from scalesynth.evaluate import evaluate_config, task_grid
+    from scalesynth.optimize import run
+
+    task = {"box": {"x": [-0.4, 0.4], "y": [-0.3, 0.3], "z": [1.2, 2.0]}, "resolution": 3}
+    data = dict(SMALL, options={"stiffness_metrics": True}, task=task, grid={"resolution": 8},
+                algorithm={"pop_size": 8, "n_gen": 2, "seed": 3},
+                objectives=[{"metric": "volume"}, {"metric": "task_min_stiffness_min", "sense": "max"}],
+                constraints=[{"metric": "task_max_deflection", "max": 0.5}])
+    cfg = config_from_dict(data)
+    result = run(cfg, tmp_path / "out", plots=False)
+    pop = result.population
+    assert {"task_max_deflection_m", "task_min_stiffness_min_N_per_m", "max_deflection_m"} <= set(pop.columns)
+    assert np.all(np.isfinite(pop["task_max_deflection_m"]))
+    assert (pop["task_max_deflection_m"] > 0.5).any()  # the constraint binds (seed 3: up to 0.69 m)
+    feasible = result.pareto
+    assert len(feasible) and (feasible["task_max_deflection_m"] <= 0.5).all()
+    rep = evaluate_config(cfg).metrics
+    design, opt = cfg.resolved_design(), cfg.resolved_options()
+    tg = task_grid(M, cfg.task, 8)
+    defl = []
+    for idx in np.ndindex(3, 3, 3):
+        pose = tg.lo + (np.array(idx) + 0.5) * tg.step
+        if fields_at(M.pack(design, opt), pose)[0] >= 0:
+            defl.append(solve(M.stiffness_model(design, opt, pose)).deflection_norm)
+    assert len(defl) >= 10
+    assert rep["task_max_deflection_m"] == pytest.approx(max(defl), rel=1e-7)
