@@ -208,10 +208,10 @@ def test_translational_response_singular_and_zero_load_never_nan():
 
 
 def test_a_synthesis_with_a_deflection_constraint_runs_and_its_task_statistic_is_the_cells_maximum(tmp_path):
-    """A small NSGA-II run of seed 000 maximising volume and task_min_stiffness_min under task_max_deflection <= 0.5 m
-    (the default slender tubes): the results carry the stiffness columns, every feasible design meets the constraint, and the config
-    design's task_max_deflection is the largest deflection of the reference solver over the task grid's reachable
-    cells (the uniform task grid)."""
+    """A small NSGA-II run of seed 000 maximising volume and task_min_stiffness_min under task_max_deflection
+    <= 0.5 m (the default slender tubes): the results carry the stiffness columns, every feasible design meets the
+    constraint, and the config design's task_max_deflection is the largest deflection of the reference solver over
+    the task grid's reachable cells (the uniform task grid)."""
     from scalesynth.evaluate import evaluate_config, task_grid
     from scalesynth.optimize import run
 
