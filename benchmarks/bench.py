@@ -222,10 +222,13 @@ def bench_compile() -> dict:
     return out
 
 
-STIFFNESS_CASES = (  # (label, config, module of the field kernel, kinematic slots, grid N per axis, designs)
+STIFFNESS_CASES = (  # (label, config, module of the field kernel, kinematic slots, grid N per axis, designs[,
+    # a flag option that switches the stiffness on: then `kinematic` is point_fields with it off, `full` with it on])
     ("planar-fivebar", "fivebar_stiffness.yaml", "planar_fivebar", 3, 256, 40),
     ("ups-sspr", "ups_sspr.yaml", "ups_sspr", 3, 40, 20),
     ("pprs-rprs", "pprs_rprs.yaml", "pprs_rprs", 4, 40, 20),  # kinematic part: LCI, sigmas and clearance
+    ("2pauu-ppap", "paper_2pauu_ppap.yaml", "pauu_ppap", 6, 40, 20, "stiffness_metrics"),  # the same: LCI, sigmas,
+    # clearance (the generic kernel, which the stiffness metrics need; the fast path computes neither)
 )
 
 
@@ -236,22 +239,29 @@ def bench_stiffness(repeat: int = 5) -> dict:
     import importlib
 
     rows = []
-    for label, config, module, n_kin, n, n_designs in STIFFNESS_CASES:
+    for label, config, module, n_kin, n, n_designs, *flag in STIFFNESS_CASES:
         mod = importlib.import_module(f"scalesynth.mechanisms.{module}")
+        kin_kernel = mod.point_fields if flag else mod.kinematic_fields
         cfg = load_config(ROOT / "configs" / config)
         mech, opts = cfg.mech, cfg.resolved_options()
         rng = np.random.default_rng(12)
         designs = [mech.resolve_design({k: float(rng.uniform(*cfg.bounds[k])) for k in cfg.bounds})
                    for _ in range(n_designs)]
         packed = np.stack([mech.pack(d, opts) for d in designs])
+        packed_kin = packed
+        if flag:
+            on = mech.resolve_options({**cfg.options, flag[0]: True})
+            packed_kin = np.stack([mech.pack(d, mech.resolve_options({**cfg.options, flag[0]: False}))
+                                   for d in designs])
+            packed = np.stack([mech.pack(d, on) for d in designs])
         grids = [make_grid(mech, d, opts, n) for d in designs]
         lo = np.stack([g.lo for g in grids])
         step = np.stack([g.step for g in grids])
         shape = grids[0].shape
         n_full = mech.n_fields
 
-        def kinematic(mod=mod, n_kin=n_kin, packed=packed, lo=lo, step=step, shape=shape):
-            return kgrid.population_stats(mod.kinematic_fields, n_kin, packed, lo, step, shape, EDGES)
+        def kinematic(kin_kernel=kin_kernel, n_kin=n_kin, packed=packed_kin, lo=lo, step=step, shape=shape):
+            return kgrid.population_stats(kin_kernel, n_kin, packed, lo, step, shape, EDGES)
 
         def full(mod=mod, n_full=n_full, packed=packed, lo=lo, step=step, shape=shape):
             return kgrid.population_stats(mod.point_fields, n_full, packed, lo, step, shape, EDGES)
@@ -426,8 +436,9 @@ def write_results_md() -> None:
                   "sigma_min, sigma_max (the field kernel without stiffness); `with stiffness` adds stiffness_min and",
                   "deflection (five-bar: closed-form per-leg condensation, 2x2 platform stiffness; ups-sspr: closed-form",
                   "per-chain condensation in the wrench form of `scalesynth.stiffness.legs`, 6x6 platform stiffness,",
-                  "3x3 Schur complement; pprs-rprs: closed-form per-chain condensation, `kinematic` there includes the",
-                  "clearance field).", "",
+                  "3x3 Schur complement; pprs-rprs: closed-form per-chain condensation; 2pauu-ppap: closed-form",
+                  "per-chain condensation, 3x3 translational stiffness; `kinematic` includes the clearance field for",
+                  "pprs-rprs and 2pauu-ppap).", "",
                   f"Conditions: NUMBA_NUM_THREADS=1 on the shared 2-core machine, load average {_load_text(rows)}, so",
                   "the absolute times are several times an idle machine's; the ratios come from one run.", "",
                   "| mechanism | designs x grid | kinematic (s) | with stiffness (s) | ns per reachable voxel, kinematic | "

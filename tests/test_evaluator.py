@@ -167,16 +167,19 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     edges = np.array(EDGES)
     full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
     fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
-    # the fast path has the three fields lci, sigma_min, sigma_max; the field kernel adds clearance (slot 3)
-    assert M.field_names[3] == "clearance" and full.shape == (16, kgrid.stat_columns(4, 3))
+    # the fast path has the three fields lci, sigma_min, sigma_max; the field kernel adds clearance (slot 3),
+    # stiffness_min and deflection (slots 4, 5)
+    assert M.field_names[3:] == ("clearance", "stiffness_min", "deflection")
+    assert full.shape == (16, kgrid.stat_columns(6, 3))
     head = kgrid.band_column(3, 0)
-    generic = np.hstack([full[:, :head], full[:, kgrid.band_column(4, 0):]])
+    generic = np.hstack([full[:, :head], full[:, kgrid.band_column(6, 0):]])
     assert fast.shape == generic.shape == (16, kgrid.stat_columns(3, 3))
-    # what the evaluator gets (options without link_radius): the fast rows in the four-field layout
+    # what the evaluator gets (options without link_radius or stiffness_metrics): the fast rows in the six-field
+    # layout
     widened = M.grid_stats(packed, lo, step, grids[0].shape, edges)
     assert widened.shape == full.shape
     assert np.array_equal(widened[:, :head], fast[:, :head])
-    assert np.array_equal(widened[:, kgrid.band_column(4, 0):], fast[:, head:])
+    assert np.array_equal(widened[:, kgrid.band_column(6, 0):], fast[:, head:])
     assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
     assert np.array_equal(generic[:, kgrid.COL_COUNT], fast[:, kgrid.COL_COUNT])
     bands = [kgrid.band_column(3, b) for b in range(3)]
@@ -221,7 +224,7 @@ def test_fast_seed000_cells_computed_like_the_generic_kernel_give_bitwise_equal_
     lo = np.stack([g.lo for g in grids]) - np.array([1e-3, 1e-3, 0.0]) * step
     edges = np.array(EDGES)
     full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
-    generic = np.hstack([full[:, : kgrid.band_column(3, 0)], full[:, kgrid.band_column(4, 0):]])
+    generic = np.hstack([full[:, : kgrid.band_column(3, 0)], full[:, kgrid.band_column(6, 0):]])
     fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
     assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
     assert (generic[:, kgrid.field_column(2, kgrid.STAT_MAX)] > 1e3).any()  # ill-conditioned designs included

@@ -146,7 +146,7 @@ def test_a_field_the_mechanism_does_not_provide_is_named(monkeypatch):
     with pytest.raises(ConfigError) as err:
         config_from_dict(data)
     assert str(err.value) == ("objectives[0].metric: mean_stiffness: field 'stiffness' is not provided by 2pauu-ppap "
-                              "(fields: lci, sigma_min, sigma_max, clearance)")
+                              "(fields: lci, sigma_min, sigma_max, clearance, stiffness_min, deflection)")
 
 
 def test_unknown_metric_lists_the_usable_choices():

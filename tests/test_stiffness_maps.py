@@ -92,7 +92,8 @@ def test_run_report_has_stiffness_maps_with_units(tmp_path):
 
 
 def test_no_stiffness_maps_without_stiffness_fields(tmp_path):
-    """seed 000 (2pauu-ppap) has no per-voxel stiffness fields: its report has LCI sections and no stiffness maps."""
+    """seed 000 (2pauu-ppap) without options.stiffness_metrics (its default, so that the paper run keeps the fast
+    path and its results): the report has LCI sections and no stiffness maps."""
     out = tmp_path / "small"
     run(config_from_dict(SMALL), out)
     plots = [p.name for p in (out / "plots").glob("sections_*")]

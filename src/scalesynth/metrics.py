@@ -309,6 +309,12 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
     return out
 
 
+def option_set(options: Mapping[str, Any], name: str) -> bool:
+    """Whether option ``name`` is set for a field's ``needs_options``: not null and not false (a flag that is off)."""
+    value = options.get(name)
+    return value is not None and value is not False
+
+
 def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None,
                cycle: Any = None) -> str | None:
     """Why ``m`` cannot be evaluated under a config (a phrase), or None if it can. ``cycle``: the config's
@@ -322,8 +328,8 @@ def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, 
             return "needs a task section"
         if need == "path" and not has_path:
             return "needs task.path"
-        if need.startswith("options.") and options is not None and options.get(need[8:]) is None:
-            return f"needs {need} (null)"
+        if need.startswith("options.") and options is not None and not option_set(options, need[8:]):
+            return f"needs {need} ({'false' if options.get(need[8:]) is False else 'null'})"
     return None
 
 

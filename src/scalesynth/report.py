@@ -23,10 +23,11 @@ from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
 from scalesynth.selection import choose, extremes
 from scalesynth.workspace_view import (  # SECTION_RESOLUTION, section_panels: also report's (memory, tests)
     SECTION_RESOLUTION,  # noqa: F401
-    STIFFNESS_MAP_FIELDS,
+    STIFFNESS_MAP_FIELDS,  # noqa: F401
     band_labels,
     map_range,
     section_panels,
+    stiffness_map_fields,
 )
 
 
@@ -157,9 +158,8 @@ def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
         rio.save_figure(fig, plots / fname)
         plotting.close(fig)
         files.append(_rel(result.out_dir, plots / fname))
-        for field in STIFFNESS_MAP_FIELDS:
-            if field in cfg.mech.field_names:
-                files.append(_rel(result.out_dir, field_sections(cfg, design, field, title, plots, name, fmt)))
+        for field in stiffness_map_fields(cfg):
+            files.append(_rel(result.out_dir, field_sections(cfg, design, field, title, plots, name, fmt)))
     return {"files": files, "featured": [(name, int(i)) for name, i in featured], "band_files": band_rel,
             "band_sizes": band_info["sizes"]}
 

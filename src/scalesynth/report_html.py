@@ -73,7 +73,7 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
                          "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
                          "path": None if path is None else path[:, :2]}
                 blocks.append(figs.html(ia.heatmap_figure(panel, "LCI"), 520))
-            if "deflection" in mech.field_names:  # the stiffness map: the report's sections coloured by deflection
+            if "deflection" in wv.stiffness_map_fields(cfg):  # the stiffness map: the sections coloured by deflection
                 panels = wv.section_panels(cfg, design, "deflection")
                 vmin, vmax = wv.map_range(panels)
                 flabel = lab.field_label(mech, "deflection", unit)

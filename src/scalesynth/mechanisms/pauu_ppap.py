@@ -24,6 +24,7 @@ from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -34,7 +35,13 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
-from scalesynth.stiffness.sections import check_positive_option, check_stiffness_options, stiffness_options
+from scalesynth.stiffness import legs as _legs_k
+from scalesynth.stiffness.sections import (
+    check_positive_option,
+    check_stiffness_options,
+    stiffness_options,
+    tube_section,
+)
 
 MODES = ("++", "+-", "-+", "--")
 # stiffness (scalesynth.stiffness, docs/stiffness.md): link groups, the actuated long links of the parallelograms
@@ -54,10 +61,16 @@ _M = 14  # m itself (the kinematics need only m - n; the capsules need both)
 _RAD = 15  # capsule radii of the 6 bodies, in LINK_RADII order
 _FREE_ONLY = 21  # 1: poses whose capsules overlap are unreachable
 _CLEARANCE_STATS = 22  # 1: the config asks for clearance statistics (or interference_free): the generic kernel
-N_PACKED = 23
+# stiffness (slots _F_STIFFNESS_MIN, _F_DEFLECTION): EA (N), EI (N m^2), GJ (N m^2) of the groups arm, arm_link and
+# link (3 each, LINK_GROUPS order), the actuator stiffness of theta1, theta2 (N m/rad) and of d (N/m), the load (N),
+# the short link c (m) and 1 when the config asks for the stiffness statistics (options.stiffness_metrics)
+_EA_ARM, _EA_ARM_LINK, _EA_LINK = 23, 26, 29
+_KACT, _KD, _FX, _C, _STIFFNESS_STATS = 32, 33, 34, 37, 38
+N_PACKED = 39
 N_FIELDS = 3  # fields of the fast path population_stats_fast: lci, sigma_min, sigma_max (MECHANISM.fields[:3])
 _F_CLEARANCE = 3  # slot of the clearance field in the field kernel's out (its index in ``fields``)
-N_KERNEL_FIELDS = 4  # fields of point_fields (MECHANISM.fields)
+_F_STIFFNESS_MIN, _F_DEFLECTION = 4, 5  # slots of the stiffness fields
+N_KERNEL_FIELDS = 6  # fields of point_fields (MECHANISM.fields)
 
 # capsules of the clearance field, in link_geometry's order: one segment per body, so segment i is body i
 _BODIES = tuple(LINK_RADII)
@@ -111,24 +124,115 @@ def _clearance(p, x, y, z, c1, s1, c2, s2):
     return min_capsule_gap(seg, _PAIRS, p[_RAD : _RAD + 6])
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _chain_stiffness(p, wx, wy, wz, ex, ez):
+    """(ok, kappa, u) of one PaUU chain, ideal joints, the frame of stiffness_model: with the platform's rotations
+    held (by the PPaP chain) the chain adds kappa u u^T to the platform's translational stiffness (N/m), u the unit
+    vector of w = D_i - C_i (the link), e = (ex, 0, ez) the unit vector A_i -> C_i of the arm.
+
+    The U-link-U part passes two wrenches: the force along the link's line (through C_i and D_i) and the couple
+    along n = the xz-projection of u (normal to both U axes y, t_i). Their 2x2 flexibility Phi adds (complementary
+    energy, the joints' free motions do no work on them) the link (a cantilever clamped at C_i: axial l2 / EA,
+    the couple's torsion and bending) and the parallelogram plate at C_i. The parallelogram lies in the xz plane
+    with joint axes along y, so its in-plane and out-of-plane responses decouple: in plane the force at C_i loads
+    the arm alone (the arm link, pinned at both ends, would only carry a moment about y, which U_C releases):
+    axial l1 / EA and transverse l1^3 / 3 EI + l1^2 / k (the actuator spring at A_i); out of plane (force along y,
+    moments about x and z) both bars are clamped at the base and at the plate (their revolutes turn about y only),
+    two cantilevers in parallel, the arm link's tip C_i - c z transported to C_i, inverted in scalars. The platform
+    cannot rotate, so the couple is a reaction and kappa = (Phi^-1)_11 = Phi_22 / det Phi."""
+    ll = math.sqrt(wx * wx + wy * wy + wz * wz)
+    hxz = math.sqrt(wx * wx + wz * wz)
+    if not (ll > 0.0 and hxz > 0.0):
+        return False, 0.0, 0.0, 0.0, 0.0
+    ux, uy, uz = wx / ll, wy / ll, wz / ll
+    nx, nz = wx / hxz, wz / hxz
+    px, pz = -ez, ex  # p = e x y, in plane, normal to the arm
+    l1 = p[_L1]
+    l2 = p[_L2]
+    c = p[_C]
+    ea_a, ei_a, gj_a = p[_EA_ARM], p[_EA_ARM + 1], p[_EA_ARM + 2]
+    ei_b, gj_b = p[_EA_ARM_LINK + 1], p[_EA_ARM_LINK + 2]
+    ea_l, ei_l, gj_l = p[_EA_LINK], p[_EA_LINK + 1], p[_EA_LINK + 2]
+    # out-of-plane stiffness of the plate at C_i in (v along y, rotation about e, rotation about p); a cantilever
+    # tip (v, phi_p) has [[12 EI / L^3, -6 EI / L^2], [-6 EI / L^2, 4 EI / L]], torsion GJ / L; the arm link's tip
+    # moves by v + c phi_x along y (phi_x = e_x phi_e + p_x phi_p)
+    il = 1.0 / l1
+    avv, avp, aee, app = 12.0 * ei_a * il * il * il, -6.0 * ei_a * il * il, gj_a * il, 4.0 * ei_a * il
+    bvv, bvp, bee, bpp = 12.0 * ei_b * il * il * il, -6.0 * ei_b * il * il, gj_b * il, 4.0 * ei_b * il
+    al = c * ex
+    be = c * px
+    ok, c00, c01, c02, c11, c12, c22 = _legs_k.sym3_inverse(
+        avv + bvv, bvv * al, avp + bvv * be + bvp, aee + bvv * al * al + bee, al * (bvv * be + bvp),
+        app + bvv * be * be + 2.0 * bvp * be + bpp)
+    if not ok:
+        return False, 0.0, 0.0, 0.0, 0.0
+    ue = ux * ex + uz * ez
+    up = ux * px + uz * pz
+    ne = nx * ex + nz * ez
+    np_ = nx * px + nz * pz
+    un = ux * nx + uz * nz
+    phi11 = (l2 / ea_l + ue * ue * l1 / ea_a + up * up * (l1 * l1 * l1 / (3.0 * ei_a) + l1 * l1 / p[_KACT])
+             + uy * uy * c00)
+    phi12 = uy * (c01 * ne + c02 * np_)
+    phi22 = l2 / ei_l + (l2 / gj_l - l2 / ei_l) * un * un + c11 * ne * ne + 2.0 * c12 * ne * np_ + c22 * np_ * np_
+    det = phi11 * phi22 - phi12 * phi12
+    if not (det > 0.0 and phi22 > 0.0):
+        return False, 0.0, 0.0, 0.0, 0.0
+    return True, phi22 / det, ux, uy, uz
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2):
+    """(stiffness_min N/m, deflection m) at P under the packed load, ideal joints, the frame of stiffness_model:
+    the platform only translates (the PPaP chain holds its rotations), so its stiffness is the 3x3
+    K = sum_i kappa_i u_i u_i^T + k_d y y^T (the two PaUU chains, _chain_stiffness, and the stroke spring: the
+    PPaP chain's other slides leave x and z free), singular where u_1, u_2 and y are coplanar (a forward
+    singularity); legs.response_translational. Arms: e_1 = (cos theta1, 0, -sin theta1),
+    e_2 = (-cos theta2, 0, -sin theta2)."""
+    zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
+    ok1, k1, ax, ay, az = _chain_stiffness(p, w1x, w1y, w1z, c1, -s1)
+    ok2, k2, bx, by, bz = _chain_stiffness(p, w2x, w2y, w2z, -c2, -s2)
+    if not (ok1 and ok2):
+        return 0.0, zero
+    return _legs_k.response_translational(
+        k1 * ax * ax + k2 * bx * bx, k1 * ax * ay + k2 * bx * by, k1 * ax * az + k2 * bx * bz,
+        k1 * ay * ay + k2 * by * by + p[_KD], k1 * ay * az + k2 * by * bz, k1 * az * az + k2 * bz * bz,
+        p[_FX], p[_FX + 1], p[_FX + 2])
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_stiffness(p, out, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2):
+    """Slots _F_STIFFNESS_MIN, _F_DEFLECTION of a reachable pose: _stiffness when the packed options ask for it
+    (options.stiffness_metrics), else 0 (written: the grid kernels reuse ``out``)."""
+    if p[_STIFFNESS_STATS] > 0.0:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2)
+    else:
+        out[_F_STIFFNESS_MIN] = 0.0
+        out[_F_DEFLECTION] = 0.0
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """Fields at P = (x, y, z) in the packed working mode (kernels.grid contract): LCI (1/kappa_2 of J), sigma_min
-    and sigma_max of J = dx/dq, clearance of the link capsules (length unit); LCI -1 (and zeros) if unreachable
+    and sigma_max of J = dx/dq, clearance of the link capsules (length unit), stiffness_min (N/m) and deflection
+    (m) under the packed load (ideal joints, docs/stiffness.md; _stiffness; 0 unless options.stiffness_metrics);
+    LCI -1 (and zeros) if unreachable
     (or, with interference_free, where the capsules overlap)."""
-    _fields(p, x, y, z, out, True)
+    _fields(p, x, y, z, out, True, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def kinematic_fields(p, x, y, z, out):
-    """Slots 0-2 of point_fields (LCI, sigma_min, sigma_max) without the clearance: the fast path's kernel for the
-    cells it does not vectorise (theta limits); ``out`` needs N_FIELDS slots."""
-    _fields(p, x, y, z, out, False)
+    """Slots 0-2 of point_fields (LCI, sigma_min, sigma_max) without the clearance and stiffness: the fast path's
+    kernel for the cells it does not vectorise (theta limits); ``out`` needs N_FIELDS slots."""
+    _fields(p, x, y, z, out, False, False)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, with_clearance):
-    """point_fields (with_clearance True) or kinematic_fields (False; a constant, so each copy keeps one branch)."""
+def _fields(p, x, y, z, out, with_clearance, with_stiffness):
+    """point_fields (both True) or kinematic_fields (both False; constants, so each copy keeps its branches). The
+    stiffness fields are computed only when the packed options ask for them (options.stiffness_metrics), so that
+    the generic kernel run for the clearance metrics alone does not pay for them (they stay 0 otherwise)."""
     if z < p[_ZMIN] or y < p[_DLO] or y > p[_DHI]:
         _grid.write_unreachable(out)
         return
@@ -164,9 +268,11 @@ def _fields(p, x, y, z, out, with_clearance):
     w2x = -(a2 - l1 * c2)
     w2z = b + l1 * s2
     if q1 == 0.0 or q2 == 0.0:
-        _grid.write_singular(out)  # inverse (type-1) singularity
+        _grid.write_singular(out)  # inverse (type-1) singularity; the structure's stiffness stays finite
         if with_clearance:
             out[_F_CLEARANCE] = gap
+        if with_stiffness:
+            _put_stiffness(p, out, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
         return
     # M = J^-1 = Jq^-1 Jx has rows w1/q1, w2/q2, (0, 1, 0); kappa(M) = kappa(J), sigma(J) = 1 / sigma(M)
     iq1 = 1.0 / q1
@@ -176,6 +282,8 @@ def _fields(p, x, y, z, out, with_clearance):
     out[1], out[2] = inverse_singular_values(smin, smax)
     if with_clearance:
         out[_F_CLEARANCE] = gap
+    if with_stiffness:
+        _put_stiffness(p, out, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -486,6 +594,17 @@ CLEARANCE = dataclasses.replace(
     "illustrative)",
 )
 
+# The stiffness fields (slots 4, 5). Like the clearance they need the generic grid kernel, so they are computed and
+# their metrics evaluated only for configs that ask for them (options.stiffness_metrics: true; else they are 0).
+STIFFNESS_FIELDS = (
+    Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at P (ideal "
+          "joints, Euler-Bernoulli links, actuator springs, the PPaP chain rigid; docs/stiffness.md); its metrics "
+          "need options.stiffness_metrics", "max", needs_options=("stiffness_metrics",)),
+    Field("deflection", "{length}", "magnitude of the deflection of P under options.load (default 150 N along -z); "
+          "1e12 at a singular pose; its metrics need options.stiffness_metrics", "min",
+          (0.0, _legs_k.DEFLECTION_CAP), needs_options=("stiffness_metrics",)),
+)
+
 
 class PauuPpap(Mechanism):
     """Seed-000 mechanism; see module docstring."""
@@ -505,6 +624,7 @@ class PauuPpap(Mechanism):
                 options[name] = float(value)
         links.check_radius_option(options, LINK_RADII)
         links.check_flag_option(options, "interference_free")
+        links.check_flag_option(options, "stiffness_metrics")
 
     def offset_e(self, design: Mapping[str, float], options: Mapping[str, Any]) -> float:
         e = options.get("e")
@@ -533,6 +653,13 @@ class PauuPpap(Mechanism):
         free = bool(options.get("interference_free"))
         p[_FREE_ONLY] = 1.0 if free else 0.0
         p[_CLEARANCE_STATS] = 1.0 if (free or options.get("link_radius") is not None) else 0.0
+        for o, group in zip((_EA_ARM, _EA_ARM_LINK, _EA_LINK), LINK_GROUPS, strict=True):
+            sec = tube_section(options, group, "m")
+            p[o], p[o + 1], p[o + 2] = sec.EA, sec.EI, sec.GJ
+        p[_KACT], p[_KD] = options["actuator_stiffness"], options["stroke_stiffness"]
+        p[_FX : _FX + 3] = options["load"]
+        p[_C] = design["c"]
+        p[_STIFFNESS_STATS] = 1.0 if options.get("stiffness_metrics") else 0.0
         return p
 
     @property
@@ -544,10 +671,11 @@ class PauuPpap(Mechanism):
 
     def grid_stats(self, packed, lo, step, shape, edges):
         """The column-interval and symmetry evaluator (population_stats_fast; the same numbers as the generic one)
-        when no design needs the clearance field's statistics: its rows then carry empty clearance columns
-        (sums 0, min +inf, max -inf), which no metric reads because clearance's metrics need options.link_radius
-        (see CLEARANCE). With link_radius or interference_free: the generic kernel over point_fields."""
-        if np.any(packed[:, _CLEARANCE_STATS] > 0.0):
+        when no design needs the statistics of the clearance or stiffness fields: its rows then carry empty columns
+        for them (sums 0, min +inf, max -inf), which no metric reads because their metrics need
+        options.link_radius (CLEARANCE) or options.stiffness_metrics (STIFFNESS_FIELDS). With link_radius,
+        interference_free or stiffness_metrics: the generic kernel over point_fields."""
+        if np.any(packed[:, _CLEARANCE_STATS] > 0.0) or np.any(packed[:, _STIFFNESS_STATS] > 0.0):
             return _grid.population_stats(point_fields, N_KERNEL_FIELDS, packed, lo, step, shape, edges)
         return widen_rows(population_stats_fast(packed, lo, step, shape, edges), N_FIELDS, N_KERNEL_FIELDS)
 
@@ -897,10 +1025,14 @@ MECHANISM = PauuPpap(
                "arm1/arm2 0.03, link1/link2 0.02, platform 0.05 (m, illustrative); setting it enables the "
                "clearance metrics"),
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
+        Option("stiffness_metrics", False, "stiffness: true computes the per-voxel fields stiffness_min and "
+               "deflection (0 otherwise) and enables their metrics; grid statistics then use the generic kernel, "
+               "slower than the fast path"),
     ),
     default_length_unit="m",
     fields=(*base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is "
-                         "dimensionless; not rescaled, as in the LCI)"), CLEARANCE),
+                         "dimensionless; not rescaled, as in the LCI)"), CLEARANCE, *STIFFNESS_FIELDS),
     design_metrics=DESIGN_METRICS,
 )
 assert MECHANISM.n_fields == N_KERNEL_FIELDS and MECHANISM.field_names[_F_CLEARANCE] == "clearance"
+assert MECHANISM.field_names[_F_STIFFNESS_MIN :] == ("stiffness_min", "deflection")

@@ -402,6 +402,33 @@ def response_upper(k, fx, fy, fz, length):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
+def response_translational(k00, k01, k02, k11, k12, k22, fx, fy, fz):
+    """:func:`platform_response` of a platform whose rotations are held rigidly (only translations are DOFs, e.g.
+    seed 000's PPaP chain): K is the symmetric 3x3 translational stiffness given by its upper entries (N/length).
+    stiffness_min = lambda_min(K), the deflection |K^-1 F|; singular (0, DEFLECTION_CAP) when K is not positive
+    definite or lambda_max(K^-1) tr(K) >= 1 / SINGULAR_RTOL (the reference solver's eigenvalue-ratio test with
+    tr(K) >= lambda_max(K)). Never NaN."""
+    zero = 0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else DEFLECTION_CAP
+    ok, a00, a01, a02, a11, a12, a22 = _sym3_inverse(k00, k01, k02, k11, k12, k22)
+    if not ok:
+        return 0.0, zero
+    cmax = sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22)
+    if not (cmax > 0.0 and math.isfinite(cmax)) or not cmax * (k00 + k11 + k22) * SINGULAR_RTOL < 1.0:
+        return 0.0, zero
+    dx = a00 * fx + a01 * fy + a02 * fz
+    dy = a01 * fx + a11 * fy + a12 * fz
+    dz = a02 * fx + a12 * fy + a22 * fz
+    return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def sym3_inverse(a00, a01, a02, a11, a12, a22):
+    """(ok, inverse entries 00, 01, 02, 11, 12, 22) of a symmetric positive definite 3x3 matrix (ok False if it
+    is not), for kernels that invert a small stiffness in scalars."""
+    return _sym3_inverse(a00, a01, a02, a11, a12, a22)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
 def _sym3_inverse(a00, a01, a02, a11, a12, a22):
     """(ok, inverse entries 00, 01, 02, 11, 12, 22) of a symmetric 3x3 matrix by its adjugate; ok False unless it
     is positive definite (leading minors > 0)."""
