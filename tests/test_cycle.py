@@ -510,7 +510,13 @@ def test_pprs_rail_input_follows_x_exactly():
 STIFF = load_config(ROOT / "configs" / "fivebar_stiffness.yaml")
 
 
-@pytest.mark.parametrize("cfg, samples", [(STIFF, (0, 13, 31, 47)), (UPS, (5, 29)), (PPRS, (3, 40))])
+PAPER = load_config(ROOT / "configs" / "paper_2pauu_ppap.yaml")
+# seed 000's stiffness fields are opt-in (options.stiffness_metrics), so that its fast path stays in use without them
+PAPER_STIFF = load_config(ROOT / "configs" / "paper_2pauu_ppap.yaml", ["options.stiffness_metrics=true"])
+
+
+@pytest.mark.parametrize("cfg, samples", [(STIFF, (0, 13, 31, 47)), (UPS, (5, 29)), (PPRS, (3, 40)),
+                                          (PAPER_STIFF, (7, 33))])
 def test_deflection_along_the_cycle_equals_the_pose_level_stiffness_command(cfg, samples):
     """At sample poses, the cycle's deflection column equals `scalesynth stiffness MECH --pose P --load F` (the
     frame model solved by the NumPy reference, ideal joints) with F = m (g - a) the force the payload exerts on the
@@ -530,6 +536,20 @@ def test_deflection_along_the_cycle_equals_the_pose_level_stiffness_command(cfg,
         ref = json.loads(cli.stdout)["deflection_norm"]
         assert res.deflection[s] == pytest.approx(ref, rel=1e-7), s
     assert analysis.result_metrics(res, cfg.cycle)["cycle_max_deflection"] == pytest.approx(res.deflection.max())
+
+
+def test_seed000_reports_no_cycle_deflection_unless_its_stiffness_fields_are_on():
+    """With options.stiffness_metrics off, 2pauu-ppap's kernel writes no deflection: the cycle has no deflection
+    column (not a column of zeros) and the catalogue refuses cycle_max_deflection, naming the option."""
+    from scalesynth import metrics
+
+    res = run(PAPER)
+    assert res.deflection is None and "deflection" not in res.columns()
+    assert "cycle_max_deflection" not in analysis.result_metrics(res, PAPER.cycle)
+    m = metrics.catalogue(PAPER.mech, PAPER.units.length)["cycle_max_deflection"]
+    why = metrics.applicable(m, True, False, PAPER.resolved_options(), PAPER.cycle)
+    assert why == "needs options.stiffness_metrics (false)"
+    assert metrics.applicable(m, True, False, PAPER_STIFF.resolved_options(), PAPER_STIFF.cycle) is None
 
 
 def test_mechanisms_without_a_stiffness_model_report_no_deflection():

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from scalesynth.mechanisms.base import Field, Mechanism
+from scalesynth.mechanisms.base import Field, Mechanism, option_set
 from scalesynth.paths import sample_path
 
 FAMILIES = ("workspace", "task", "path", "design", "cycle")
@@ -211,7 +211,7 @@ def _cycle_values(ctx: EvalContext) -> dict[str, np.ndarray]:
 
 
 def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
-    from scalesynth.cycle.analysis import CYCLE_PENALTY, has_deflection
+    from scalesynth.cycle.analysis import CYCLE_PENALTY, deflection_field, has_deflection
 
     def entry(name, unit, rng, better, worst, needs, description, plain=False):
         def compute(ctx: EvalContext, name=name) -> np.ndarray:
@@ -246,7 +246,8 @@ def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
         entry("cycle_min_clearance", lu, (-CYCLE_PENALTY, math.inf), "max", None,
               ("cycle",), f"smallest distance between non-adjacent link capsules along the cycle ({lu}; < 0: "
               f"interference; -{CYCLE_PENALTY:g} if the cycle cannot be followed)"),
-        *([entry("cycle_max_deflection", lu, (0.0, CYCLE_PENALTY), "min", CYCLE_PENALTY, ("cycle",),
+        *([entry("cycle_max_deflection", lu, (0.0, CYCLE_PENALTY), "min", CYCLE_PENALTY,
+                 ("cycle", *(f"options.{o}" for o in deflection_field(mech).needs_options)),
                  f"largest deflection of the payload point along the cycle under the payload's weight and inertia "
                  f"m (g - a) ({lu}; stiffness model with ideal joints, docs/cycles.md){failed}")]
           if has_deflection(mech) else []),
@@ -307,12 +308,6 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
         out[m.name] = m
     _CACHE[key] = out
     return out
-
-
-def option_set(options: Mapping[str, Any], name: str) -> bool:
-    """Whether option ``name`` is set for a field's ``needs_options``: not null and not false (a flag that is off)."""
-    value = options.get(name)
-    return value is not None and value is not False
 
 
 def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None,

@@ -320,11 +320,9 @@ SECTION_RESOLUTION = 128  # plots want finer cells than the optimisation grid; a
 def stiffness_map_fields(cfg) -> tuple[str, ...]:
     """The STIFFNESS_MAP_FIELDS a config's report draws: those its mechanism has and whose needs_options are set
     (seed 000's stiffness fields need options.stiffness_metrics, as their metrics do)."""
-    from scalesynth.metrics import option_set
-
     mech, options = cfg.mech, cfg.resolved_options()
     return tuple(name for name in STIFFNESS_MAP_FIELDS if name in mech.field_names
-                 and all(option_set(options, o) for o in mech.fields[mech.field_names.index(name)].needs_options))
+                 and mech.fields[mech.field_names.index(name)].enabled(options))
 
 
 def section_panels(cfg, design: dict[str, float], field: str = "lci") -> list[dict[str, Any]]:

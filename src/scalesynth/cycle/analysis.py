@@ -22,7 +22,8 @@ Along the sampled trajectory (``cycle.trajectory``), in the configured working m
 * the LCI from the point kernel and the clearance of the link capsules (``cycle.clearance``).
 
 * the deflection (``CycleResult.deflection``, where the mechanism has a per-voxel ``deflection`` field and a
-  ``load`` option: planar-fivebar, pprs-rprs, ups-sspr): at every sample the magnitude of the payload point's deflection
+  ``load`` option, and the options switch the field on: planar-fivebar, pprs-rprs, ups-sspr, and 2pauu-ppap with
+  ``stiffness_metrics: true``): at every sample the magnitude of the payload point's deflection
   under the force the payload exerts on the platform, m (g - c_ddot) (N; at rest its weight), from the
   mechanism's stiffness model with ideal joints (its field kernel re-packed with that load; the same model as
   the pose-level ``scalesynth stiffness`` command, tested against it). None for the other mechanisms.
@@ -304,16 +305,25 @@ def si_velocity_map(mech: Mechanism, A: np.ndarray, length_unit: str) -> np.ndar
     return A * row[:, None] * col[None, :]
 
 
-def has_deflection(mech: Mechanism) -> bool:
-    """Whether the cycle analysis reports a deflection for ``mech`` (a per-voxel deflection field and a load)."""
-    return "deflection" in mech.field_names and "load" in mech.option_names
+def has_deflection(mech: Mechanism, options: Mapping[str, Any] | None = None) -> bool:
+    """Whether the cycle analysis reports a deflection for ``mech`` (a per-voxel deflection field and a load) and,
+    given ``options``, whether they switch the field on (its ``needs_options`` set: e.g. 2pauu-ppap's
+    ``stiffness_metrics``; with them off the kernel writes no deflection)."""
+    if not ("deflection" in mech.field_names and "load" in mech.option_names):
+        return False
+    return options is None or deflection_field(mech).enabled(options)
+
+
+def deflection_field(mech: Mechanism):
+    """The mechanism's ``deflection`` Field."""
+    return mech.fields[mech.field_names.index("deflection")]
 
 
 def deflection_along(mech: Mechanism, design, options, poses: np.ndarray, loads: np.ndarray) -> np.ndarray | None:
     """Deflection magnitude (length unit) of the platform at each pose (n, k) under its load (n, 2 or 3; N, the
     mechanism's load axes), from the field kernel's ``deflection`` slot with ``options['load']`` replaced per
-    sample; None when the mechanism has no deflection field."""
-    if not has_deflection(mech):
+    sample; None when the mechanism has no deflection field or the options leave it off."""
+    if not has_deflection(mech, options):
         return None
     from scalesynth.kernels.paired import paired_points_fields
 
@@ -435,7 +445,7 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
         bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
                 "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
                 "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
-        if has_deflection(mech):
+        if has_deflection(mech, options):
             bad["cycle_max_deflection"] = CYCLE_PENALTY
         if cyc.speed_limits is not None or cyc.force_limits is not None:
             bad["max_cycles_per_minute"] = 0.0

@@ -52,7 +52,8 @@ class Field:
 
     ``unit`` may contain ``{length}`` (the config's length unit); '1' = dimensionless. ``better`` is the sense an
     engineer prefers ('max' or 'min'); ``range`` the values it can take. ``needs_options``: options that must be
-    set (not null) for the field to mean something (e.g. a material constant the kernel reads from ``pack``).
+    set (not null, not false) for the field to mean something (e.g. a material constant the kernel reads from
+    ``pack``, or a flag that switches the field on); without them the kernel writes no meaningful value.
     """
 
     name: str
@@ -61,6 +62,16 @@ class Field:
     better: str = "max"
     range: tuple[float, float] = (0.0, math.inf)
     needs_options: tuple[str, ...] = ()
+
+    def enabled(self, options: Mapping[str, Any]) -> bool:
+        """Whether ``options`` (resolved) set every option the field needs."""
+        return all(option_set(options, o) for o in self.needs_options)
+
+
+def option_set(options: Mapping[str, Any], name: str) -> bool:
+    """Whether option ``name`` is set for a field's ``needs_options``: not null and not false (a flag that is off)."""
+    value = options.get(name)
+    return value is not None and value is not False
 
 
 def base_fields(sigma_unit: str, jacobian: str) -> tuple[Field, Field, Field]:
