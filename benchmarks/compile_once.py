@@ -22,16 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 PROBE = ROOT / "tests" / "compile_probe.py"
 sys.path.insert(0, str(ROOT / "tests"))
 
-from compile_probe import commands  # noqa: E402
+from adaptive import CONFIGS  # noqa: E402  (one config per mechanism, shared by the issue-15 benchmarks)
 
-CONFIGS = {
-    "2pauu-ppap": "paper_2pauu_ppap.yaml",
-    "planar-fivebar": "fivebar_packing.yaml",
-    "pprs-rprs": "pprs_rprs.yaml",
-    "rps-upu": "rps_upu.yaml",
-    "rps-upu-tool": "rps_upu_tool.yaml",
-    "ups-sspr": "ups_sspr.yaml",
-}
+from compile_probe import commands  # noqa: E402
 
 
 def probe(args: list[str], env: dict, report: Path) -> dict:

@@ -408,12 +408,21 @@ def response_translational(k00, k01, k02, k11, k12, k22, fx, fy, fz):
     stiffness_min = lambda_min(K), the deflection |K^-1 F|; singular (0, DEFLECTION_CAP) when K is not positive
     definite or lambda_max(K^-1) tr(K) >= 1 / SINGULAR_RTOL (the reference solver's eigenvalue-ratio test with
     tr(K) >= lambda_max(K)). Never NaN."""
+    return _stiffness_3x3_response(k00, k01, k02, k11, k12, k22, fx, fy, fz, k00 + k11 + k22)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _stiffness_3x3_response(s00, s01, s02, s11, s12, s22, fx, fy, fz, trace):
+    """(stiffness_min, deflection) of the symmetric 3x3 translational stiffness S (upper entries): 1/lambda_max(S^-1)
+    and |S^-1 F| capped at DEFLECTION_CAP; singular (0, DEFLECTION_CAP, or 0 deflection under no load) when S is not
+    positive definite or lambda_max(S^-1) * trace >= 1 / SINGULAR_RTOL (``trace``: that of the stiffness the
+    singularity test scales by)."""
     zero = 0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else DEFLECTION_CAP
-    ok, a00, a01, a02, a11, a12, a22 = _sym3_inverse(k00, k01, k02, k11, k12, k22)
+    ok, a00, a01, a02, a11, a12, a22 = _sym3_inverse(s00, s01, s02, s11, s12, s22)
     if not ok:
         return 0.0, zero
     cmax = sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22)
-    if not (cmax > 0.0 and math.isfinite(cmax)) or not cmax * (k00 + k11 + k22) * SINGULAR_RTOL < 1.0:
+    if not (cmax > 0.0 and math.isfinite(cmax)) or not cmax * trace * SINGULAR_RTOL < 1.0:
         return 0.0, zero
     dx = a00 * fx + a01 * fy + a02 * fz
     dy = a01 * fx + a11 * fy + a12 * fz
@@ -468,16 +477,7 @@ def _response(t00, t01, t02, t11, t12, t22, c00, c01, c02, c10, c11, c12, c20, c
     s11 = t11 - (u10 * c10 + u11 * c11 + u12 * c12)
     s12 = t12 - (u10 * c20 + u11 * c21 + u12 * c22)
     s22 = t22 - (u20 * c20 + u21 * c21 + u22 * c22)
-    ok, a00, a01, a02, a11, a12, a22 = _sym3_inverse(s00, s01, s02, s11, s12, s22)
-    if not ok:
-        return 0.0, zero
-    cmax = sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22)
-    if not (cmax > 0.0 and math.isfinite(cmax)) or not cmax * tr * SINGULAR_RTOL < 1.0:
-        return 0.0, zero
-    dx = a00 * fx + a01 * fy + a02 * fz
-    dy = a01 * fx + a11 * fy + a12 * fz
-    dz = a02 * fx + a12 * fy + a22 * fz
-    return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
+    return _stiffness_3x3_response(s00, s01, s02, s11, s12, s22, fx, fy, fz, tr)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
