@@ -44,6 +44,7 @@ from scalesynth.kernels.flags import FASTMATH
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -55,19 +56,27 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
-from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options
+from scalesynth.stiffness import legs as _legs_k
+from scalesynth.stiffness.sections import check_stiffness_options, stiffness_options, tube_section
 
 MODELS = ("P", "C")
 C3_VARIANTS = ("plane", "upu")
 BRANCH = "+++"  # the only IK branch: every leg length is the positive root q_i = |A_i B_i|
 
 # packed-parameter layout (see RpsUpu.pack); _RAD: capsule radii of base, leg1, leg2, leg3, platform (LINK_RADII
-# order); _FREE_ONLY 1: poses whose capsules overlap are unreachable
+# order); _FREE_ONLY 1: poses whose capsules overlap are unreachable; stiffness: EA (N), EI, GJ (N mm^2) of the
+# 'leg' group, the actuators' compliance 1/k (mm/N) and the load (N)
 _G, _H, _C, _E, _MODEL_C, _UPU, _QLO, _QHI, _INV_L = range(9)
 _RAD = 9
 _FREE_ONLY = 14
-N_PACKED = 15
+_EA, _EI, _GJ, _CK, _FX = 15, 16, 17, 18, 19
+N_PACKED = 22
 _F_CLEARANCE = 3  # slot of the clearance field in the field kernels' out (its index in ``fields``), both workspaces
+_F_STIFFNESS_MIN, _F_DEFLECTION = 4, 5  # slots of the stiffness fields, both workspaces
+# the tool kernel's Newton solve for the C-model pose placing the tool at T: tolerance relative to max(g, h, c) + d
+# and an iteration cap (it converges in 3-5 steps from the P-model pose; a failure is reported as singular)
+_TOOL_NEWTON_RTOL = 1e-13
+_TOOL_NEWTON_ITERS = 50
 
 # capsules of the clearance field in link_geometry's order (base12, base23, base31, leg1..3, platform12, 23, 31,
 # then the tool of rps-upu-tool) and their bodies (index into TOOL_RADII: base, leg1..3, platform, tool)
@@ -218,12 +227,134 @@ def _leg_ok(qs, lo, hi):
     return lo <= q <= hi, q
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _chain_columns(p, kk, ax, ay, az, bx, by, bz, f2x, f2y, f2z, m2x, m2y, m2z, rx, ry, rz):
+    """K += W Phi^-1 W^T for one leg A -> B (ideal joints, the frame of stiffness_model): its two constraint
+    wrenches at B are w1 = the force along the leg (it also loads the actuator spring) and w2 = (f2, m2) (N, N mm
+    about B), reciprocal to the leg's passive joints; Phi (2x2) is their flexibility on the leg clamped at A
+    (cylinder and rod: one straight round-section beam, legs.tip_bilinear) plus the spring's 1/k (F . e)^2. The
+    columns W L^-T (Phi = L L^T) are carried to the reference point (rx, ry, rz): moment M + (B - ref) x F.
+    Returns (ok, kk); ok False for a leg of zero length or a flexibility that is not positive definite."""
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    length = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if not length > 0.0:
+        return False, kk
+    ex, ey, ez = dx / length, dy / length, dz / length
+    ea, ei, gj, ck = p[_EA], p[_EI], p[_GJ], p[_CK]
+    f2e = f2x * ex + f2y * ey + f2z * ez
+    p11 = _legs_k.tip_bilinear(length, ea, ei, gj, ex, ey, ez, ex, ey, ez, 0.0, 0.0, 0.0, ex, ey, ez, 0.0, 0.0,
+                               0.0) + ck
+    p12 = _legs_k.tip_bilinear(length, ea, ei, gj, ex, ey, ez, ex, ey, ez, 0.0, 0.0, 0.0, f2x, f2y, f2z, m2x, m2y,
+                               m2z) + ck * f2e
+    p22 = _legs_k.tip_bilinear(length, ea, ei, gj, ex, ey, ez, f2x, f2y, f2z, m2x, m2y, m2z, f2x, f2y, f2z, m2x,
+                               m2y, m2z) + ck * f2e * f2e
+    if not p11 > 0.0:
+        return False, kk
+    l11 = math.sqrt(p11)
+    l21 = p12 / l11
+    q22 = p22 - l21 * l21
+    if not q22 > 0.0:
+        return False, kk
+    i11 = 1.0 / l11
+    i22 = 1.0 / math.sqrt(q22)
+    sx, sy, sz = bx - rx, by - ry, bz - rz  # ref -> B
+    # column 1: w1 / l11; column 2: (w2 - l21 w1 / l11) / l22
+    ux, uy, uz = ex * i11, ey * i11, ez * i11
+    kk = _legs_k.outer_add(kk, ux, uy, uz, sy * uz - sz * uy, sz * ux - sx * uz, sx * uy - sy * ux)
+    t = l21 * i11
+    vx, vy, vz = (f2x - t * ex) * i22, (f2y - t * ey) * i22, (f2z - t * ez) * i22
+    kk = _legs_k.outer_add(kk, vx, vy, vz, m2x * i22 + sy * vz - sz * vy, m2y * i22 + sz * vx - sx * vz,
+                           m2z * i22 + sx * vy - sy * vx)
+    return True, kk
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, upu, y0, z, st, ct, sp, cp, sf, cf, rx, ry, rz):
+    """(stiffness_min N/mm, deflection mm) of the reference point (rx, ry, rz) under the packed load, ideal joints,
+    the frame of stiffness_model at the constraint-consistent (C-model) pose: O' = (0, y0, z), R = Rz(phi) Ry(theta)
+    Rx(psi) (sf, cf: sine and cosine of the yaw phi). Per leg two constraint wrenches (_chain_columns): RPS_1, RPS_2
+    (revolute about x at A_i, spherical at B_i) and chain 3 'plane' (revolute about y at A3) pass forces through B_i
+    along the leg and along the revolute axis; chain 3 'upu' (universal joints (x, m) at A3 and (m, w) at B3,
+    m = x X w) passes the force along the leg and a force along m through the point Q where the x axis through A3
+    meets the w axis through B3 (both lie in the plane normal to m that holds the leg). Six wrench columns; the
+    platform response from the 21 entries of K (legs.response_upper, characteristic length the longest beam, half
+    a leg). (0, 1e12) where a leg has zero length or the wrenches degenerate (w along x: Q at infinity)."""
+    g = p[_G]
+    h = p[_H]
+    c = p[_C]
+    e = p[_E]
+    zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
+    ux, uy, uz = cf * ct, sf * ct, -st  # R x
+    vx, vy, vz = cf * st * sp - sf * cp, sf * st * sp + cf * cp, ct * sp  # R y
+    b1x, b1y, b1z = -h * vx, y0 - h * vy, z - h * vz
+    b2x, b2y, b2z = h * vx, y0 + h * vy, z + h * vz
+    b3x, b3y, b3z = c * ux, y0 + c * uy, z + c * uz
+    kk = (0.0,) * 21
+    ok1, kk = _chain_columns(p, kk, 0.0, -g, 0.0, b1x, b1y, b1z, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, rx, ry, rz)
+    ok2, kk = _chain_columns(p, kk, 0.0, g, 0.0, b2x, b2y, b2z, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, rx, ry, rz)
+    if upu:
+        wx, wy, wz = cf * st * cp + sf * sp, sf * st * cp - cf * sp, ct * cp  # R z
+        my, mz = -wz, wy  # x X w = (0, -wz, wy)
+        mn = math.sqrt(my * my + mz * mz)
+        if not mn > 1e-12:
+            return 0.0, zero
+        my, mz = my / mn, mz / mn
+        # Q = A3 + s x = B3 + t w (the lines are coplanar): t = (d.x (x.w) - d.w) / (1 - (x.w)^2), d = B3 - A3
+        dx, dy, dz = b3x - e, b3y, b3z
+        t = (dx * wx - (dx * wx + dy * wy + dz * wz)) / (mn * mn)
+        # the force along m through Q, about B3: (Q - B3) x m = t w x m
+        ok3, kk = _chain_columns(p, kk, e, 0.0, 0.0, b3x, b3y, b3z, 0.0, my, mz, t * (wy * mz - wz * my),
+                                 t * (-wx * mz), t * (wx * my), rx, ry, rz)
+    else:
+        ok3, kk = _chain_columns(p, kk, e, 0.0, 0.0, b3x, b3y, b3z, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, rx, ry, rz)
+    if not (ok1 and ok2 and ok3):
+        return 0.0, zero
+    l1 = math.sqrt(b1x * b1x + (b1y + g) * (b1y + g) + b1z * b1z)
+    l2 = math.sqrt(b2x * b2x + (b2y - g) * (b2y - g) + b2z * b2z)
+    l3 = math.sqrt((b3x - e) * (b3x - e) + b3y * b3y + b3z * b3z)
+    return _legs_k.response_upper(kk, p[_FX], p[_FX + 1], p[_FX + 2], 0.5 * max(l1, l2, l3))
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
+    """Every field at task point (z, theta, psi) = (x, y, z) (see _fields): LCI, sigma_min, sigma_max, clearance,
+    stiffness_min, deflection."""
+    _fields(p, x, y, z, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def kinematic_fields(p, x, y, z, out):
+    """Slots 0-3 only (LCI, sigma_min, sigma_max, clearance), for benchmarks (the cost without stiffness)."""
+    _fields(p, x, y, z, out, False)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx, ry, rz):
+    """(stiffness_min, deflection) at the constraint-consistent placement of (z, theta, psi): the configured
+    C-model pose itself when ``placed`` (y0, sf, cf given), else the C-model pose with the configured chain-3
+    variant computed here (the P-model violates the RPS joint constraints; docs/stiffness.md). The reference point
+    is O' = (0, y0, z) when ``at_origin``, else (rx, ry, rz). A degenerate C-model parametrisation gives (0, 1e12)."""
+    upu = p[_UPU] > 0.0
+    if not placed:
+        ok, _, _, _, _, _, _, _, _, _, _, _, _, y0, sf, cf = _c_model_rows(p[_G], p[_H], p[_C], p[_E], upu, z, st,
+                                                                         ct, sp, cp)
+        if not ok:
+            zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
+            return 0.0, zero
+    if at_origin:
+        rx, ry, rz = 0.0, y0, z
+    return _stiffness(p, upu, y0, z, st, ct, sp, cp, sf, cf, rx, ry, rz)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, x, y, z, out, stiffness):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
     length leaves the stroke limits or the parametrisation is degenerate (C-model). Fields (kernels.grid contract):
     LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless); 3 clearance (mm) of the link capsules
-    (with interference_free, overlapping capsules make the pose unreachable)."""
+    (with interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, 4 stiffness_min
+    (N/mm) and 5 deflection (mm) of O' under the packed load on the frame at the constraint-consistent placement
+    of the pose (ideal joints; _stiffness), computed at every reachable pose whether or not that placement's own
+    legs are within the stroke limits (docs/stiffness.md)."""
     g = p[_G]
     h = p[_H]
     c = p[_C]
@@ -256,21 +387,23 @@ def point_fields(p, x, y, z, out):
         return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0:
         _grid.write_singular(out)  # inverse singularity: a leg of zero length has no direction
-        out[_F_CLEARANCE] = gap
-        return
-    # row i of dq/dx is (q_i dq_i/dx) / q_i; the angle columns are divided by L (homogenisation)
-    i1 = 1.0 / q1
-    i2 = 1.0 / q2
-    i3 = 1.0 / q3
-    il = p[_INV_L]
-    lci, smin, smax = sv_3x3(
-        a11 * i1, a12 * i1 * il, a13 * i1 * il,
-        a21 * i2, a22 * i2 * il, a23 * i2 * il,
-        a31 * i3, a32 * i3 * il, a33 * i3 * il,
-    )  # fmt: skip
-    out[0] = lci
-    out[1], out[2] = inverse_singular_values(smin, smax)
+    else:
+        # row i of dq/dx is (q_i dq_i/dx) / q_i; the angle columns are divided by L (homogenisation)
+        i1 = 1.0 / q1
+        i2 = 1.0 / q2
+        i3 = 1.0 / q3
+        il = p[_INV_L]
+        lci, smin, smax = sv_3x3(
+            a11 * i1, a12 * i1 * il, a13 * i1 * il,
+            a21 * i2, a22 * i2 * il, a23 * i2 * il,
+            a31 * i3, a32 * i3 * il, a33 * i3 * il,
+        )  # fmt: skip
+        out[0] = lci
+        out[1], out[2] = inverse_singular_values(smin, smax)
     out[_F_CLEARANCE] = gap
+    if stiffness:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _placement_stiffness(
+            p, y0, x, st, ct, sp, cp, sf, cf, p[_MODEL_C] > 0.0, True, 0.0, 0.0, 0.0)
 
 
 # ----- NumPy kinematics (vectorised over poses; CLI, FK and tests) ----------------------------------------
@@ -664,6 +797,10 @@ class RpsUpu(Mechanism):
         rad = links.radii(options, LINK_RADII)
         p[_RAD : _RAD + 5] = [rad[body] for body in LINK_RADII]
         p[_FREE_ONLY] = 1.0 if options.get("interference_free") else 0.0
+        sec = tube_section(options, "leg", "mm")
+        p[_EA], p[_EI], p[_GJ] = sec.EA, sec.EI, sec.GJ
+        p[_CK] = 1.0 / options["actuator_stiffness"]
+        p[_FX : _FX + 3] = options["load"]
         return p
 
     @property
@@ -907,15 +1044,15 @@ class RpsUpu(Mechanism):
 
     def _stiffness_placement(self, design, options, pose) -> tuple[np.ndarray, str, np.ndarray]:
         """(z, theta, psi) of the constraint-consistent (C-model) frame, its chain-3 variant and the platform
-        reference point (O'); raises InvalidPose outside the workspace box, the configured model's workspace or the
-        C-model's stroke limits."""
+        reference point (O'); raises InvalidPose outside the workspace box or the configured model's workspace.
+        The frame's own legs may leave the stroke limits (a P-model pose whose placement differs): the model's
+        notes say so, and the per-voxel fields use the same frame (docs/stiffness.md)."""
         x = self.check_vector("pose", pose, 3)
         variant = options["c3_variant"]
         c_opts = {**options, "model": "C"}
-        if (not self._in_box(options, x) or self.point_kernel(self.pack(design, options), *x) < 0.0
-                or self.point_kernel(self.pack(design, c_opts), *x) < 0.0):
+        if not self._in_box(options, x) or self.point_kernel(self.pack(design, options), *x) < 0.0:
             raise InvalidPose(f"pose: ({', '.join(f'{v:g}' for v in x)}) is outside the workspace (box and stroke "
-                              f"limits of the {options['model']}-model and of the C-model frame)")
+                              f"limits of the {options['model']}-model)")
         return x, variant, RpsUpu.platform_pose(self, design, c_opts, x)["p"]
 
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
@@ -972,6 +1109,15 @@ class RpsUpu(Mechanism):
         if options.get("model", "P") == "P":
             notes.append("the P-model violates the RPS joint constraints (spec §2.3): the frame uses the C-model "
                          "placement")
+        legs = np.linalg.norm(top - base, axis=1)
+        stroke = options.get("stroke_limits")
+        if stroke is not None and not np.all((legs >= stroke[0]) & (legs <= stroke[1])):
+            notes.append(f"the placement's leg lengths ({', '.join(f'{v:.6g}' for v in legs)}) mm leave the stroke "
+                         f"limits [{stroke[0]:g}, {stroke[1]:g}]: the frame is the structure at that placement all the "
+                         "same (the per-voxel fields use the same rule)")
+        if not self._in_box(options, x):
+            notes.append("the placement's (z, theta, psi) leaves the pose ranges: the frame is the structure at that "
+                         "placement all the same (the per-voxel fields use the same rule)")
         return fb.model("mm", bodies, options["load"], notes)
 
 
@@ -988,8 +1134,20 @@ DESIGN_METRICS = (
         lambda d, o: enclosing_circle_radius([(0.0, -d["g"]), (0.0, d["g"]), (d["e"], 0.0)]),
     ),
 )
+
+def _stiffness_fields(point: str) -> tuple[Field, Field]:
+    """stiffness_min and deflection (slots 4, 5) of the reference point ``point`` (docs/stiffness.md)."""
+    return (
+        Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at "
+              f"{point} under a pure force (ideal joints, Euler-Bernoulli legs, actuator springs, at the "
+              "constraint-consistent C-model placement; docs/stiffness.md)", "max"),
+        Field("deflection", "{length}", f"magnitude of the deflection of {point} under options.load (default 150 N "
+              "along -z); 1e12 at a singular pose", "min", (0.0, _legs_k.DEFLECTION_CAP)),
+    )
+
+
 FIELDS = (*base_fields("1", "J = dx/dq, x = (z, L theta, L psi) homogenised by the characteristic length L (mm/mm)"),
-          links.CLEARANCE_FIELD)
+          links.CLEARANCE_FIELD, *_stiffness_fields("O'"))
 
 MECHANISM = RpsUpu(
     name="rps-upu",
@@ -1032,8 +1190,89 @@ _D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI, _RAD_TOOL = range(N_PACKED, N_PACKED + 8
 N_PACKED_TOOL = N_PACKED + 8
 
 
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _c_plane_tool(c, d, z, st, ct, sp, cp):
+    """Tool point T = O' + R (0, 0, -d) of the C-model pose (z, theta, psi) with chain 3 'plane' (y0 = -c R[1, 0],
+    yaw phi = atan2(sin theta sin psi, cos psi)) and its Jacobian dT/d(z, theta, psi) (rows T_x, T_y, T_z), as
+    (ok, tx, ty, tz, j01, j02, j11, j12, j21, j22) (column 0 is (0, 0, 1)); ok False where the yaw is undefined."""
+    nn = st * sp
+    mm = cp
+    n2 = nn * nn + mm * mm
+    if n2 < _YAW_EPS2:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    n = math.sqrt(n2)
+    sf = nn / n
+    cf = mm / n
+    n_t = nn * ct * sp / n
+    n_p = -sp * cp * ct * ct / n
+    sf_t = (ct * sp * n - nn * n_t) / n2
+    sf_p = (st * cp * n - nn * n_p) / n2
+    cf_t = -mm * n_t / n2
+    cf_p = (-sp * n - mm * n_p) / n2
+    y0 = -c * sf * ct
+    y0_t = -c * (sf_t * ct - sf * st)
+    y0_p = -c * sf_p * ct
+    wx = cf * st * cp + sf * sp  # R z
+    wy = sf * st * cp - cf * sp
+    wz = ct * cp
+    wx_t = cf_t * st * cp + cf * ct * cp + sf_t * sp
+    wx_p = cf_p * st * cp - cf * st * sp + sf_p * sp + sf * cp
+    wy_t = sf_t * st * cp + sf * ct * cp - cf_t * sp
+    wy_p = sf_p * st * cp - sf * st * sp - cf_p * sp - cf * cp
+    return (True, -d * wx, y0 - d * wy, z - d * wz, -d * wx_t, -d * wx_p, y0_t - d * wy_t, y0_p - d * wy_p,
+            d * st * cp, d * ct * sp)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _tool_stiffness(p, tx, ty, tz, z, th, ps):
+    """(stiffness_min N/mm, deflection mm) of the tool point T under the packed load: Newton from the P-model pose
+    (z, theta, psi) to the C-model pose (chain 3 'plane') that puts the tool at T (as RpsUpuTool's pose level),
+    then _stiffness with T as the reference point. (0, 1e12) when Newton does not converge (the pose level
+    refuses such a T) or the pose is degenerate."""
+    c = p[_C]
+    d = p[_D]
+    zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
+    tol = _TOOL_NEWTON_RTOL * (max(p[_G], p[_H], c) + d)
+    for _ in range(_TOOL_NEWTON_ITERS):
+        st = math.sin(th)
+        ct = math.cos(th)
+        sp = math.sin(ps)
+        cp = math.cos(ps)
+        ok, fx, fy, fz, j01, j02, j11, j12, j21, j22 = _c_plane_tool(c, d, z, st, ct, sp, cp)
+        if not ok:
+            return 0.0, zero
+        rx, ry, rz = fx - tx, fy - ty, fz - tz
+        if max(abs(rx), abs(ry), abs(rz)) <= tol:
+            nn = st * sp
+            n = math.sqrt(nn * nn + cp * cp)
+            sf, cf = nn / n, cp / n
+            return _stiffness(p, False, -c * sf * ct, z, st, ct, sp, cp, sf, cf, tx, ty, tz)
+        # J = [[0, j01, j02], [0, j11, j12], [1, j21, j22]]: the angles from the first two rows, then z
+        det = j01 * j12 - j02 * j11
+        if not abs(det) > 0.0:
+            return 0.0, zero
+        dth = (rx * j12 - j02 * ry) / det
+        dps = (j01 * ry - rx * j11) / det
+        th -= dth
+        ps -= dps
+        z -= rz - j21 * dth - j22 * dps
+    return 0.0, zero
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def tool_point_fields(p, x, y, z, out):
+    """Every field at tool point T = (x, y, z) (see _tool_fields)."""
+    _tool_fields(p, x, y, z, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def tool_kinematic_fields(p, x, y, z, out):
+    """Slots 0-3 only (LCI, sigma_min, sigma_max, clearance), for benchmarks (the cost without stiffness)."""
+    _tool_fields(p, x, y, z, out, False)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _tool_fields(p, x, y, z, out, stiffness):
     """LCI of dq/dT (dimensionless) at tool point T = (x, y, z) mm of the P-model, principal branch
     (cos theta > 0, cos psi > 0), or -1 when T is out of reach of that branch, its pose leaves the z/theta/psi
     ranges or a leg leaves the stroke limits.
@@ -1041,7 +1280,10 @@ def tool_point_fields(p, x, y, z, out):
     Pose from T (spec §2.8): sin psi = T_y/d, sin theta = -T_x/(d cos psi), z0 = T_z + d cos theta cos psi; then
     dq/dT = dq/d(z0, theta, psi) . d(z0, theta, psi)/dT with the closed-form inverse of dT/d(z0, theta, psi).
     Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dT/dq (dimensionless); 3 clearance (mm) of the
-    link capsules and the tool O' -> T (with interference_free, overlapping capsules make the pose unreachable).
+    link capsules and the tool O' -> T (with interference_free, overlapping capsules make the pose unreachable);
+    with ``stiffness``, 4 stiffness_min (N/mm) and 5 deflection (mm) of T under the packed load, on the frame at
+    the C-model pose that puts the tool at T (_tool_stiffness), whether or not that pose is within the pose ranges
+    and stroke limits (docs/stiffness.md).
     """
     d = p[_D]
     sp = y / d
@@ -1081,6 +1323,8 @@ def tool_point_fields(p, x, y, z, out):
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0 or ct <= 1e-12:
         _grid.write_singular(out)  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
         out[_F_CLEARANCE] = gap
+        if stiffness:
+            out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _tool_stiffness(p, x, y, z, z0, th, ps)
         return
     # d(z0, theta, psi)/dT, rows z0, theta, psi; columns T_x, T_y, T_z
     inv = 1.0 / (d * ct * cp)
@@ -1101,6 +1345,8 @@ def tool_point_fields(p, x, y, z, out):
     out[0] = lci
     out[1], out[2] = inverse_singular_values(smin, smax)
     out[_F_CLEARANCE] = gap
+    if stiffness:
+        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _tool_stiffness(p, x, y, z, z0, th, ps)
 
 
 def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -1323,8 +1569,9 @@ class RpsUpuTool(RpsUpu):
     # ----- stiffness (scalesynth.stiffness; pose level) ------------------------------------------------------
     def _stiffness_placement(self, design, options, pose) -> tuple[np.ndarray, str, np.ndarray]:
         """The C-model pose (z, theta, psi), chain 3 'plane', that puts the tool at T = pose (Newton from the
-        P-model's principal pose '++'), and T; raises InvalidPose when T is outside the tool workspace, Newton
-        fails, or that pose leaves the pose ranges or the stroke limits."""
+        P-model's principal pose '++'), and T; raises InvalidPose when T is outside the tool workspace or Newton
+        fails. That pose may leave the pose ranges or its legs the stroke limits: the model's notes say so, and the
+        per-voxel fields use the same frame (docs/stiffness.md)."""
         t = self.check_vector("pose", pose, 3)
         where = f"pose: tool point ({', '.join(f'{v:g}' for v in t)})"
         if self.point_kernel(self.pack(design, options), *t) < 0.0:
@@ -1342,10 +1589,6 @@ class RpsUpuTool(RpsUpu):
             x = x - np.linalg.solve(jac, res)
         else:
             raise InvalidPose(f"{where}: no constraint-consistent (C-model) pose places the tool there")
-        c_opts = {**self._p(options), "model": "C"}
-        if not self._in_box(options, x) or MECHANISM.point_kernel(MECHANISM.pack(design, c_opts), *x) < 0.0:
-            raise InvalidPose(f"{where}: its constraint-consistent pose ({', '.join(f'{v:g}' for v in x)}) leaves "
-                              "the pose ranges or the stroke limits")
         return x, "plane", t
 
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
@@ -1381,6 +1624,7 @@ TOOL_MECHANISM = RpsUpuTool(
         Option("interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable"),
     ),
     default_length_unit="mm",
-    fields=(*base_fields("1", "J = dT/dq of the tool point (mm/mm)"), links.CLEARANCE_FIELD),
+    fields=(*base_fields("1", "J = dT/dq of the tool point (mm/mm)"), links.CLEARANCE_FIELD,
+            *_stiffness_fields("the tool point T")),
     design_metrics=DESIGN_METRICS,
 )
