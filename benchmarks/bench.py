@@ -238,28 +238,33 @@ def bench_compile() -> dict:
     return out
 
 
-STIFFNESS_CASES = (  # (label, config, module of the field kernel, kinematic slots, grid N per axis, designs[,
-    # a flag option that switches the stiffness on: then `kinematic` is point_fields with it off, `full` with it on])
-    ("planar-fivebar", "fivebar_stiffness.yaml", "planar_fivebar", 3, 256, 40),
-    ("ups-sspr", "ups_sspr.yaml", "ups_sspr", 3, 40, 20),
-    ("pprs-rprs", "pprs_rprs.yaml", "pprs_rprs", 4, 40, 20),  # kinematic part: LCI, sigmas and clearance
-    ("2pauu-ppap", "paper_2pauu_ppap.yaml", "pauu_ppap", 6, 40, 20, "stiffness_metrics"),  # the same: LCI, sigmas,
-    # clearance (the generic kernel, which the stiffness metrics need; the fast path computes neither)
+STIFFNESS_CASES = (  # (label, config, module.kernel of the kinematic part, kinematic slots, grid N per axis,
+    # designs[, a flag option that switches the stiffness on: then `kinematic` is that kernel with it off, `full` with
+    # it on]); `full` is the mechanism's field kernel
+    ("planar-fivebar", "fivebar_stiffness.yaml", "planar_fivebar.kinematic_fields", 6, 256, 40),  # LCI, sigmas,
+    # clearance (slot 5; the stiffness slots 3 and 4 written 0)
+    ("ups-sspr", "ups_sspr.yaml", "ups_sspr.kinematic_fields", 6, 40, 20),  # the same (clearance slot 5)
+    ("pprs-rprs", "pprs_rprs.yaml", "pprs_rprs.kinematic_fields", 4, 40, 20),  # kinematic: LCI, sigmas, clearance
+    ("2pauu-ppap", "paper_2pauu_ppap.yaml", "pauu_ppap.point_fields", 6, 40, 20, "stiffness_metrics"),  # the same:
+    # LCI, sigmas, clearance (the generic kernel, which the stiffness metrics need; the fast path computes neither)
+    ("rps-upu", "rps_upu.yaml", "rps_upu.kinematic_fields", 4, 40, 20),  # LCI, sigmas, clearance
+    ("rps-upu-tool", "rps_upu_tool.yaml", "rps_upu.tool_kinematic_fields", 4, 40, 20),  # the same
 )
 
 
 def bench_stiffness(repeat: int = 5) -> dict:
     """Per-voxel cost of the stiffness fields of every mechanism that has them per voxel: the full field kernel
-    (LCI, sigma_min, sigma_max, stiffness_min, deflection) against the kinematic part alone (``kinematic_fields``,
-    LCI, sigma_min, sigma_max), same designs, grids and process, timed alternately (best of ``repeat``)."""
+    (LCI, sigma_min, sigma_max, clearance, stiffness_min, deflection) against the rest alone (``kinematic_fields``:
+    every field but the stiffness), same designs, grids and process, timed alternately (best of ``repeat``)."""
     import importlib
 
     rows = []
-    for label, config, module, n_kin, n, n_designs, *flag in STIFFNESS_CASES:
-        mod = importlib.import_module(f"scalesynth.mechanisms.{module}")
-        kin_kernel = mod.point_fields if flag else mod.kinematic_fields
+    for label, config, kin_name, n_kin, n, n_designs, *flag in STIFFNESS_CASES:
+        module, kernel = kin_name.rsplit(".", 1)
+        kin_kernel = getattr(importlib.import_module(f"scalesynth.mechanisms.{module}"), kernel)
         cfg = load_config(ROOT / "configs" / config)
         mech, opts = cfg.mech, cfg.resolved_options()
+        full_kernel = mech.field_kernel
         rng = np.random.default_rng(12)
         designs = [mech.resolve_design({k: float(rng.uniform(*cfg.bounds[k])) for k in cfg.bounds})
                    for _ in range(n_designs)]
@@ -279,8 +284,8 @@ def bench_stiffness(repeat: int = 5) -> dict:
         def kinematic(kin_kernel=kin_kernel, n_kin=n_kin, packed=packed_kin, lo=lo, step=step, shape=shape):
             return kgrid.population_stats(kin_kernel, n_kin, packed, lo, step, shape, EDGES)
 
-        def full(mod=mod, n_full=n_full, packed=packed, lo=lo, step=step, shape=shape):
-            return kgrid.population_stats(mod.point_fields, n_full, packed, lo, step, shape, EDGES)
+        def full(full_kernel=full_kernel, n_full=n_full, packed=packed, lo=lo, step=step, shape=shape):
+            return kgrid.population_stats(full_kernel, n_full, packed, lo, step, shape, EDGES)
 
         kinematic()
         full()
@@ -449,12 +454,13 @@ def write_results_md() -> None:
         lines += _header("Per-voxel cost of the stiffness fields", data["stiffness"])
         lines += ["Random designs in the bounds of each config, N per axis grids over their bounding boxes, the generic",
                   "grid evaluator; best of 5, the two kernels timed alternately in one process. `kinematic` = LCI,",
-                  "sigma_min, sigma_max (the field kernel without stiffness); `with stiffness` adds stiffness_min and",
+                  "sigma_min, sigma_max, clearance (the field kernel without stiffness); `with stiffness` adds stiffness_min and",
                   "deflection (five-bar: closed-form per-leg condensation, 2x2 platform stiffness; ups-sspr: closed-form",
                   "per-chain condensation in the wrench form of `scalesynth.stiffness.legs`, 6x6 platform stiffness,",
                   "3x3 Schur complement; pprs-rprs: closed-form per-chain condensation; 2pauu-ppap: closed-form",
-                  "per-chain condensation, 3x3 translational stiffness; `kinematic` includes the clearance field for",
-                  "pprs-rprs and 2pauu-ppap).", "",
+                  "per-chain condensation, 3x3 translational stiffness; rps-upu: closed-form per-leg condensation at",
+                  "the constraint-consistent placement, rps-upu-tool with a Newton solve for that placement per voxel;",
+                  "`kinematic` = every field but the stiffness, the clearance included).", "",
                   f"Conditions: NUMBA_NUM_THREADS=1 on the shared 2-core machine, load average {_load_text(rows)}, so",
                   "the absolute times are several times an idle machine's; the ratios come from one run.", "",
                   "| mechanism | designs x grid | kinematic (s) | with stiffness (s) | ns per reachable voxel, kinematic | "

@@ -168,7 +168,9 @@ RPS_DESIGN = RPS.resolve_design({})  # g = 80, h = 50, c = 50, e = 0 mm
 # stroke limits lifted, a pose 3 mm above the forward singularity of z = 0 (all legs in the base plane)
 RPS_POSES = [((53.0, 0.019, 0.0), {}), ((66.67, 0.314, 0.314), {}), ((60.0, -0.314, 0.314), {}),
              ((43.33, 0.314, -0.293), {}), ((40.0, -0.314, -0.314), {}), ((46.67, 0.314, 0.0), {}),
-             ((3.0, 0.05, -0.1), {"stroke_limits": None})]
+             ((3.0, 0.05, -0.1), {"stroke_limits": None}),
+             # a P-model pose whose C-model placement has leg 2 at 39.27 mm, below the stroke limits (solved and noted)
+             ((39.5447, 0.1113, -0.3033), {})]
 # chain-3 variant 'upu' (C-model): grid points nearest three corners, the lowest-LCI point (LCI 0.22), two generic
 UPU_POSES = [(60.0, 0.314, 0.293), (53.33, -0.314, -0.314), (56.67, -0.314, 0.314), (26.67, -0.314, 0.0),
              (50.0, 0.0, 0.0), (50.0, 0.2, 0.1)]
@@ -176,7 +178,9 @@ UPU_POSES = [(60.0, 0.314, 0.293), (53.33, -0.314, -0.314), (56.67, -0.314, 0.31
 # corners (LCI 0.26 ... 0.41), and one with lifted strokes 2 mm above the singular pose (z, theta, psi) = 0
 TOOL_POSES = [((0.19, 0.0, 4.0), {}), ((14.156, 15.443, 14.212), {}), ((14.156, 15.443, -7.615), {}),
               ((-14.156, 9.009, 22.943), {}), ((-14.156, -9.009, -3.25), {}), ((14.156, -15.443, 14.212), {}),
-              ((0.5, -0.5, -48.0), {"stroke_limits": None})]
+              ((0.5, -0.5, -48.0), {"stroke_limits": None}),
+              # its C-model pose has leg 1 at 90.01 mm, above the stroke limits (solved and noted)
+              ((-7.525, -10.6872, 22.9668), {})]
 
 
 def rps_model(mech, pose, joints="ideal", **opts):

@@ -153,9 +153,9 @@ def _kinematics(p, x, y, out):
 
 @njit(cache=True, fastmath=FASTMATH)
 def kinematic_fields(p, x, y, z, out):
-    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
-    the LCI alone) and the stiffness twin tests."""
-    _kinematics(p, x, y, out)
+    """point_fields without the stiffness (slots 3, 4 left 0): LCI, sigma_min, sigma_max and the clearance, for
+    benchmarks (the cost of the stiffness fields against the rest)."""
+    _fields(p, x, y, out, False)
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
@@ -226,13 +226,23 @@ def point_fields(p, x, y, z, out):
     sigma_max of J = dx/dq (mm/rad); 3 stiffness_min (N/mm), 4 deflection (mm) under the packed load (ideal
     joints, docs/stiffness.md); 5 clearance (mm) of the link capsules; LCI -1 (and zeros) if unreachable (or, with
     interference_free, where the capsules overlap); z unused."""
+    _fields(p, x, y, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, x, y, out, stiffness):
+    """point_fields, with the stiffness slots only when ``stiffness`` (a constant: each caller's copy keeps its
+    branch)."""
     ok, c1, s1, c2, s2 = _kinematics(p, x, y, out)
     if ok:
         gap = _clearance(p, x, y, c1, s1, c2, s2)
         if gap < 0.0 and p[_FREE_ONLY] > 0.0:
             _grid.write_unreachable(out)
             return
-        out[3], out[4] = _stiffness(p, x, y, c1, s1, c2, s2)
+        if stiffness:
+            out[3], out[4] = _stiffness(p, x, y, c1, s1, c2, s2)
+        else:
+            out[3], out[4] = 0.0, 0.0
         out[_F_CLEARANCE] = gap
 
 

@@ -164,9 +164,9 @@ def _kinematics(p, alpha, beta, yy, out):
 
 @njit(cache=True, fastmath=FASTMATH)
 def kinematic_fields(p, alpha, beta, yy, out):
-    """Slots 0-2 only (LCI, sigma_min, sigma_max): the kinematic part of point_fields, for benchmarks (the cost of
-    the LCI alone) and the stiffness twin tests."""
-    _kinematics(p, alpha, beta, yy, out)
+    """point_fields without the stiffness (its slots left 0): LCI, sigma_min, sigma_max and the clearance, for
+    benchmarks (the cost of the stiffness fields against the rest)."""
+    _fields(p, alpha, beta, yy, out, False)
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -176,15 +176,25 @@ def point_fields(p, alpha, beta, yy, out):
     (mm) under the packed load (ideal joints, docs/stiffness.md); _F_CLEARANCE (mm) of link_geometry's capsules;
     LCI -1 (and zeros) outside the workspace box or the actuator limits, or, with interference_free, where the
     capsules overlap (an exact singular pose, a zero-length leg, has clearance 0)."""
+    _fields(p, alpha, beta, yy, out, True)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, alpha, beta, yy, out, stiffness):
+    """point_fields, with the stiffness slots only when ``stiffness`` (a constant: each caller's copy keeps its
+    branch)."""
     ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
     if ok:
         gap = _clearance(p, sa, ca, sb, cb, px, yy, pz)
         if gap < 0.0 and p[_FREE_ONLY] > 0.0:
             _grid.write_unreachable(out)
             return
-        out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+        if stiffness:
+            out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(p, sa, ca, sb, cb, px, yy, pz, lmax)
+        else:
+            out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = 0.0, 0.0
         out[_F_CLEARANCE] = gap
-    elif out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
+    elif stiffness and out[0] == 0.0 and (p[_FX] != 0.0 or p[_FY] != 0.0 or p[_FZ] != 0.0):
         out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # an exact singular pose (zero-length leg): stiffness_min 0
 
 
