@@ -114,6 +114,23 @@ def _p_model_rows(g, h, c, e, z, st, ct, sp, cp):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
+def _yaw(st, ct, sp, cp):
+    """The C-model's parasitic yaw phi = atan2(N, M), N = sin theta sin psi, M = cos psi: (ok, n = |(N, M)|, its sine
+    sf = N/n and cosine cf = M/n, and the derivatives of n, sf, cf with respect to theta (_t) and psi (_p)); ok False
+    where the yaw is undefined (n = 0)."""
+    nn = st * sp
+    mm = cp
+    n2 = nn * nn + mm * mm
+    if n2 < _YAW_EPS2:
+        return False, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    n = math.sqrt(n2)
+    n_t = nn * ct * sp / n
+    n_p = -sp * cp * ct * ct / n
+    return (True, n, nn / n, mm / n, n_t, n_p, (ct * sp * n - nn * n_t) / n2, (st * cp * n - nn * n_p) / n2,
+            -mm * n_t / n2, (-sp * n - mm * n_p) / n2)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
 def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     """Squared leg lengths and the rows of q_i dq_i/d(z, theta, psi) of the C-model (spec §2.3).
 
@@ -122,21 +139,9 @@ def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     row is d_i . dB_i/dx. Returns ok = False where the parametrisation is degenerate; then y0, sin and cos of the
     yaw (for the platform's placement).
     """
-    nn = st * sp
-    mm = cp
-    n2 = nn * nn + mm * mm
-    if n2 < _YAW_EPS2:
+    ok, n, sf, cf, n_t, n_p, sf_t, sf_p, cf_t, cf_p = _yaw(st, ct, sp, cp)
+    if not ok:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0
-    n = math.sqrt(n2)
-    sf = nn / n
-    cf = mm / n
-    # derivatives of n, sf, cf with respect to theta (_t) and psi (_p)
-    n_t = nn * ct * sp / n
-    n_p = -sp * cp * ct * ct / n
-    sf_t = (ct * sp * n - nn * n_t) / n2
-    sf_p = (st * cp * n - nn * n_p) / n2
-    cf_t = -mm * n_t / n2
-    cf_p = (-sp * n - mm * n_p) / n2
     r10 = sf * ct
     r10_t = sf_t * ct - sf * st
     r10_p = sf_p * ct
@@ -1195,20 +1200,9 @@ def _c_plane_tool(c, d, z, st, ct, sp, cp):
     """Tool point T = O' + R (0, 0, -d) of the C-model pose (z, theta, psi) with chain 3 'plane' (y0 = -c R[1, 0],
     yaw phi = atan2(sin theta sin psi, cos psi)) and its Jacobian dT/d(z, theta, psi) (rows T_x, T_y, T_z), as
     (ok, tx, ty, tz, j01, j02, j11, j12, j21, j22) (column 0 is (0, 0, 1)); ok False where the yaw is undefined."""
-    nn = st * sp
-    mm = cp
-    n2 = nn * nn + mm * mm
-    if n2 < _YAW_EPS2:
+    ok, _, sf, cf, _, _, sf_t, sf_p, cf_t, cf_p = _yaw(st, ct, sp, cp)
+    if not ok:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    n = math.sqrt(n2)
-    sf = nn / n
-    cf = mm / n
-    n_t = nn * ct * sp / n
-    n_p = -sp * cp * ct * ct / n
-    sf_t = (ct * sp * n - nn * n_t) / n2
-    sf_p = (st * cp * n - nn * n_p) / n2
-    cf_t = -mm * n_t / n2
-    cf_p = (-sp * n - mm * n_p) / n2
     y0 = -c * sf * ct
     y0_t = -c * (sf_t * ct - sf * st)
     y0_p = -c * sf_p * ct
@@ -1243,9 +1237,7 @@ def _tool_stiffness(p, tx, ty, tz, z, th, ps):
             return 0.0, zero
         rx, ry, rz = fx - tx, fy - ty, fz - tz
         if max(abs(rx), abs(ry), abs(rz)) <= tol:
-            nn = st * sp
-            n = math.sqrt(nn * nn + cp * cp)
-            sf, cf = nn / n, cp / n
+            _, _, sf, cf, _, _, _, _, _, _ = _yaw(st, ct, sp, cp)
             return _stiffness(p, False, -c * sf * ct, z, st, ct, sp, cp, sf, cf, tx, ty, tz)
         # J = [[0, j01, j02], [0, j11, j12], [1, j21, j22]]: the angles from the first two rows, then z
         det = j01 * j12 - j02 * j11
