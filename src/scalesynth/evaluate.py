@@ -100,6 +100,9 @@ class ColumnPlan:
     bisections: int
     levels: int
     beta: float = 1.0
+    zlevels: int = 0  # most doublings of the z-cells on the coarse grid (z-levels, kernels.adaptive step 0)
+    zconfirm: int = 1  # consecutive z-level changes within the tolerance before the z-cells are trusted
+    faces: bool = False  # box-face columns as ghost neighbours of the edge columns (kernels.adaptive step 3)
 
     def coarse_cells(self, ndim: int) -> int:
         """Cells of the coarse grid (the unit of the statistics rows' counts)."""
@@ -159,7 +162,8 @@ def adaptive_population_stats(
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
     stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
                                                       plan.columns, plan.cells, plan.bisections, plan.levels,
-                                                      tolerance.volume, tolerance.gci, edges, plan.beta)
+                                                      tolerance.volume, tolerance.gci, edges, plan.beta,
+                                                      plan.zlevels, plan.zconfirm, plan.faces)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 
