@@ -3,29 +3,43 @@ Gauss rules; the columns refined (ternary) only where the column measures curve.
 
 Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
 
+0. z-levels (``zlevels`` > 0): level 0 is computed with m z-cells, then again with 2m, 4m, ... (every column of
+   the coarse grid) until ``zconfirm`` consecutive changes of the measure (relative) and of the GCI (absolute)
+   meet the tolerance, or ``zlevels`` doublings; the later steps use that z-resolution. A reachable shell thinner
+   than a z-cell lies between two nodes of every column, so no cross level can see it; nested node sets (m, 2m)
+   can miss the same shell twice, hence the confirmations (issue 15: 2pauu-ppap's lobe tips, pprs-rprs's and
+   rps-upu-tool's thin slabs, 1-24 % of the volume at m = 8).
 1. Columns run along the last task axis ("z"; planar mechanisms: y) over a cell-centred grid of the other axes
    (n x n columns; planar: n). Along a column the fields are evaluated at the m + 1 nodes ``zlo + k hz``; where
    reachability changes between two nodes, ``nbis`` bisection steps locate the boundary (estimate: the midpoint of
    the last bracket, error <= hz / 2^(nbis+1)). So the column's reachable length is exact to that precision, not
    a voxel count.
-2. Each reachable piece of a z-cell (between two reachable nodes, or between a node and the boundary) is integrated
-   by the 2-point Gauss-Legendre rule: every field at its two points, each with half the piece's length (a point
-   that turns out unreachable gives its weight to the other; a piece with neither reachable is dropped). The
-   points' fields and weights feed the shared statistics accumulator (kernels.grid), so every statistic of the
-   row layout (count, sum, sum of squares, min, max per field, band measures) exists as for uniform grids.
+2. Each reachable piece of a z-cell is integrated by the 2-point Gauss-Legendre rule: every field at its two points,
+   each with half the piece's length (a point that turns out unreachable gives its weight to the other; a piece
+   with neither reachable is dropped). The points' fields and weights feed the shared statistics accumulator
+   (kernels.grid), so every statistic of the row layout (count, sum, sum of squares, min, max per field, band
+   measures) exists as for uniform grids.
 3. Level 0 integrates the column measures L and LCI sums S over the cross grid by the midpoint rule. Its local
    error indicator is the second difference of L (and of S) over the neighbouring columns (the midpoint rule is
-   exact for linear variation; walls and silhouettes give large second differences). A column whose indicator
-   x cell area / 24 exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3
-   (planar: 3) cells, each with its own column (the centre one recomputed). The next level repeats steps 1-3 on
-   the new columns, with the others held at their coarser values.
+   exact for linear variation; walls and silhouettes give large second differences). At the box the neighbour is
+   the edge column itself (clamped), or, with ``faces``, the ghost value 2 F - L where F is the column on the box
+   face (x = lo or hi; y = lo or hi) next to it: a wall between an edge column's centre and the box face (a task
+   box cutting the workspace: rps-upu-tool) is otherwise invisible. A column whose indicator x cell area / 24
+   exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3 (planar: 3) cells,
+   each with its own column (the centre one recomputed). The next level repeats steps 1-3 on the new columns, with
+   the others held at their coarser values.
 4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
    (absolute) from level l-1; the design stops at the first level whose estimate meets the tolerance, or at
    ``maxlev``, or when no column is flagged for refinement (the estimate is then the last change, reported as
-   it is even when above the tolerance; 0 if that happens at level 0: the midpoint rule sees no curvature).
+   it is even when above the tolerance; 0 if that happens at level 0: the midpoint rule sees no curvature). The
+   reported estimate is the larger of it and the last z-level change.
 
-Counts are in units of the coarse cell (cross cell x hz): measure = count x hx hy hz. Parallel over designs, each
-design serial with a fixed order of columns: deterministic whatever the thread count.
+Limits: a change of 0 between two levels is not proof of accuracy (a wall whose refined columns' centres all stay
+on one side of it; tests/test_adaptive.py::test_box_face_columns_see_a_wall_inside_the_edge_columns); a shell
+thinner than the finest z-cell, or a slit narrower than the finest column spacing, is still missed.
+
+Counts are in units of the coarse cell (cross cell x hz with hz = box / m): measure = count x hx hy hz. Parallel
+over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
 """
 
 from __future__ import annotations
@@ -55,6 +69,19 @@ def _add_product(a, b, c):
     """a + b c without fastmath (no fused multiply-add): sample coordinates are computed exactly as the NumPy
     twin computes them, so a point on the box face (where reachability may flip) is the same point in both."""
     return a + b * c
+
+
+@njit(cache=True)
+def _div(a, b):
+    """a / b without fastmath ('arcp' would multiply by a rounded reciprocal): cell sizes as the twin computes them."""
+    return a / b
+
+
+@njit(cache=True)
+def _centre(lo, i, h, scale):
+    """lo + (i + 0.5) h / scale without fastmath (no reciprocal, no fused multiply-add): a column's cross coordinate
+    exactly as the NumPy twin computes it (near a singular surface a field can change by 1e-6 relative per ulp)."""
+    return lo + (i + 0.5) * h / scale
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -232,9 +259,9 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     ca = ndim - 1
     init_row(row, n_fields)
     zlo = lo_d[ca]
-    hz0 = (hi_d[ca] - zlo) / m
-    hx = (hi_d[0] - lo_d[0]) / n
-    hy = (hi_d[1] - lo_d[1]) / n if ndim == 3 else 1.0
+    hz0 = _div(hi_d[ca] - zlo, m)
+    hx = _div(hi_d[0] - lo_d[0], n)
+    hy = _div(hi_d[1] - lo_d[1], n) if ndim == 3 else 1.0
     zfix = lo_d[2]
     info[:] = 0.0
     if not (hz0 > 0.0 and hx > 0.0 and hy > 0.0):
@@ -275,15 +302,15 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     zl = 0
     zok = 0
     while True:
-        hz = (hi_d[ca] - zlo) / mz
+        hz = _div(hi_d[ca] - zlo, mz)
         scale = 1.0
         for _ in range(level):
             scale *= 3.0
         area = 1.0 / (scale * scale) if ndim == 3 else 1.0 / scale
         rows = np.empty((n_active, ncol))
         for a in range(n_active):
-            x = lo_d[0] + (ci[a] + 0.5) * hx / scale
-            y = lo_d[1] + (cj[a] + 0.5) * hy / scale
+            x = _centre(lo_d[0], ci[a], hx, scale)
+            y = _centre(lo_d[1], cj[a], hy, scale)
             FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
             evals += out[3]
             init_row(colrow, n_fields)
@@ -328,8 +355,8 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
                         for side in range(2):
                             if idx != (0 if side == 0 else edge):
                                 continue
-                            x = lo_d[0] + (ci[a] + 0.5) * hx / scale
-                            y = lo_d[1] + (cj[a] + 0.5) * hy / scale
+                            x = _centre(lo_d[0], ci[a], hx, scale)
+                            y = _centre(lo_d[1], cj[a], hy, scale)
                             fpos = END_NUDGE if side == 0 else n - END_NUDGE
                             if axis == 0:
                                 x = _add_product(lo_d[0], fpos, hx)
