@@ -111,9 +111,17 @@ class ColumnPlan:
 
 # per task dimension, and per mechanism where its workspaces need less (chosen with
 # `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid on 20 random
-# designs): planar workspaces have parts thinner than 1/64 of the box along y; ups-sspr's are smooth and simple
-ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6), 3: ColumnPlan(24, 8, 5, 3, beta=3.0)}
-ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {"ups-sspr": ColumnPlan(8, 6, 5, 3, beta=3.0)}
+# designs): planar workspaces have parts thinner than 1/64 of the box along y; 3-D workspaces have shells thinner
+# than the 8 coarse z-cells (2pauu-ppap's lobe tips, pprs-rprs's and rps-upu-tool's thin slabs) and walls between
+# the edge columns and the box (rps-upu-tool's task box), hence z-levels confirmed twice and box-face columns;
+# rps-upu's and ups-sspr's workspaces are smooth and thick (the benchmark meets the tolerance without either)
+ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6),
+                 3: ColumnPlan(24, 8, 5, 3, beta=1.0, zlevels=5, zconfirm=2, faces=True)}
+ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
+    "ups-sspr": ColumnPlan(8, 6, 5, 3, beta=3.0),
+    "rps-upu": ColumnPlan(24, 8, 5, 3, beta=3.0),
+    "2pauu-ppap": ColumnPlan(24, 8, 5, 3, beta=3.0, zlevels=5, zconfirm=2, faces=True),
+}
 
 
 def adaptive_plan(mech: Mechanism) -> ColumnPlan:
