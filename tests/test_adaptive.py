@@ -175,12 +175,14 @@ def test_box_face_columns_see_a_wall_inside_the_edge_columns():
     assert est == pytest.approx(abs(157 / 162 - 26 / 27) / (157 / 162), rel=1e-12)
 
 
-def test_adaptive_is_deterministic_and_independent_of_the_batch():
+@pytest.mark.parametrize("name", ["rps-upu", "rps-upu-tool"])
+def test_adaptive_is_deterministic_and_independent_of_the_batch(name):
     """Two runs give byte-identical rows, a design evaluated alone gives the same row as inside a population
     (each design is evaluated serially, designs in parallel: no dependence on threads or scheduling), and every
-    field's statistics use the same weights (the band measures add up to the count)."""
-    mech = get("rps-upu")
-    cfg = load_config(config_for("rps-upu"))
+    field's statistics use the same weights (the band measures add up to the count). rps-upu-tool: the plan with
+    z-levels and box-face columns."""
+    mech = get(name)
+    cfg = load_config(config_for(name))
     options = cfg.resolved_options()
     base = cfg.resolved_design()
     k0, k1 = list(base)[:2]
