@@ -441,7 +441,8 @@ def rps_upu_tool_fields(design, options, x, y, z):
     return out.reshape(x.shape + (3,))
 
 
-def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, beta=1.0):
+def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, beta=1.0, zlevels=0,
+                 zconfirm=1, faces=False):
     """NumPy twin of kernels.adaptive.column_stats for one design, vectorised over the active columns of a level:
     ``fields(points (k, 3)) -> (k, n_fields)`` (field 0 LCI, -1 unreachable); lo, hi: the design's box (3,).
     Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
@@ -449,16 +450,14 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     ca = ndim - 1
     zlo = lo[ca]
-    hz = (hi[ca] - zlo) / m
-    zn = zlo + np.arange(m + 1) * hz
+    hz0 = (hi[ca] - zlo) / m
     nudge = 2.0**-20  # kernels.adaptive.END_NUDGE: the end nodes are evaluated just inside the box
-    z_eval = zlo + np.r_[nudge, np.arange(1, m), m - nudge] * hz
     hx = (hi[0] - lo[0]) / n
     hy = (hi[1] - lo[1]) / n if ndim == 3 else 1.0
     gx = 1.0 / np.sqrt(3.0)
     evals = 0
     nb = len(edges) - 1
-    if not (hz > 0 and hx > 0 and hy > 0):  # an empty box: nothing reachable
+    if not (hz0 > 0 and hx > 0 and hy > 0):  # an empty box: nothing reachable
         row = np.zeros(1 + 4 * n_fields + nb)
         row[3:1 + 4 * n_fields:4], row[4:1 + 4 * n_fields:4] = np.inf, -np.inf
         return row, 0.0, 0.0, 0, 0
@@ -466,10 +465,15 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     def pts(xx, yy, zz):
         return np.c_[xx, yy, zz] if ndim == 3 else np.c_[xx, zz, np.full(zz.shape, lo[2])]
 
-    def columns(X, Y, area):
-        """Column measure L, LCI sum S (z in units of hz) and the Gauss points (fields, weights x area) of each."""
+    def columns(X, Y, area, mz):
+        """Column measure L, LCI sum S (z in units of hz0) and the Gauss points (fields, weights x area) of each,
+        with mz z-cells."""
         nonlocal evals
         nc = X.size
+        hz = (hi[ca] - zlo) / mz
+        zn = zlo + np.arange(mz + 1) * hz
+        z_eval = zlo + np.r_[nudge, np.arange(1, mz), mz - nudge] * hz
+        m = mz
         lci = fields(pts(np.repeat(X, m + 1), np.repeat(Y, m + 1), np.tile(z_eval, nc)))[:, 0].reshape(nc, m + 1)
         evals += nc * (m + 1)
         r = lci >= 0
@@ -493,7 +497,7 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         q = fields(pts(np.repeat(X[pc], 2), np.repeat(Y[pc], 2), zq)).reshape(-1, 2, n_fields)
         evals += zq.size
         ok = q[:, :, 0] >= 0
-        w = np.where(ok, np.where(ok.sum(axis=1) == 2, half, 2 * half)[:, None] / hz, 0.0)
+        w = np.where(ok, np.where(ok.sum(axis=1) == 2, half, 2 * half)[:, None] / hz0, 0.0)
         L = np.bincount(pc, weights=w.sum(axis=1), minlength=nc)
         S = np.bincount(pc, weights=(w * np.where(ok, q[:, :, 0], 0.0)).sum(axis=1), minlength=nc)
         return L, S, np.repeat(pc, 2), q.reshape(-1, n_fields), w.ravel() * area
@@ -501,32 +505,64 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     ny = n if ndim == 3 else 1
     ci, cj = (v.ravel() for v in np.meshgrid(np.arange(n), np.arange(ny), indexing="ij"))
     lg, sg = np.zeros((n, ny)), np.zeros((n, ny))
+    # face columns [side, L or S, index]: x = lo, hi per j; y = lo, hi per i
+    fxg, fyg = np.zeros((2, 2, ny)), np.zeros((2, 2, n))
     kept_v, kept_w = [], []
     prev = None
-    err_v = err_g = 0.0
+    err_v = err_g = zerr_v = zerr_g = 0.0
     level = 0
+    mz, zl, zok = m, 0, 0
+
+    def change(vol, gci):
+        return (abs(vol - prev[0]) / vol if vol > 0 else (0.0 if prev[0] == 0 else 1.0)), abs(gci - prev[1])
+
     while True:
         scale = 3.0 ** level
         area = 1.0 / scale ** (ndim - 1)
         X = lo[0] + (ci + 0.5) * hx / scale
         Y = lo[1] + (cj + 0.5) * hy / scale
-        L, S, owner, qv, qw = columns(X, Y, area)
+        L, S, owner, qv, qw = columns(X, Y, area, mz)
         lg[ci, cj], sg[ci, cj] = L, S
         vol, ssum = lg.sum() * area, sg.sum() * area
         gci = ssum / vol if vol > 0 else 0.0
-        if prev is not None:
-            err_v = abs(vol - prev[0]) / vol if vol > 0 else (0.0 if prev[0] == 0 else 1.0)
-            err_g = abs(gci - prev[1])
+        if level == 0 and zl > 0:
+            zerr_v, zerr_g = change(vol, gci)
+            zok = zok + 1 if zerr_v <= tol_v and zerr_g <= tol_g else 0
+        if level == 0 and zl < zlevels and zok < zconfirm:
+            prev = (vol, gci)  # z-levels: again with twice the z-cells
+            mz, zl = 2 * mz, zl + 1
+            continue
+        if level > 0:
+            err_v, err_g = change(vol, gci)
         prev = (vol, gci)
         stop = level >= maxlev or (level >= 1 and err_v <= tol_v and err_g <= tol_g)
         flag = np.zeros(ci.size, dtype=bool)
         if not stop:  # second differences along each cross axis, neighbours clamped at the box
+            if faces:  # the face column next to each active edge column (in column order, x faces first)
+                for axis in range(ndim - 1):
+                    idx, other = (ci, cj) if axis == 0 else (cj, ci)
+                    fg = fxg if axis == 0 else fyg
+                    for side in (0, 1):
+                        e = idx == (0 if side == 0 else lg.shape[axis] - 1)
+                        if not e.any():
+                            continue
+                        face = lo[axis] + (nudge if side == 0 else n - nudge) * (hx if axis == 0 else hy)
+                        FX = np.full(e.sum(), face) if axis == 0 else X[e]
+                        FY = np.full(e.sum(), face) if axis == 1 else Y[e]
+                        fl, fs, *_ = columns(FX, FY, area, mz)
+                        fg[side, 0, other[e]], fg[side, 1, other[e]] = fl, fs
             for axis in range(ndim - 1):
                 sh = lg.shape[axis]
                 lo_i = (np.maximum(ci - 1, 0), cj) if axis == 0 else (ci, np.maximum(cj - 1, 0))
                 hi_i = (np.minimum(ci + 1, sh - 1), cj) if axis == 0 else (ci, np.minimum(cj + 1, sh - 1))
-                for g, tol in ((lg, tol_v), (sg, tol_g)):
-                    d2 = np.abs(g[hi_i] + g[lo_i] - 2.0 * g[ci, cj])
+                idx, other = (ci, cj) if axis == 0 else (cj, ci)
+                fg = fxg if axis == 0 else fyg
+                for t, (g, tol) in enumerate(((lg, tol_v), (sg, tol_g))):
+                    c, below, above = g[ci, cj], g[lo_i], g[hi_i]
+                    if faces:  # ghost neighbour 2 F - c beyond the box face (F: the face column)
+                        below = np.where(idx == 0, 2.0 * fg[0, t, other] - c, below)
+                        above = np.where(idx == sh - 1, 2.0 * fg[1, t, other] - c, above)
+                    d2 = np.abs(above + below - 2.0 * c)
                     flag |= d2 * area / 24.0 > tol * vol * beta / (n * ny)
         keep = ~flag[owner]
         kept_v.append(qv[keep])
@@ -538,6 +574,7 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         cj = (3 * cj[flag][:, None] + db[None, :]).ravel() if ndim == 3 else np.zeros(ci.size, dtype=np.int64)
         lg = np.repeat(np.repeat(lg, 3, axis=0), 3 if ndim == 3 else 1, axis=1)
         sg = np.repeat(np.repeat(sg, 3, axis=0), 3 if ndim == 3 else 1, axis=1)
+        fxg, fyg = np.repeat(fxg, 3 if ndim == 3 else 1, axis=2), np.repeat(fyg, 3, axis=2)
         level += 1
     v, wt = np.concatenate(kept_v), np.concatenate(kept_w)
     keep = wt > 0
@@ -549,4 +586,4 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
                                      v[:, f].min() if len(v) else np.inf, v[:, f].max() if len(v) else -np.inf]
     band = np.searchsorted(np.asarray(edges)[1:-1], v[:, 0], side="left")
     row[1 + 4 * n_fields:] = np.bincount(band, weights=wt, minlength=nb)
-    return row, err_v, err_g, level, evals
+    return row, max(err_v, zerr_v), max(err_g, zerr_g), level, evals

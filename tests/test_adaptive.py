@@ -9,6 +9,7 @@ import sys
 import numpy as np
 import pytest
 import yaml
+from numba import njit
 
 from scalesynth.config import config_from_dict, load_config
 from scalesynth.errors import ConfigError
@@ -41,7 +42,10 @@ def test_column_kernel_equals_numpy_twin(name):
     """Same nodes, bisections, Gauss points, refinement decisions and stopping level: the same number of field
     evaluations, the same error estimates, and every statistic of every field equal to the twin's up to the order
     of the floating-point sums and of the field kernel's own rounding, which differs in the last bits between two
-    compilations of it (fused multiply-adds): 1e-12 relative. The twin evaluates the fields through the
+    compilations of it (fused multiply-adds): 1e-12 relative for the count, the LCI statistics and the band
+    measures; the other fields' statistics within 1e-12 plus 4x their change when the twin evaluates those fields
+    one ulp away from the same points (~1e-16 relative except next to a singular surface). Plans with and without
+    z-levels and box-face columns. The twin evaluates the fields through the
     mechanism's kernel (population_points_fields) so that only the algorithm is compared; the field kernels
     themselves are checked against NumPy SVD twins in test_fields.py."""
     mech = get(name)
@@ -55,17 +59,32 @@ def test_column_kernel_equals_numpy_twin(name):
         return kgrid.population_points_fields(mech.field_kernel, mech.n_fields, packed[None, :], pts)[0]
 
     n = 6 if ndim == 3 else 12
-    for maxlev, beta in ((0, 1.0), (2, 1.0), (2, 3.0)):
+    for maxlev, beta, zlevels, zconfirm, faces in ((0, 1.0, 0, 1, False), (2, 1.0, 0, 1, False),
+                                                   (2, 3.0, 0, 1, False), (2, 1.0, 2, 2, True)):
+        opt = dict(zlevels=zlevels, zconfirm=zconfirm, faces=faces)
         s, ev, eg, lv, ne = column_stats(mech.field_kernel, mech.n_fields, packed[None, :], lo[None, :],
-                                         hi[None, :], ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta)
+                                         hi[None, :], ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt)
         row, tv, tg, tl, tn = column_twin(fields, mech.n_fields, lo, hi, ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES,
-                                          beta)
+                                          beta, **opt)
         assert row[0] > 0, name
         assert lv[0] == tl and ne[0] == tn
         assert ev[0] == pytest.approx(tv, rel=1e-10, abs=1e-15)
         assert eg[0] == pytest.approx(tg, rel=1e-10, abs=1e-15)
-        np.testing.assert_allclose(s[0], row, rtol=1e-12, atol=1e-12 * np.abs(row).max())
-        if beta == 1.0 and maxlev == 2:
+        # the other fields' statistics up to their sensitivity to the field kernel's rounding: 4x their change when
+        # the twin evaluates every field but the LCI (so the same points are reachable) one ulp away, either way
+        # (pprs-rprs's deflection changes by 2.6e-6 relative per ulp of z next to its singular surface, LCI 5e-6,
+        # where the two compilations differ by 1.2e-8 relative in its max, 1.25x its one-ulp change; elsewhere
+        # the slack is ~1e-16)
+        slack = np.zeros(row.shape)
+        for direction in (np.inf, -np.inf):
+            ulp, *_ = column_twin(lambda pts, d=direction: np.c_[fields(pts)[:, :1],
+                                                                fields(np.nextafter(pts, d))[:, 1:]],
+                                  mech.n_fields, lo, hi, ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt)
+            slack = np.maximum(slack, 4.0 * np.abs(ulp - row))
+        lci_cols = [0, 1, 2, 3, 4] + list(range(1 + 4 * mech.n_fields, len(row)))
+        np.testing.assert_allclose(s[0][lci_cols], row[lci_cols], rtol=1e-12, atol=1e-12 * np.abs(row).max())
+        assert np.all(np.abs(s[0] - row) <= 1e-12 * np.abs(row) + 1e-12 * np.abs(row).max() + slack), name
+        if beta == 1.0 and maxlev == 2 and not zlevels:
             assert tl >= 1  # the refinement itself was compared
 
 
@@ -88,12 +107,82 @@ def test_adaptive_seed000_volume_against_exact_quadrature(group):
     assert r.error_volume[0] >= abs(volume - exact) / exact
 
 
-def test_adaptive_is_deterministic_and_independent_of_the_batch():
+@njit(cache=True)
+def _slab_field(p, x, y, z, out):
+    """Synthetic field kernel with the three slots every mechanism has (LCI, sigma_min, sigma_max): LCI 0.5 inside
+    the region p[0] < z < p[1] and x > p[2], else -1; sigma_min 1, sigma_max 2."""
+    out[0] = 0.5 if p[0] < z < p[1] and x > p[2] else -1.0
+    out[1] = 1.0
+    out[2] = 2.0
+
+
+def _synthetic(params, n, m, nbis, maxlev, tol=0.002, **opt):
+    """(volume, GCI, error_volume, levels, evaluations) of the unit box by the kernel, after checking that the NumPy
+    twin gives the same row, estimates and number of evaluations."""
+    lo, hi = np.zeros(3), np.ones(3)
+    p = np.asarray(params, dtype=float)
+    s, ev, eg, lv, ne = column_stats(_slab_field, 3, p[None, :], lo[None], hi[None], 3, n, m, nbis, maxlev, tol,
+                                     tol, EDGES, 1.0, **opt)
+
+    def fields(pts):
+        inside = (p[0] < pts[:, 2]) & (pts[:, 2] < p[1]) & (pts[:, 0] > p[2])
+        return np.c_[np.where(inside, 0.5, -1.0), np.ones(len(pts)), np.full(len(pts), 2.0)]
+
+    row, tv, tg, tl, tn = column_twin(fields, 3, lo, hi, 3, n, m, nbis, maxlev, tol, tol, EDGES, 1.0, **opt)
+    assert (lv[0], ne[0]) == (tl, tn)
+    assert ev[0] == pytest.approx(tv, rel=1e-10, abs=1e-15)
+    np.testing.assert_allclose(s[0], row, rtol=1e-12, atol=1e-15)
+    volume = s[0, 0] / (n * n * m)  # counts in coarse cells of the unit box
+    return volume, (s[0, 1] / s[0, 0] if s[0, 0] > 0 else 0.0), ev[0], lv[0], ne[0]
+
+
+def test_z_levels_find_a_slab_between_the_coarse_nodes():
+    """A slab 0.40 < z < 0.43 across the whole unit box (volume 0.03) lies between the coarse nodes z = 0.375 and
+    0.5 of m = 8 z-cells and between those of m = 16 (0.375, 0.4375): without z-levels the evaluator reports an
+    empty workspace with error estimate 0, and with z-levels trusted after one small change it stops at m = 16
+    (the change 8 -> 16 is 0: nested node sets miss the same slab twice). With two confirmations it doubles
+    to m = 32 (node 0.40625 inside the slab), then to 64 and 128 (two changes within the tolerance): volume 0.03
+    within its two bisected boundaries' bracket, 2 x (1/128) / 2^13 (12 bisection steps), GCI 0.5 (the constant
+    LCI)."""
+    slab = (0.40, 0.43, -1.0)
+    assert _synthetic(slab, 6, 8, 12, 0)[:3] == (0.0, 0.0, 0.0)
+    assert _synthetic(slab, 6, 8, 12, 0, zlevels=5, zconfirm=1)[:3] == (0.0, 0.0, 0.0)
+    volume, gci, est, _, evals = _synthetic(slab, 6, 8, 12, 0, zlevels=5, zconfirm=2)
+    assert volume == pytest.approx(0.03, abs=2 * (1 / 128) / 2**13)
+    assert gci == pytest.approx(0.5, rel=1e-12)
+    assert est <= 0.002
+    # nodes of m = 8, 16, 32, 64, 128 for each of the 36 columns: the doubling stopped at 128
+    assert evals >= 36 * (9 + 17 + 33 + 65 + 129)
+
+
+def test_box_face_columns_see_a_wall_inside_the_edge_columns():
+    """A workspace x > 0.03 filling the rest of the unit box (volume 0.97): the edge columns (6 per axis: centres
+    x = 1/12 and beyond) are all reachable, so every column has the same measure, no second difference flags
+    anything and the evaluator reports 1.0 with error estimate 0, even for a tolerance it cannot meet (1e-9). The
+    face columns (x = 0) see the wall: with that tolerance the evaluator refines the columns next to it up to the
+    last level (3): 17/18 at level 1 (column centre 1/36 < 0.03), 26/27 at level 2, 157/162 at level 3 (the 5
+    columns of width 1/162 whose centres lie below 0.03 unreachable), within 1/162 of 0.97 (the wall lies in one
+    full-height column of that width), with a nonzero estimate (the change 26/27 -> 157/162). A wall at 0.05 or
+    0.02 would stop with a change of 0 (the refined columns' centres all on one side of it: the limit stated in
+    kernels.adaptive)."""
+    wall = (-1.0, 2.0, 0.03)
+    volume, _, est, levels, _ = _synthetic(wall, 6, 4, 5, 3, tol=1e-9)
+    assert (volume, est, levels) == (1.0, 0.0, 0)
+    volume, _, est, levels, _ = _synthetic(wall, 6, 4, 5, 3, tol=1e-9, faces=True)
+    assert levels == 3
+    assert volume == pytest.approx(157 / 162, rel=1e-12)
+    assert abs(volume - 0.97) <= 1 / 162
+    assert est == pytest.approx(abs(157 / 162 - 26 / 27) / (157 / 162), rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["rps-upu", "rps-upu-tool"])
+def test_adaptive_is_deterministic_and_independent_of_the_batch(name):
     """Two runs give byte-identical rows, a design evaluated alone gives the same row as inside a population
     (each design is evaluated serially, designs in parallel: no dependence on threads or scheduling), and every
-    field's statistics use the same weights (the band measures add up to the count)."""
-    mech = get("rps-upu")
-    cfg = load_config(config_for("rps-upu"))
+    field's statistics use the same weights (the band measures add up to the count). rps-upu-tool: the plan with
+    z-levels and box-face columns."""
+    mech = get(name)
+    cfg = load_config(config_for(name))
     options = cfg.resolved_options()
     base = cfg.resolved_design()
     k0, k1 = list(base)[:2]

@@ -100,6 +100,9 @@ class ColumnPlan:
     bisections: int
     levels: int
     beta: float = 1.0
+    zlevels: int = 0  # most doublings of the z-cells on the coarse grid (z-levels, kernels.adaptive step 0)
+    zconfirm: int = 1  # consecutive z-level changes within the tolerance before the z-cells are trusted
+    faces: bool = False  # box-face columns as ghost neighbours of the edge columns (kernels.adaptive step 3)
 
     def coarse_cells(self, ndim: int) -> int:
         """Cells of the coarse grid (the unit of the statistics rows' counts)."""
@@ -108,9 +111,17 @@ class ColumnPlan:
 
 # per task dimension, and per mechanism where its workspaces need less (chosen with
 # `python benchmarks/bench.py adaptive`, which checks the tolerance against a 3x finer uniform grid on 20 random
-# designs): planar workspaces have parts thinner than 1/64 of the box along y; ups-sspr's are smooth and simple
-ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6), 3: ColumnPlan(24, 8, 5, 3, beta=3.0)}
-ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {"ups-sspr": ColumnPlan(8, 6, 5, 3, beta=3.0)}
+# designs): planar workspaces have parts thinner than 1/64 of the box along y; 3-D workspaces have shells thinner
+# than the 8 coarse z-cells (2pauu-ppap's lobe tips, pprs-rprs's and rps-upu-tool's thin slabs) and walls between
+# the edge columns and the box (rps-upu-tool's task box), hence z-levels confirmed twice and box-face columns;
+# rps-upu's and ups-sspr's workspaces are smooth and thick (the benchmark meets the tolerance without either)
+ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6),
+                 3: ColumnPlan(24, 8, 5, 3, beta=1.0, zlevels=5, zconfirm=2, faces=True)}
+ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
+    "ups-sspr": ColumnPlan(8, 6, 5, 3, beta=3.0),
+    "rps-upu": ColumnPlan(24, 8, 5, 3, beta=3.0),
+    "2pauu-ppap": ColumnPlan(24, 8, 5, 3, beta=3.0, zlevels=5, zconfirm=2, faces=True),
+}
 
 
 def adaptive_plan(mech: Mechanism) -> ColumnPlan:
@@ -159,7 +170,8 @@ def adaptive_population_stats(
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
     stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
                                                       plan.columns, plan.cells, plan.bisections, plan.levels,
-                                                      tolerance.volume, tolerance.gci, edges, plan.beta)
+                                                      tolerance.volume, tolerance.gci, edges, plan.beta,
+                                                      plan.zlevels, plan.zconfirm, plan.faces)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 

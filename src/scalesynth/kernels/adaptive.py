@@ -3,29 +3,43 @@ Gauss rules; the columns refined (ternary) only where the column measures curve.
 
 Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
 
+0. z-levels (``zlevels`` > 0): level 0 is computed with m z-cells, then again with 2m, 4m, ... (every column of
+   the coarse grid) until ``zconfirm`` consecutive changes of the measure (relative) and of the GCI (absolute)
+   meet the tolerance, or ``zlevels`` doublings; the later steps use that z-resolution. A reachable shell thinner
+   than a z-cell lies between two nodes of every column, so no cross level can see it; nested node sets (m, 2m)
+   can miss the same shell twice, hence the confirmations (issue 15: 2pauu-ppap's lobe tips, pprs-rprs's and
+   rps-upu-tool's thin slabs, 1-24 % of the volume at m = 8).
 1. Columns run along the last task axis ("z"; planar mechanisms: y) over a cell-centred grid of the other axes
    (n x n columns; planar: n). Along a column the fields are evaluated at the m + 1 nodes ``zlo + k hz``; where
    reachability changes between two nodes, ``nbis`` bisection steps locate the boundary (estimate: the midpoint of
    the last bracket, error <= hz / 2^(nbis+1)). So the column's reachable length is exact to that precision, not
    a voxel count.
-2. Each reachable piece of a z-cell (between two reachable nodes, or between a node and the boundary) is integrated
-   by the 2-point Gauss-Legendre rule: every field at its two points, each with half the piece's length (a point
-   that turns out unreachable gives its weight to the other; a piece with neither reachable is dropped). The
-   points' fields and weights feed the shared statistics accumulator (kernels.grid), so every statistic of the
-   row layout (count, sum, sum of squares, min, max per field, band measures) exists as for uniform grids.
+2. Each reachable piece of a z-cell is integrated by the 2-point Gauss-Legendre rule: every field at its two points,
+   each with half the piece's length (a point that turns out unreachable gives its weight to the other; a piece
+   with neither reachable is dropped). The points' fields and weights feed the shared statistics accumulator
+   (kernels.grid), so every statistic of the row layout (count, sum, sum of squares, min, max per field, band
+   measures) exists as for uniform grids.
 3. Level 0 integrates the column measures L and LCI sums S over the cross grid by the midpoint rule. Its local
    error indicator is the second difference of L (and of S) over the neighbouring columns (the midpoint rule is
-   exact for linear variation; walls and silhouettes give large second differences). A column whose indicator
-   x cell area / 24 exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3
-   (planar: 3) cells, each with its own column (the centre one recomputed). The next level repeats steps 1-3 on
-   the new columns, with the others held at their coarser values.
+   exact for linear variation; walls and silhouettes give large second differences). At the box the neighbour is
+   the edge column itself (clamped), or, with ``faces``, the ghost value 2 F - L where F is the column on the box
+   face (x = lo or hi; y = lo or hi) next to it: a wall between an edge column's centre and the box face (a task
+   box cutting the workspace: rps-upu-tool) is otherwise invisible. A column whose indicator x cell area / 24
+   exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3 (planar: 3) cells,
+   each with its own column (the centre one recomputed). The next level repeats steps 1-3 on the new columns, with
+   the others held at their coarser values.
 4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
    (absolute) from level l-1; the design stops at the first level whose estimate meets the tolerance, or at
    ``maxlev``, or when no column is flagged for refinement (the estimate is then the last change, reported as
-   it is even when above the tolerance; 0 if that happens at level 0: the midpoint rule sees no curvature).
+   it is even when above the tolerance; 0 if that happens at level 0: the midpoint rule sees no curvature). The
+   reported estimate is the larger of it and the last z-level change.
 
-Counts are in units of the coarse cell (cross cell x hz): measure = count x hx hy hz. Parallel over designs, each
-design serial with a fixed order of columns: deterministic whatever the thread count.
+Limits: a change of 0 between two levels is not proof of accuracy (a wall whose refined columns' centres all stay
+on one side of it; tests/test_adaptive.py::test_box_face_columns_see_a_wall_inside_the_edge_columns); a shell
+thinner than the finest z-cell, or a slit narrower than the finest column spacing, is still missed.
+
+Counts are in units of the coarse cell (cross cell x hz with hz = box / m): measure = count x hx hy hz. Parallel
+over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
 """
 
 from __future__ import annotations
@@ -57,6 +71,19 @@ def _add_product(a, b, c):
     return a + b * c
 
 
+@njit(cache=True)
+def _div(a, b):
+    """a / b without fastmath ('arcp' would multiply by a rounded reciprocal): cell sizes as the twin computes them."""
+    return a / b
+
+
+@njit(cache=True)
+def _centre(lo, i, h, scale):
+    """lo + (i + 0.5) h / scale without fastmath (no reciprocal, no fused multiply-add): a column's cross coordinate
+    exactly as the NumPy twin computes it (near a singular surface a field can change by 1e-6 relative per ulp)."""
+    return lo + (i + 0.5) * h / scale
+
+
 @njit(cache=True, fastmath=FASTMATH)
 def add_row(acc, row, n_fields):
     """Fold statistics row ``row`` into ``acc`` (sums added, min/max combined)."""
@@ -84,7 +111,7 @@ def level_sums(lg, sg, area):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, flags):
+def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces, fxg, fyg, flags):
     """flags[a] = whether active column a (cell ci[a], cj[a]) is refined: a second difference of the column
     measure (or LCI sum) along a cross axis, x area / 24, above its budget (neighbours clamped at the box)."""
     nl = lg.shape[0]
@@ -98,13 +125,36 @@ def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, flags
                 i0, j0, i1, j1 = max(i - 1, 0), j, min(i + 1, nl - 1), j
             else:
                 i0, j0, i1, j1 = i, max(j - 1, 0), i, min(j + 1, nyl - 1)
-            d2 = abs(lg[i1, j1] + lg[i0, j0] - 2.0 * lg[i, j])
-            if d2 * area / 24.0 > budget_v:
-                f = True
-            d2 = abs(sg[i1, j1] + sg[i0, j0] - 2.0 * sg[i, j])
-            if d2 * area / 24.0 > budget_g:
-                f = True
+            for t in range(2):
+                g = lg if t == 0 else sg
+                c = g[i, j]
+                below = g[i0, j0]
+                above = g[i1, j1]
+                if faces:
+                    # at the box, the neighbour is the ghost 2 F - c, F the face column's value (linear
+                    # extrapolation through the face): a wall between the edge column and the face shows
+                    idx = i if axis == 0 else j
+                    other = j if axis == 0 else i
+                    fg = fxg if axis == 0 else fyg
+                    if idx == 0:
+                        below = 2.0 * fg[0, t, other] - c
+                    if idx == (nl - 1 if axis == 0 else nyl - 1):
+                        above = 2.0 * fg[1, t, other] - c
+                d2 = abs(above + below - 2.0 * c)
+                if d2 * area / 24.0 > (budget_v if t == 0 else budget_g):
+                    f = True
         flags[a] = f
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def refine_faces(fg, r):
+    """Face-column values [side, L or S, index] at the next level: every value repeated over its r children."""
+    out = np.empty((2, 2, fg.shape[2] * r))
+    for s in range(2):
+        for t in range(2):
+            for i in range(out.shape[2]):
+                out[s, t, i] = fg[s, t, i // r]
+    return out
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -118,9 +168,90 @@ def refine_grid(g, ndim):
     return out
 
 
-def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges, row, info):
-    """Template (serial): statistics row of one design into ``row``; info: error_volume, error_gci, level,
-    evaluations."""
+def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out):
+    """Template (serial): one column at (x, y) with ``mz`` z-cells of height ``hz`` (steps 1-2): its Gauss points'
+    fields into buf[:, :npts] and weights (x ``area``, in units of ``hz0``) into wbuf; out = (column measure L, LCI
+    sum S, npts, field-kernel calls)."""
+    n_fields = N_FIELDS
+    evals = 0.0
+    for k in range(mz + 1):
+        zk = _add_product(zlo, END_NUDGE if k == 0 else (mz - END_NUDGE if k == mz else k), hz)
+        if ndim == 3:
+            FIELD_KERNEL(p, x, y, zk, cell)
+        else:
+            FIELD_KERNEL(p, x, zk, zfix, cell)
+        for f in range(n_fields):
+            nodes[k, f] = cell[f]
+    evals += mz + 1
+    npts = 0
+    col_l = 0.0
+    col_s = 0.0
+    for k in range(mz):
+        r0 = nodes[k, 0] >= 0.0
+        r1 = nodes[k + 1, 0] >= 0.0
+        if not r0 and not r1:
+            continue
+        za = _add_product(zlo, k, hz)
+        zb = _add_product(zlo, k + 1, hz)
+        if r0 != r1:
+            # bisection: [a, b] keeps node k's reachability at a
+            ba = za
+            bb = zb
+            for _ in range(nbis):
+                mid = 0.5 * (ba + bb)
+                if ndim == 3:
+                    FIELD_KERNEL(p, x, y, mid, cell)
+                else:
+                    FIELD_KERNEL(p, x, mid, zfix, cell)
+                if (cell[0] >= 0.0) == r0:
+                    ba = mid
+                else:
+                    bb = mid
+            evals += nbis
+            cross = 0.5 * (ba + bb)
+            if r0:
+                zb = cross
+            else:
+                za = cross
+        # 2. 2-point Gauss rule on the piece [za, zb]
+        half = 0.5 * (zb - za)
+        zm = 0.5 * (za + zb)
+        if ndim == 3:
+            FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
+            FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
+        else:
+            FIELD_KERNEL(p, x, _add_product(zm, -half, GAUSS_X), zfix, q0)
+            FIELD_KERNEL(p, x, _add_product(zm, half, GAUSS_X), zfix, q1)
+        evals += 2
+        ok0 = q0[0] >= 0.0
+        ok1 = q1[0] >= 0.0
+        if not ok0 and not ok1:
+            continue
+        w = half / hz0 if ok0 and ok1 else 2.0 * half / hz0
+        if ok0:
+            for f in range(n_fields):
+                buf[f, npts] = q0[f]
+            wbuf[npts] = w * area
+            npts += 1
+            col_l += w
+            col_s += w * q0[0]
+        if ok1:
+            for f in range(n_fields):
+                buf[f, npts] = q1[f]
+            wbuf[npts] = w * area
+            npts += 1
+            col_l += w
+            col_s += w * q1[0]
+    out[0] = col_l
+    out[1] = col_s
+    out[2] = npts
+    out[3] = evals
+
+
+def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces, edges, row,
+                  info):
+    """Template (serial; FIELD_KERNEL is the bound ``_column``): statistics row of one design into ``row``; info:
+    error_volume, error_gci, level, evaluations."""
     n_fields = N_FIELDS
     nb = edges.shape[0] - 1
     ncol = 1 + 4 * n_fields + nb
@@ -128,20 +259,24 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, e
     ca = ndim - 1
     init_row(row, n_fields)
     zlo = lo_d[ca]
-    hz = (hi_d[ca] - zlo) / m
-    hx = (hi_d[0] - lo_d[0]) / n
-    hy = (hi_d[1] - lo_d[1]) / n if ndim == 3 else 1.0
+    hz0 = _div(hi_d[ca] - zlo, m)
+    hx = _div(hi_d[0] - lo_d[0], n)
+    hy = _div(hi_d[1] - lo_d[1], n) if ndim == 3 else 1.0
     zfix = lo_d[2]
     info[:] = 0.0
-    if not (hz > 0.0 and hx > 0.0 and hy > 0.0):
+    if not (hz0 > 0.0 and hx > 0.0 and hy > 0.0):
         return  # an empty box (a degenerate design's bounding box): nothing reachable
+    mmax = m
+    for _ in range(zlevels):
+        mmax *= 2
     cell = np.empty(n_fields)
-    nodes = np.empty((m + 1, n_fields))
-    buf = np.empty((n_fields, 2 * m))
-    wbuf = np.empty(2 * m)
+    nodes = np.empty((mmax + 1, n_fields))
+    buf = np.empty((n_fields, 2 * mmax))
+    wbuf = np.empty(2 * mmax)
     q0 = np.empty(n_fields)
     q1 = np.empty(n_fields)
     colrow = np.empty(ncol)
+    out = np.empty(4)
     evals = 0.0
     # level 0: every cell of the cross grid is active, in (i, j) order
     n_active = n * ny
@@ -152,98 +287,53 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, e
         cj[a] = a - (a // ny) * ny
     lg = np.zeros((n, ny))
     sg = np.zeros((n, ny))
+    # box-face columns (step 3): measure and LCI sum of the column on the face x = lo, x = hi (per j), y = lo,
+    # y = hi (per i) next to each edge column, [side, L or S, index]
+    fxg = np.zeros((2, 2, ny))
+    fyg = np.zeros((2, 2, n))
     prev_v = 0.0
     prev_g = 0.0
     err_v = 0.0
     err_g = 0.0
+    zerr_v = 0.0
+    zerr_g = 0.0
     level = 0
+    mz = m
+    zl = 0
+    zok = 0
     while True:
+        hz = _div(hi_d[ca] - zlo, mz)
         scale = 1.0
         for _ in range(level):
             scale *= 3.0
         area = 1.0 / (scale * scale) if ndim == 3 else 1.0 / scale
         rows = np.empty((n_active, ncol))
         for a in range(n_active):
-            x = lo_d[0] + (ci[a] + 0.5) * hx / scale
-            y = lo_d[1] + (cj[a] + 0.5) * hy / scale
-            # 1. nodes
-            for k in range(m + 1):
-                zk = _add_product(zlo, END_NUDGE if k == 0 else (m - END_NUDGE if k == m else k), hz)
-                if ndim == 3:
-                    FIELD_KERNEL(p, x, y, zk, cell)
-                else:
-                    FIELD_KERNEL(p, x, zk, zfix, cell)
-                for f in range(n_fields):
-                    nodes[k, f] = cell[f]
-            evals += m + 1
-            npts = 0
-            col_l = 0.0
-            col_s = 0.0
-            for k in range(m):
-                r0 = nodes[k, 0] >= 0.0
-                r1 = nodes[k + 1, 0] >= 0.0
-                if not r0 and not r1:
-                    continue
-                za = _add_product(zlo, k, hz)
-                zb = _add_product(zlo, k + 1, hz)
-                if r0 != r1:
-                    # bisection: [a, b] keeps node k's reachability at a
-                    ba = za
-                    bb = zb
-                    for _ in range(nbis):
-                        mid = 0.5 * (ba + bb)
-                        if ndim == 3:
-                            FIELD_KERNEL(p, x, y, mid, cell)
-                        else:
-                            FIELD_KERNEL(p, x, mid, zfix, cell)
-                        if (cell[0] >= 0.0) == r0:
-                            ba = mid
-                        else:
-                            bb = mid
-                    evals += nbis
-                    cross = 0.5 * (ba + bb)
-                    if r0:
-                        zb = cross
-                    else:
-                        za = cross
-                # 2. 2-point Gauss rule on the piece [za, zb]
-                half = 0.5 * (zb - za)
-                zm = 0.5 * (za + zb)
-                if ndim == 3:
-                    FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
-                    FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
-                else:
-                    FIELD_KERNEL(p, x, _add_product(zm, -half, GAUSS_X), zfix, q0)
-                    FIELD_KERNEL(p, x, _add_product(zm, half, GAUSS_X), zfix, q1)
-                evals += 2
-                ok0 = q0[0] >= 0.0
-                ok1 = q1[0] >= 0.0
-                if not ok0 and not ok1:
-                    continue
-                w = half / hz if ok0 and ok1 else 2.0 * half / hz
-                if ok0:
-                    for f in range(n_fields):
-                        buf[f, npts] = q0[f]
-                    wbuf[npts] = w * area
-                    npts += 1
-                    col_l += w
-                    col_s += w * q0[0]
-                if ok1:
-                    for f in range(n_fields):
-                        buf[f, npts] = q1[f]
-                    wbuf[npts] = w * area
-                    npts += 1
-                    col_l += w
-                    col_s += w * q1[0]
+            x = _centre(lo_d[0], ci[a], hx, scale)
+            y = _centre(lo_d[1], cj[a], hy, scale)
+            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
+            evals += out[3]
             init_row(colrow, n_fields)
-            accumulate_cells(colrow, buf, wbuf, npts, edges)
+            accumulate_cells(colrow, buf, wbuf, int(out[2]), edges)
             for c in range(ncol):
                 rows[a, c] = colrow[c]
-            lg[ci[a], cj[a]] = col_l
-            sg[ci[a], cj[a]] = col_s
-        # 4. error estimate against the previous level
+            lg[ci[a], cj[a]] = out[0]
+            sg[ci[a], cj[a]] = out[1]
         vol, ssum = level_sums(lg, sg, area)
         gci = ssum / vol if vol > 0.0 else 0.0
+        if level == 0 and zl > 0:
+            zerr_v = abs(vol - prev_v) / vol if vol > 0.0 else (0.0 if prev_v == 0.0 else 1.0)
+            zerr_g = abs(gci - prev_g)
+            zok = zok + 1 if zerr_v <= tol_v and zerr_g <= tol_g else 0
+        if level == 0 and zl < zlevels and zok < zconfirm:
+            # 0. z-levels: the coarse cross grid again with twice the z-cells until ``zconfirm`` consecutive
+            # changes meet the tolerance (nested node sets can miss the same thin shell twice)
+            prev_v = vol
+            prev_g = gci
+            mz *= 2
+            zl += 1
+            continue
+        # 4. error estimate against the previous level
         if level > 0:
             if vol > 0.0:
                 err_v = abs(vol - prev_v) / vol
@@ -255,9 +345,35 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, e
         stop = level >= maxlev or (level >= 1 and err_v <= tol_v and err_g <= tol_g)
         flags = np.zeros(n_active, dtype=np.bool_)
         if not stop:
+            if faces:
+                nl = lg.shape[0]
+                nyl = lg.shape[1]
+                for a in range(n_active):
+                    for axis in range(ndim - 1):
+                        idx = ci[a] if axis == 0 else cj[a]
+                        edge = nl - 1 if axis == 0 else nyl - 1
+                        for side in range(2):
+                            if idx != (0 if side == 0 else edge):
+                                continue
+                            x = _centre(lo_d[0], ci[a], hx, scale)
+                            y = _centre(lo_d[1], cj[a], hy, scale)
+                            fpos = END_NUDGE if side == 0 else n - END_NUDGE
+                            if axis == 0:
+                                x = _add_product(lo_d[0], fpos, hx)
+                            else:
+                                y = _add_product(lo_d[1], fpos, hy)
+                            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1,
+                                         buf, wbuf, out)
+                            evals += out[3]
+                            if axis == 0:
+                                fxg[side, 0, cj[a]] = out[0]
+                                fxg[side, 1, cj[a]] = out[1]
+                            else:
+                                fyg[side, 0, ci[a]] = out[0]
+                                fyg[side, 1, ci[a]] = out[1]
             ncell0 = n * ny
             flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
-                         tol_g * vol * beta / ncell0, flags)
+                         tol_g * vol * beta / ncell0, faces, fxg, fyg, flags)
         n_flag = 0
         for a in range(n_active):
             if flags[a]:
@@ -283,26 +399,28 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, e
         n_active = t
         lg = refine_grid(lg, ndim)
         sg = refine_grid(sg, ndim)
+        fxg = refine_faces(fxg, 3 if ndim == 3 else 1)
+        fyg = refine_faces(fyg, 3)
         level += 1
-    info[0] = err_v
-    info[1] = err_g
+    info[0] = max(err_v, zerr_v)
+    info[1] = max(err_g, zerr_g)
     info[2] = level
     info[3] = evals
 
 
-def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges):
+def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces, edges):
     """Template (parallel over designs): FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel."""
     n_designs = params.shape[0]
     stats = np.zeros((n_designs, 1 + 4 * N_FIELDS + edges.shape[0] - 1))
     info = np.zeros((n_designs, 4))
     for d in prange(n_designs):
-        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, edges, stats[d],
-                     info[d])
+        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
+                     edges, stats[d], info[d])
     return stats, info
 
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
-                 beta=1.0):
+                 beta=1.0, zlevels=0, zconfirm=1, faces=False):
     """Statistics rows of every design by the column algorithm (module docstring).
 
     params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
@@ -312,9 +430,11 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     stat_columns), error_volume (d,), error_gci (d,), levels (d,) int64, evaluations (d,)): counts in units of the
     coarse cell (hx hy hz with hx = (hi - lo)[0] / n, ...; planar hx hz).
     """
-    one = bind(_design_stats, field_kernel, n_fields, fastmath=FASTMATH)
+    col = bind(_column, field_kernel, n_fields, fastmath=FASTMATH)
+    one = bind(_design_stats, col, n_fields, fastmath=FASTMATH)
     run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
     stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),
                       np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), int(m), int(nbis), int(maxlev),
-                      float(tol_v), float(tol_g), float(beta), np.ascontiguousarray(edges, dtype=float))
+                      float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces),
+                      np.ascontiguousarray(edges, dtype=float))
     return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()
