@@ -194,3 +194,16 @@ def test_a_synthesis_with_a_deflection_constraint_runs(tmp_path):
     assert (pop["max_deflection_mm"] > 0.015).any() and (pop["max_deflection_mm"] <= 0.015).any()  # seed 3: 0.007-0.025
     front = result.pareto
     assert len(front) and (front["max_deflection_mm"] <= 0.015).all()
+
+
+def test_the_command_prints_the_placement_notes():
+    """`scalesynth stiffness` prints the model's notes, so a user sees that the frame's legs leave the stroke limits
+    (a P-model pose whose C-model placement has leg 2 at 39.27 mm, below the 40 mm limit)."""
+    from typer.testing import CliRunner
+
+    from scalesynth.cli import app
+
+    out = CliRunner().invoke(app, ["stiffness", "rps-upu", "--pose=39.5447,0.1113,-0.3033"])
+    assert out.exit_code == 0, out.output
+    notes = [line for line in out.output.splitlines() if line.startswith("  note: ")]
+    assert any("leave the stroke limits [40, 90]" in n and "39.27" in n for n in notes), out.output

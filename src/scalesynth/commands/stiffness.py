@@ -55,3 +55,5 @@ def stiffness_cmd(
     m = out["model"]
     typer.echo(f"  model: {len(m['links'])} links, {len(m['joints'])} joints, {len(m['actuators'])} actuators, "
                f"platform {m['platform']['body']} ({m['platform']['kind']}); --json prints it whole")
+    for note in m.get("notes", []):
+        typer.echo(f"  note: {note}")
