@@ -569,20 +569,27 @@ def _targets(data: dict) -> list[str]:
     return out + [""]
 
 
-def _src_commits_after(part: str) -> tuple[int, str] | None:
-    """(non-merge commits touching src/ after the last commit that stored benchmarks/results/<part>.json, that
-    commit's short hash); None without git or when the part is not committed."""
+def _src_commits_after(part: str, date: str) -> tuple[int, str] | None:
+    """(non-merge commits touching src/ that HEAD has and the commit which first stored the measurement of ``date``
+    in benchmarks/results/<part>.json has not, that commit's short hash): the source changes the measurement did
+    not see, when it was committed with (or after) the tree it measured. None without git or when no commit has
+    stored it yet (measured on the working tree)."""
     rel = f"benchmarks/results/{part}.json"
+
+    def git(*args: str) -> str:
+        return subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True, check=True).stdout
+
     try:
-        stored = subprocess.run(["git", "-C", str(ROOT), "log", "-1", "--format=%h", "--", rel], capture_output=True,
-                                text=True, check=True).stdout.strip()
-        if not stored:
+        first = None
+        for c in git("log", "--format=%h", "--", rel).split():  # newest first
+            if date not in git("show", f"{c}:{rel}"):
+                break
+            first = c
+        if first is None:
             return None
-        n = subprocess.run(["git", "-C", str(ROOT), "rev-list", "--count", "--no-merges", f"{stored}..HEAD", "--",
-                            "src"], capture_output=True, text=True, check=True).stdout.strip()
+        return int(git("rev-list", "--count", "--no-merges", f"{first}..HEAD", "--", "src").strip()), first
     except (OSError, subprocess.CalledProcessError):
         return None
-    return int(n), stored
 
 
 def _issue15_summary(data: dict) -> list[str]:
@@ -723,15 +730,18 @@ def _issue15_summary(data: dict) -> list[str]:
             part = "compile_all"
         if part not in data:
             continue
-        date = data[part]["date"]
+        dates = [data[part]["date"]]
+        twins = []
         if part == "adaptive":
-            dates = sorted({m.get("date", date) for m in ad.values()})
+            dates = sorted({m.get("date", data[part]["date"]) for m in ad.values()})
             twins = sorted({m["numpy_twin"]["date"] for m in ad.values() if m.get("numpy_twin", {}).get("date")})
-            date = ", ".join(dates) + (f"; NumPy twin timings {', '.join(twins)}" if twins else "")
-        after = _src_commits_after(part)
-        stale = (f"; {after[0]} commits to src/ after the commit that stored it ({after[1]}), not re-measured "
-                 "after them" if after and after[0] else "")
-        out.append(f"- `{part}` ({notes[part]}): measured {date}{stale}.")
+        when = []
+        for d in dates + twins:
+            after = _src_commits_after(part, d)
+            label = f"NumPy twin {d}" if d in twins else d
+            when.append(f"{label} ({after[0]} commits to src/ after {after[1]}, which stored it: not re-measured "
+                        "after them)" if after and after[0] else label)
+        out.append(f"- `{part}` ({notes[part]}): measured {'; '.join(when)}.")
     return out + [""]
 
 
