@@ -19,6 +19,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -105,6 +106,7 @@ def bench_mechanism(name: str) -> dict:
     print(f"{name}: reference N = {n_ref}: {ref_sec * 1e3:.1f} ms/design; {int((~solid).sum())} slivers", flush=True)
     packed = np.stack([mech.pack(d, options) for d in designs])
     plan = adaptive_plan(mech)
+    ndim = len(mech.task_axes)
     adaptive_population_stats(mech, designs[:1], options, packed[:1], tol, edges, region)  # compiled or loaded
     t0 = time.perf_counter()
     ad = adaptive_population_stats(mech, designs, options, packed, tol, edges, region)
@@ -146,28 +148,7 @@ def bench_mechanism(name: str) -> dict:
             equal = row
             print(f"  uniform at equal accuracy: N = {n}, {sec * 1e3:.2f} ms/design", flush=True)
             break
-    # the NumPy twin of the same algorithm (tests/naive.py::column_stats over the NumPy field twins) on two designs
-    twin = TWINS[name]
-    ndim = len(mech.task_axes)
-    t0 = time.perf_counter()
-    def twin_fields(pts, d):
-        """The NumPy field twins' fields, zero-padded to the mechanism's slots where they compute fewer (the
-        clearance field has no NumPy twin here): a timing twin, not a check."""
-        if len(pts) == 0:
-            return np.zeros((0, mech.n_fields))
-        out = np.asarray(twin(d, options, pts[:, 0], pts[:, 1], pts[:, 2])).reshape(len(pts), -1)
-        return np.pad(out, ((0, 0), (0, mech.n_fields - out.shape[1])))
-
-    for d in designs[:2]:
-        g = make_grid(mech, d, options, 1, region)
-        naive.column_stats(lambda pts, d=d: twin_fields(pts, d), mech.n_fields,
-                           g.lo, g.lo + g.step * g.shape, ndim, plan.columns, plan.cells, plan.bisections,
-                           plan.levels, tol.volume, tol.gci, edges, plan.beta, plan.zlevels, plan.zconfirm,
-                           plan.faces)
-    twin_sec = (time.perf_counter() - t0) / 2
-    t0 = time.perf_counter()
-    adaptive_population_stats(mech, designs[:2], options, packed[:2], tol, edges, region)
-    ad2_sec = (time.perf_counter() - t0) / 2
+    twin = numpy_twin(name, mech, designs, options, packed, tol, edges, region)
     return {
         "mechanism": name, "config": CONFIGS[name], "tolerance": {"volume": tol.volume, "gci": tol.gci},
         "designs": len(designs), "slivers": int((~solid).sum()), "reference_N": n_ref, "ndim": ndim,
@@ -182,9 +163,120 @@ def bench_mechanism(name: str) -> dict:
                      "kernel_calls": float(ad.evaluations.mean()), "levels": [int(v) for v in ad.levels],
                      "projected_40000_s": ad_sec * 40000},
         "uniform_equal_accuracy": equal, "uniform_equal_accuracy_solid": equal_solid,
-        "old_resolution": OLD_RESOLUTION[name],
-        "numpy_twin_s_per_design": twin_sec, "adaptive_same_designs_s": ad2_sec,
+        "old_resolution": OLD_RESOLUTION[name], "numpy_twin": twin,
     }
+
+
+# The NumPy twin of the same algorithm, timed against the Numba kernel: tests/naive.py::column_stats (vectorised over
+# the active columns of a level) with the fields from the NumPy field twins of tests/naive.py (vectorised over all
+# the points of a call), not through the Numba field kernel as in tests/test_adaptive.py. The NumPy field twins
+# compute LCI, sigma_min and sigma_max; the Numba kernel computes every field of the mechanism (clearance and,
+# where the options ask for them, stiffness), so the twin does less work per point than the kernel it is compared
+# with. ``ADAPTIVE_TWIN_DESIGNS`` (default 3) of the random designs, the first ones (same plan and tolerance).
+TWIN_DESIGNS = int(os.environ.get("ADAPTIVE_TWIN_DESIGNS", "3"))
+TWIN_FIELDS = 3  # LCI, sigma_min, sigma_max: the fields every NumPy field twin computes
+# agreement of the twin's rows with the kernel's on the timed designs: the same refinement level and number of
+# field evaluations (exact), the count (workspace measure) and the band measures to TWIN_RTOL_LCI relative, the
+# error estimates (relative volume change, absolute GCI change) to TWIN_RTOL_LCI absolute, the LCI, sigma_min and sigma_max statistics (sum, sum of squares, min, max) to
+# TWIN_RTOL_FIELDS relative (of each statistic, or of the largest |statistic| of the row where that is larger):
+# test_fields.py checks the field twins against the kernels to 1e-6 relative away from singular points
+TWIN_RTOL_LCI = 1e-9
+TWIN_RTOL_FIELDS = 1e-6
+
+
+def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int = TWIN_DESIGNS) -> dict:
+    """ms/design of the NumPy twin and of the Numba kernel (one thread) on the first ``k`` designs, measured
+    alternately in this process, and the twin's agreement with the kernel on them."""
+    import numba
+
+    plan = adaptive_plan(mech)
+    ndim = len(mech.task_axes)
+    field_twin = TWINS[name]
+    k = min(k, len(designs))
+    sub, sub_packed = designs[:k], packed[:k]
+
+    def fields(pts, d):
+        if len(pts) == 0:
+            return np.zeros((0, TWIN_FIELDS))
+        return np.asarray(field_twin(d, options, pts[:, 0], pts[:, 1], pts[:, 2])).reshape(len(pts), TWIN_FIELDS)
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        adaptive_population_stats(mech, sub[:1], options, sub_packed[:1], tol, edges, region)  # compiled or loaded
+        kernel_wall, kernel_cpu = [], []
+        for _ in range(3):
+            t0, c0 = time.perf_counter(), time.process_time()
+            ad = adaptive_population_stats(mech, sub, options, sub_packed, tol, edges, region)
+            kernel_wall.append(time.perf_counter() - t0)
+            kernel_cpu.append(time.process_time() - c0)
+    finally:
+        numba.set_num_threads(threads)
+    t0, c0 = time.perf_counter(), time.process_time()
+    rows = []
+    for d in sub:
+        g = make_grid(mech, d, options, 1, region)
+        rows.append(naive.column_stats(lambda pts, d=d: fields(pts, d), TWIN_FIELDS, g.lo, g.lo + g.step * g.shape,
+                                       ndim, plan.columns, plan.cells, plan.bisections, plan.levels, tol.volume,
+                                       tol.gci, edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces))
+    twin_wall, twin_cpu = time.perf_counter() - t0, time.process_time() - c0
+
+    def rel(a, b, scale=None):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        both_inf = np.isinf(a) & np.isinf(b) & (np.sign(a) == np.sign(b))
+        den = np.maximum(np.abs(b), 1e-300 if scale is None else scale)
+        return float(np.where(both_inf, 0.0, np.abs(a - b) / den).max(initial=0.0))
+
+    nf, nb = mech.n_fields, len(edges) - 1
+    dev = {"levels_equal": True, "evaluations_equal": True, "count": 0.0, "error_volume": 0.0, "error_gci": 0.0,
+           "bands": 0.0, "fields": 0.0}
+    for i, (row, ev, eg, lv, ne) in enumerate(rows):
+        s = ad.stats[i]
+        dev["levels_equal"] &= bool(lv == ad.levels[i])
+        dev["evaluations_equal"] &= bool(ne == ad.evaluations[i])
+        dev["count"] = max(dev["count"], rel(row[0], s[0]))
+        dev["error_volume"] = max(dev["error_volume"], float(abs(ev - ad.error_volume[i])))  # absolute: both estimates
+        dev["error_gci"] = max(dev["error_gci"], float(abs(eg - ad.error_gci[i])))  # are differences (cancellation)
+        dev["bands"] = max(dev["bands"], rel(row[-nb:], s[1 + 4 * nf:], 1e-300))
+        kern = s[1:1 + 4 * TWIN_FIELDS]
+        finite = np.isfinite(kern)
+        dev["fields"] = max(dev["fields"], rel(row[1:1 + 4 * TWIN_FIELDS], kern,
+                                               np.abs(kern[finite]).max(initial=1e-300)))
+    agree = (dev["levels_equal"] and dev["evaluations_equal"]
+             and max(dev["count"], dev["error_volume"], dev["error_gci"], dev["bands"]) <= TWIN_RTOL_LCI
+             and dev["fields"] <= TWIN_RTOL_FIELDS)
+    out = {"designs": k, "numba_threads": 1, "twin_fields": TWIN_FIELDS, "kernel_fields": nf,
+           "blas_threads_env": {v: os.environ.get(v) for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")},
+           "twin_s_per_design": twin_wall / k, "twin_cpu_s_per_design": twin_cpu / k,
+           "kernel_s_per_design": min(kernel_wall) / k, "kernel_cpu_s_per_design": min(kernel_cpu) / k,
+           "ratio": twin_wall / min(kernel_wall), "ratio_cpu": twin_cpu / max(min(kernel_cpu), 1e-9),
+           "kernel_calls": float(ad.evaluations.mean()), "deviation": dev,
+           "tolerance": {"lci": TWIN_RTOL_LCI, "fields": TWIN_RTOL_FIELDS}, "agree": bool(agree)}
+    print(f"  NumPy twin on {k} designs: {1e3 * out['twin_s_per_design']:.1f} ms/design against the kernel's "
+          f"{1e3 * out['kernel_s_per_design']:.2f} (one thread): {out['ratio']:.0f}x wall, {out['ratio_cpu']:.0f}x "
+          f"CPU; rows agree: {agree} {dev}", flush=True)
+    return out
+
+
+def bench_twin(names: list[str] | None = None) -> dict:
+    """The NumPy twin timing alone (``python benchmarks/bench.py adaptive_twin [MECH ...]``), per mechanism, with
+    its own date and load average: merged into the stored adaptive rows without re-measuring the rest."""
+    out = {}
+    for name in names or list(CONFIGS):
+        cfg = load_config(ROOT / "configs" / CONFIGS[name])
+        mech, options = cfg.mech, cfg.resolved_options()
+        tol = Tolerance(**cfg.grid.tolerance.model_dump()) if cfg.grid.tolerance is not None else Tolerance()
+        edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
+        designs = random_designs(cfg, N_DESIGNS)
+        packed = np.stack([mech.pack(d, options) for d in designs])
+        print(f"{name}:", flush=True)
+        load = os.getloadavg()[0]
+        twin = numpy_twin(name, mech, designs, options, packed, tol, edges, cfg.grid.region)
+        twin["load_average"] = [load, os.getloadavg()[0]]
+        twin["date"] = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
+        twin["separate_run"] = True
+        out[name] = twin
+    return out
 
 
 def bench_adaptive(names: list[str] | None = None) -> dict:
@@ -194,6 +286,7 @@ def bench_adaptive(names: list[str] | None = None) -> dict:
         load = os.getloadavg()[0]
         row = bench_mechanism(n)
         row["load_average"] = [load, os.getloadavg()[0]]  # 1-minute load before and after (2 cores)
+        row["date"] = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")  # a partial run merges rows of other dates
         rows.append(row)
     return {"mechanisms": rows}
 
@@ -243,6 +336,30 @@ def finer_line(f: dict | None, n_ref: int) -> list[str]:
     return [f"- the {len(f['designs'])} designs (not slivers) outside the tolerance, against a uniform N = {f['N']}: "
             f"adaptive {100 * f['adaptive_volume_error']:.3f} %, {f['adaptive_gci_error']:.1e}; the reference "
             f"N = {n_ref} itself {100 * f['reference_volume_error']:.3f} %, {f['reference_gci_error']:.1e}"]
+
+
+def twin_line(m: dict) -> list[str]:
+    """The RESULTS.md line of the NumPy twin's timing and agreement in a stored adaptive row."""
+    t = m.get("numpy_twin")
+    if t is None:
+        if "numpy_twin_s_per_design" in m:  # stored before the twin was checked against the kernel
+            return [f"- NumPy twin of the same algorithm (an earlier timing, fields zero-padded, rows not checked "
+                    f"against the kernel, thread count not recorded): {m['numpy_twin_s_per_design']:.2f} s/design, "
+                    f"{m['numpy_twin_s_per_design'] / m['adaptive_same_designs_s']:.0f}x the Numba kernel"]
+        return []
+    d = t["deviation"]
+    when = (f"measured separately {t['date']} (`python benchmarks/bench.py adaptive_twin {m['mechanism']}`), load "
+            f"average {t['load_average'][0]:.1f} before, {t['load_average'][1]:.1f} after"
+            if t.get("separate_run") else "measured in this run")
+    return [f"- NumPy twin of the same algorithm (tests/naive.py::column_stats over the NumPy field twins, "
+            f"{t['twin_fields']} fields per point against the kernel's {t['kernel_fields']}), first {t['designs']} "
+            f"designs, one thread, {when}: {1e3 * t['twin_s_per_design']:.1f} ms/design against the Numba "
+            f"kernel's {1e3 * t['kernel_s_per_design']:.2f} ms/design: **{t['ratio']:.1f}x** in wall time, "
+            f"{t['ratio_cpu']:.1f}x in CPU time; rows agree: {'yes' if t['agree'] else 'NO'} (levels and "
+            f"field evaluations {'equal' if d['levels_equal'] and d['evaluations_equal'] else 'DIFFERENT'}; "
+            f"count {d['count']:.1e}, bands {d['bands']:.1e} relative; error estimates {d['error_volume']:.1e}, "
+            f"{d['error_gci']:.1e} absolute (tolerance {t['tolerance']['lci']:.0e}); LCI, sigma_min, sigma_max "
+            f"statistics {d['fields']:.1e} relative (tolerance {t['tolerance']['fields']:.0e}))"]
 
 
 def markdown(data: dict) -> list[str]:
@@ -309,7 +426,8 @@ def markdown(data: dict) -> list[str]:
                     f"axis, {pl['cells']} z-cells, {pl['bisections']} bisections, up to {pl['levels']} levels, beta "
                     f"{pl.get('beta', 1.0):g}, up to {pl.get('zlevels', 0)} z-levels (confirmed "
                     f"{pl.get('zconfirm', 1)}x), box-face columns {'on' if pl.get('faces') else 'off'}. "
-                    f"Load average (1 min, 2 cores) {m['load_average'][0]:.1f} before, {m['load_average'][1]:.1f} "
+                    + (f"Measured {m['date']}. " if "date" in m else "")
+                    + f"Load average (1 min, 2 cores) {m['load_average'][0]:.1f} before, {m['load_average'][1]:.1f} "
                     "after.", "",
                     "| evaluator | ms/design | max volume error | max GCI error | error estimate (max) | "
                     "kernel calls/design | projected 40 000 designs |", "|---|---|---|---|---|---|---|"]
@@ -339,9 +457,7 @@ def markdown(data: dict) -> list[str]:
                     f"{a['designs_within_tolerance']} of {m['designs']}",
                     f"- uniform at equal accuracy / adaptive: {ratio(u)}; without slivers: {ratio(us)} (goal >= 10x)",
                     *finer_line(m.get("finer_check"), m["reference_N"]),
-                    f"- NumPy twin of the same algorithm: {m['numpy_twin_s_per_design']:.2f} s/design, "
-                    f"{m['numpy_twin_s_per_design'] / m['adaptive_same_designs_s']:.0f}x the Numba kernel on the "
-                    "same designs", ""]
+                    *twin_line(m), ""]
     return out
 
 

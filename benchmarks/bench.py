@@ -9,6 +9,8 @@
     python benchmarks/bench.py stiffness    # five-bar stiffness fields vs the kinematic fields alone, per voxel
     python benchmarks/bench.py fastpath     # seed 000's fast path: this tree vs a baseline git ref (default 2524d65)
     python benchmarks/bench.py compile_commands  # every CLI command per mechanism: second process compiles nothing
+    python benchmarks/bench.py adaptive [MECH ...]  # adaptive evaluator vs uniform grids and its NumPy twin (merged)
+    python benchmarks/bench.py adaptive_twin [MECH ...]  # the NumPy twin timing alone, merged into adaptive.json
     python benchmarks/bench.py synthesis    # every config: ms/design, projected 200 x 200 NSGA-II loop, peak memory
     python benchmarks/bench.py show         # `scalesynth show` at resolution 96: wall, CPU and JIT seconds per process
 
@@ -385,6 +387,7 @@ def write_results_md() -> None:
              "Rebuilt by `python benchmarks/bench.py all` (or one part: " + ", ".join(f"`{p}`" for p in PARTS) + ").",
              "Each section states the machine and date it was measured on.", ""]
     lines += _targets(data)
+    lines += _issue15_summary(data)
     for part, title in (("compile_all", "Issue 15: compile once, per mechanism"),
                         ("adaptive", "Issue 15: adaptive evaluator against uniform grids at equal accuracy")):
         if part in data:
@@ -566,6 +569,191 @@ def _targets(data: dict) -> list[str]:
     return out + [""]
 
 
+def _src_commits_after(part: str, date: str) -> tuple[int, str] | None:
+    """(non-merge commits touching src/ that HEAD has and the commit which first stored the measurement of ``date``
+    in benchmarks/results/<part>.json has not, that commit's short hash): the source changes the measurement did
+    not see, when it was committed with (or after) the tree it measured. None without git or when no commit has
+    stored it yet (measured on the working tree)."""
+    rel = f"benchmarks/results/{part}.json"
+
+    def git(*args: str) -> str:
+        return subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True, check=True).stdout
+
+    try:
+        first = None
+        for c in git("log", "--format=%h", "--", rel).split():  # newest first
+            if date not in git("show", f"{c}:{rel}"):
+                break
+            first = c
+        if first is None:
+            return None
+        return int(git("rev-list", "--count", "--no-merges", f"{first}..HEAD", "--", "src").strip()), first
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+def _issue15_summary(data: dict) -> list[str]:
+    """Issue 15's table per mechanism and config, from the stored adaptive, compile_commands (or compile_all) and
+    synthesis parts; each cell from its part, which keeps its own date and machine (listed below the table)."""
+    ad = {m["mechanism"]: m for m in data.get("adaptive", {}).get("result", {}).get("mechanisms", [])}
+    syn = {c["config"]: c for c in data.get("synthesis", {}).get("result", {}).get("configs", [])}
+    comp, comp_part = {}, None
+    if "compile_commands" in data:
+        comp_part = "compile_commands"
+        for m in data["compile_commands"]["result"]["mechanisms"]:
+            ev = next(r for r in m["commands"] if r["command"] == "evaluate")["round2"]
+            comp[m["mechanism"]] = (m["first_process_compile_s"], ev.get("first_grid_s"), ev.get("first_grid_cpu_s"))
+    elif "compile_all" in data:
+        comp_part = "compile_all"
+        for r in data["compile_all"]["result"]["rows"]:
+            comp[r["mechanism"]] = (r["first_evaluation_s"], r["second_import_s"] + r["second_evaluation_s"], None)
+    if not (ad or syn or comp):
+        return []
+    configs = sorted((ROOT / "configs").glob("*.yaml"))
+    by_mech: dict[str, list[tuple[str, object]]] = {}
+    for path in configs:
+        cfg = load_config(path)
+        by_mech.setdefault(cfg.mechanism, []).append((path.name, cfg))
+    order = list(adaptive_bench.CONFIGS) + sorted(set(by_mech) - set(adaptive_bench.CONFIGS))
+    yes = {True: "met", False: "**NOT met**"}
+    out = ["## Issue 15: summary per mechanism", "",
+           "One row per config in `configs/`, grouped by mechanism; the accuracy, equal-accuracy, NumPy-twin and compile "
+           "columns are measured on the mechanism's benchmark config (the first row of each group; `-` on the others: "
+           "not measured for that config). Every cell comes from the stored part named in its column; the parts were "
+           "measured at different dates on shared 2-core machines with one Numba thread (sources below the table); "
+           "compare ratios within a part, not absolute times across parts. NumPy twin / Numba: the adaptive "
+           "algorithm in NumPy (tests/naive.py::column_stats, vectorised over the active columns of a level, the "
+           "fields by the NumPy field twins vectorised over all the points of a call: LCI, sigma_min and sigma_max, "
+           "while the Numba kernel also computes the clearance and, where enabled, the stiffness fields) against the "
+           "Numba kernel on the same designs, plan and tolerance, one thread each, wall time in one process; its rows "
+           "(count, levels, field evaluations, error estimates, band measures, field statistics) are checked against "
+           "the kernel's (adaptive section). No goal is stated for that ratio.", "",
+           "| mechanism | config | evaluator (config now) | ms/design | accuracy vs 3x finer reference: volume, GCI "
+           "(tolerance 0.2 %, 5e-4) | projected 200 x 200 NSGA-II loop (goal <= 30 s) | uniform at equal accuracy / "
+           "adaptive, time (calls) (goal >= 10x) | NumPy twin / Numba (adaptive) | first-process compile s | second "
+           "process to first evaluation, wall s (CPU s) (goal < 1 s CPU) |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    for mech in order:
+        rows = by_mech.get(mech, [])
+        bench_cfg = adaptive_bench.CONFIGS.get(mech)
+        rows.sort(key=lambda r: r[0] != bench_cfg)
+        a = ad.get(mech)
+        for name, cfg in rows:
+            label = synthesis.evaluator_label(cfg)
+            adaptive_now = label.startswith("adaptive")
+            s = syn.get(name)
+            first = name == bench_cfg and a is not None
+            # time per design: the config's evaluator now
+            if adaptive_now and first:
+                ms = f"{1e3 * a['adaptive']['s_per_design']:.2f} (adaptive part: the evaluator alone)"
+            elif s and s["evaluator"] == label:
+                ms = f"{1e3 * s['evaluation']['s_per_design']:.2f} (synthesis part)"
+            else:
+                ms = "not measured"
+            # accuracy of the config's evaluator (errors without slivers)
+            acc = "-"
+            if first and "volume_error_solid" in a["adaptive"]:
+                tol, ad_row = a["tolerance"], a["adaptive"]
+                ok = ad_row["volume_error_solid"] <= tol["volume"] and ad_row["gci_error_solid"] <= tol["gci"]
+                adaptive_acc = (f"{100 * ad_row['volume_error_solid']:.3f} %, {ad_row['gci_error_solid']:.1e}: "
+                                f"{yes[ok]} ({ad_row['designs_within_tolerance']} of {a['designs']} designs within it, "
+                                "slivers included)")
+                f = a.get("finer_check")
+                if f:
+                    adaptive_acc += (f"; the {len(f['designs'])} designs outside it against a uniform N = {f['N']}: "
+                                     f"adaptive {100 * f['adaptive_volume_error']:.3f} %, "
+                                     f"{f['adaptive_gci_error']:.1e}, the reference itself "
+                                     f"{100 * f['reference_volume_error']:.3f} %, {f['reference_gci_error']:.1e}")
+                if adaptive_now:
+                    acc = adaptive_acc
+                else:
+                    eq, n = a.get("uniform_equal_accuracy_solid"), cfg.grid.resolution
+                    if eq is None:
+                        acc = (f"uniform N = {n}: {yes[False]} (no uniform grid below the reference N = "
+                               f"{a['reference_N']} meets it)")
+                    elif n < eq["N"]:
+                        acc = f"uniform N = {n}: {yes[False]} (the coarsest uniform grid meeting it is N = {eq['N']})"
+                    elif n == eq["N"]:
+                        acc = (f"uniform N = {n}: {100 * eq['volume_error_solid']:.3f} %, {eq['gci_error_solid']:.1e}: {yes[True]}")
+                    else:
+                        acc = (f"{yes[True]} (N = {eq['N']}, coarser than N = {n}, meets it: "
+                               f"{100 * eq['volume_error_solid']:.3f} %, {eq['gci_error_solid']:.1e})")
+                    acc += f"; the adaptive evaluator (not the config's): {adaptive_acc}"
+            # projected loop
+            if s is None or "error" in s["loop"]:
+                loop = "not measured"
+            else:
+                lp = s["loop"]
+                loop = (f"{lp['projected_loop_s']:.0f} s ({lp['projected_loop_cpu_s']:.0f} s CPU): "
+                        f"{yes[lp['projected_loop_s'] <= synthesis.GOAL_LOOP_S]}")
+                if s["evaluator"] != label:
+                    loop = f"{loop}, measured with {s['evaluator']}, before the config changed to " + (
+                        "grid.tolerance" if adaptive_now else label)
+                    if first and adaptive_now:
+                        ev40 = a["adaptive"]["s_per_design"] * synthesis.PAPER_DESIGNS
+                        loop += (f"; the adaptive evaluator alone x 40 000 designs: {ev40:.0f} s "
+                                 f"({yes[False] if ev40 > synthesis.GOAL_LOOP_S else 'loop not measured'})")
+            # equal accuracy and the NumPy twin (the benchmark config only)
+            eqr = twin = "-"
+            if first and "volume_error_solid" in a["adaptive"]:
+                us, ar = a.get("uniform_equal_accuracy_solid"), a["adaptive"]
+                if us is None:
+                    t = a["reference_s_per_design"] / ar["s_per_design"]
+                    c = a["reference_N"] ** a.get("ndim", 3) / ar["kernel_calls"]
+                    eqr = (f">= {t:.1f}x (>= {c:.1f}x), a lower bound (no uniform grid below the reference N = "
+                           f"{a['reference_N']} meets the tolerance): {'**NOT shown**' if t < 10 else 'met'}")
+                else:
+                    t = us["s_per_design"] / ar["s_per_design"]
+                    eqr = f"{t:.2f}x ({us['kernel_calls'] / ar['kernel_calls']:.2f}x), N = {us['N']}: {yes[t >= 10]}"
+                tw = a.get("numpy_twin")
+                if tw is not None:
+                    when = f", {tw['date']}" if tw.get("separate_run") else ""
+                    twin = (f"**{tw['ratio']:.1f}x**: {1e3 * tw['twin_s_per_design']:.1f} against "
+                            f"{1e3 * tw['kernel_s_per_design']:.2f} ms/design ({tw['designs']} designs{when}; rows "
+                            f"{'agree' if tw['agree'] else 'DO NOT agree'})")
+                elif "numpy_twin_s_per_design" in a:
+                    twin = (f"{a['numpy_twin_s_per_design'] / a['adaptive_same_designs_s']:.0f}x (earlier unchecked "
+                            "timing)")
+                else:
+                    twin = "not measured"
+            cp = "-"
+            sp = "-"
+            if name == (bench_cfg or rows[0][0]) and mech in comp:
+                c1, w2, c2 = comp[mech]
+                cp = f"{c1:.1f}"
+                if comp_part == "compile_commands" and w2 is not None:
+                    sp = f"{w2:.2f} ({c2:.2f}): {yes[c2 < 1.0]}"
+                elif w2 is not None:
+                    sp = f"{w2:.2f} (imports included; CPU not recorded)"
+            out.append(f"| {mech} | {name} | {label} | {ms} | {acc} | {loop} | {eqr} | {twin} | {cp} | {sp} |")
+    out += ["", "Sources (each section below keeps its own machine, date and conditions):", ""]
+    notes = {"adaptive": "accuracy (20 random designs, errors without slivers: reference measure below 1 % of the "
+                         "median), adaptive ms/design, equal-accuracy ratio, NumPy twin",
+             "compile_commands": "first-process compile seconds (every command, empty cache) and the second "
+                                 "`evaluate` process's time to its first grid evaluation",
+             "compile_all": "first-process and second-process times to the first evaluation",
+             "synthesis": "uniform configs' ms/design (`evaluate_config_population`, 40 random designs) and the "
+                          "projected 200 x 200 loop (population 200, 4 generations, plots and report)"}
+    for part in ("adaptive", "compile_commands", "synthesis"):
+        if part == "compile_commands" and comp_part == "compile_all":
+            part = "compile_all"
+        if part not in data:
+            continue
+        dates = [data[part]["date"]]
+        twins = []
+        if part == "adaptive":
+            dates = sorted({m.get("date", data[part]["date"]) for m in ad.values()})
+            twins = sorted({m["numpy_twin"]["date"] for m in ad.values() if m.get("numpy_twin", {}).get("date")})
+        when = []
+        for d in dates + twins:
+            after = _src_commits_after(part, d)
+            label = f"NumPy twin {d}" if d in twins else d
+            when.append(f"{label} ({after[0]} commits to src/ after {after[1]}, which stored it: not re-measured "
+                        "after them)" if after and after[0] else label)
+        out.append(f"- `{part}` ({notes[part]}): measured {'; '.join(when)}.")
+    return out + [""]
+
+
 def _load_text(rows: list[dict]) -> str:
     loads = [r["load_average"] for r in rows if "load_average" in r]
     return f"{min(loads):.1f} to {max(loads):.1f}" if loads else "not recorded"
@@ -589,6 +777,10 @@ def _header(title: str, entry: dict) -> list[str]:
 def main(argv: list[str]) -> None:
     if argv and argv[0] == "adaptive" and len(argv) > 1:  # adaptive MECH ...: a subset, merged into the stored part
         _run_part("adaptive", lambda: _merge_adaptive(adaptive_bench.bench_adaptive(argv[1:])))
+        write_results_md()
+        return
+    if argv and argv[0] == "adaptive_twin":  # the NumPy twin timing alone, merged into the stored adaptive rows
+        _merge_twin(adaptive_bench.bench_twin(argv[1:]))
         write_results_md()
         return
     parts = list(PARTS) if not argv or argv[0] == "all" else argv
@@ -615,6 +807,24 @@ def _merge_adaptive(new: dict) -> dict:
     rows = {m["mechanism"]: m for m in (json.loads(path.read_text())["result"]["mechanisms"] if path.exists() else [])}
     rows.update({m["mechanism"]: m for m in new["mechanisms"]})
     return {"mechanisms": [rows[k] for k in adaptive_bench.CONFIGS if k in rows]}
+
+
+def _merge_twin(new: dict) -> None:
+    """Store the twin timings of ``new`` (mechanism -> bench_twin row) in the stored adaptive rows of those
+    mechanisms, each with its own date, load and machine; the rest of adaptive.json (its date included) is kept."""
+    path = RESULTS / "adaptive.json"
+    if not path.exists():
+        raise SystemExit("no stored adaptive part: run `python benchmarks/bench.py adaptive` first")
+    entry = json.loads(path.read_text())
+    rows = {m["mechanism"]: m for m in entry["result"]["mechanisms"]}
+    for name, twin in new.items():
+        if name not in rows:
+            print(f"{name}: no stored adaptive row; run `python benchmarks/bench.py adaptive {name}` (not merged)")
+            continue
+        rows[name]["numpy_twin"] = dict(twin, machine=machine())
+        rows[name].pop("numpy_twin_s_per_design", None)  # the earlier unchecked timing
+        rows[name].pop("adaptive_same_designs_s", None)
+    path.write_text(json.dumps(entry, indent=2) + "\n")
 
 
 if __name__ == "__main__":
