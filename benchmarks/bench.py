@@ -748,8 +748,9 @@ def _issue15_summary(data: dict) -> list[str]:
         for d in dates + twins:
             after = _src_commits_after(part, d)
             label = f"NumPy twin {d}" if d in twins else d
-            when.append(f"{label} ({after[0]} commits to src/ after {after[1]}, which stored it: not re-measured "
-                        "after them)" if after and after[0] else label)
+            plural = "s" if after and after[0] != 1 else ""
+            when.append(f"{label} ({after[0]} commit{plural} to src/ after {after[1]}, which stored it: not "
+                        f"re-measured after {'them' if plural else 'it'})" if after and after[0] else label)
         out.append(f"- `{part}` ({notes[part]}): measured {'; '.join(when)}.")
     return out + [""]
 
