@@ -68,8 +68,6 @@ def _rel(run_dir: Path, path: Path) -> str:
 
 def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
     """plots/front.<fmt> (front, final population, reference designs, knee) and plots/hypervolume.<fmt>."""
-    from scalesynth import plotting  # matplotlib: imported by the functions that draw, after any evaluation
-
     plots = _plots_dir(result, out, fmt)
     cfg, pareto, history, population, problem = (result.cfg, result.pareto, result.history, result.population,
                                                  result.problem)
@@ -87,6 +85,8 @@ def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
     pop_xy = None
     if population is not None and len(population):
         pop_xy = (population[xk].to_numpy(), population[yk].to_numpy())
+    from scalesynth import plotting  # matplotlib: imported where the drawing starts, after the evaluations
+
     fig = plotting.front_figure(
         pareto[xk].to_numpy(),
         pareto[yk].to_numpy(),
