@@ -65,6 +65,7 @@ def numba_floor(runs: int = 5) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "floor_kernel.py").write_text(FLOOR_MODULE)
         env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "numba-cache"))
+        env.setdefault("OPENBLAS_NUM_THREADS", "1")  # as scalesynth.cli sets it for every command
         code = "import time; T0 = time.perf_counter()\n" + FLOOR_RUN
         times = []
         for _ in range(runs + 1):  # the first run compiles and fills the cache

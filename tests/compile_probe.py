@@ -29,6 +29,8 @@ from pathlib import Path
 
 T0, C0 = time.perf_counter(), time.process_time()
 
+# the CLI module first, as the `scalesynth` command imports it: it sets OPENBLAS_NUM_THREADS before NumPy loads
+importlib.import_module("scalesynth.cli")
 from numba.core import dispatcher, event  # noqa: E402
 
 JIT = {"s": 0.0, "depth": 0}

@@ -109,3 +109,16 @@ def test_optimize_evaluates_its_first_population_before_pandas_and_matplotlib(ro
     assert "pymoo" in out["modules"]  # the hook saw the search's first evaluation
     assert [m for m in ("pandas", "matplotlib") if m in out["modules"]] == []
     assert (tmp_path / "run" / "pareto.csv").exists()
+
+
+def test_cli_runs_openblas_single_threaded_unless_told_otherwise():
+    """scalesynth.cli sets OPENBLAS_NUM_THREADS=1 before NumPy loads (OpenBLAS's thread pools cost a short command
+    about 0.1 s of start-up; scalesynth's parallel work is Numba's); an explicit setting is kept."""
+    code = ("import json, os, sys; import scalesynth.cli; "
+            "print(json.dumps(os.environ.get('OPENBLAS_NUM_THREADS')), file=sys.stderr)")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    for given, expected in ((None, "1"), ("3", "3")):
+        run_env = env if given is None else dict(env, OPENBLAS_NUM_THREADS=given)
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=run_env, timeout=120)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        assert json.loads(proc.stderr.strip().splitlines()[-1]) == expected
