@@ -29,8 +29,8 @@ from pathlib import Path
 
 T0, C0 = time.perf_counter(), time.process_time()
 
-# the CLI module first, as the `scalesynth` command imports it: it sets OPENBLAS_NUM_THREADS before NumPy loads
-importlib.import_module("scalesynth.cli")
+if __name__ == "__main__":  # the CLI module first, as the `scalesynth` command does: it sets OPENBLAS_NUM_THREADS
+    importlib.import_module("scalesynth.cli")  # before NumPy loads (not when tests import commands() from here)
 from numba.core import dispatcher, event  # noqa: E402
 
 JIT = {"s": 0.0, "depth": 0}
