@@ -132,7 +132,7 @@ def markdown(entry: dict) -> list[str]:
                 f"function takes {f0['cpu_s']:.2f} s CPU ({f0['wall_s']:.2f} s wall; median of {f0['runs']}) "
                 f"before the runs, {f1['cpu_s']:.2f} s ({f1['wall_s']:.2f} s) after: the imports and Numba's "
                 "first-dispatch set-up (its typing and target registries; its BLAS check imports scipy.linalg), "
-                "part of every first evaluation below."]
+                "part of every first evaluation below (OpenBLAS single-threaded, as the CLI runs it)."]
         if not res.get("bytecode_cache", True):
             out.append("PYTHONDONTWRITEBYTECODE was set: every process compiled scalesynth's modules from source "
                        "(an installed package has their bytecode; measured at about 0.04 s CPU per process).")
