@@ -113,7 +113,8 @@ def test_optimize_evaluates_its_first_population_before_pandas_and_matplotlib(ro
 
 def test_cli_runs_openblas_single_threaded_unless_told_otherwise():
     """scalesynth.cli sets OPENBLAS_NUM_THREADS=1 before NumPy loads (OpenBLAS's thread pools cost a short command
-    about 0.1 s of start-up; scalesynth's parallel work is Numba's); an explicit setting is kept."""
+    about 0.1 s of wall and 0.25 s of CPU time at start; scalesynth's parallel work is Numba's); an explicit setting
+    is kept."""
     code = ("import json, os, sys; import scalesynth.cli; "
             "print(json.dumps(os.environ.get('OPENBLAS_NUM_THREADS')), file=sys.stderr)")
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}

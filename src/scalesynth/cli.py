@@ -10,9 +10,10 @@ import sys
 from pathlib import Path
 from typing import Annotated
 
-# OpenBLAS (NumPy's and SciPy's copies) starts a thread pool per library when it loads: about 0.1 s of every CLI
-# process's start on 2 cores. scalesynth's parallel work is Numba's; its BLAS calls are on matrices too small for
-# OpenBLAS to thread. Set before anything imports NumPy; an explicit OPENBLAS_NUM_THREADS wins.
+# OpenBLAS (NumPy's and SciPy's copies) starts a thread pool per library when it loads, whose threads spin: about
+# 0.1 s of wall and 0.25 s of CPU time at every CLI process's start on 2 cores (benchmarks/notes/first_evaluation.md).
+# scalesynth's parallel work is Numba's; its BLAS calls are on matrices too small for OpenBLAS to thread. Set before
+# anything imports NumPy; an explicit OPENBLAS_NUM_THREADS wins.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import typer  # noqa: E402
