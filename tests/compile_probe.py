@@ -11,12 +11,17 @@ REPORT.json gets one entry per command: ``compiled`` (qualified names, in order,
 ``Dispatcher.compile`` calls: compilations and disk-cache loads, what JIT costs the command), ``wall_s`` /
 ``cpu_s`` of the command (the first command's include the process start and the imports), ``exit_code``, and
 ``first_grid_s`` / ``first_grid_cpu_s``: wall and CPU seconds from the process start to the end of the process's
-first workspace-grid evaluation (``Mechanism.grid_stats``; None if the command made none).
+first evaluation: a workspace grid (``Mechanism.grid_stats``, or the adaptive evaluator for configs with
+``grid.tolerance``), a field or LCI grid (``kernels.grid.sample_fields`` / ``sample_grid``), a cycle
+(``cycle.analysis.analyse``) or a pose's stiffness (``stiffness.report.pose_stiffness``), whichever comes first;
+None if the command made none. The probe imports no scalesynth module the command would not.
 Used by tests/test_compile_cache.py and by benchmarks/compile_once.py, which both run ``commands()``.
 """
 
 from __future__ import annotations
 
+import functools
+import importlib.abc
 import json
 import sys
 import time
@@ -24,6 +29,8 @@ from pathlib import Path
 
 T0, C0 = time.perf_counter(), time.process_time()
 
+if __name__ == "__main__":  # the CLI module first, as the `scalesynth` command does: it sets OPENBLAS_NUM_THREADS
+    importlib.import_module("scalesynth.cli")  # before NumPy loads (not when tests import commands() from here)
 from numba.core import dispatcher, event  # noqa: E402
 
 JIT = {"s": 0.0, "depth": 0}
@@ -46,23 +53,86 @@ dispatcher.Dispatcher.compile = _timed_compile
 FIRST_GRID: dict[str, float] = {}
 
 
-def _watch_grid_stats() -> None:
-    """Record when the first Mechanism.grid_stats call of the process returns (every registered class)."""
-    from scalesynth.mechanisms import available, get
+def _first_evaluation(func):
+    """``func`` that records when the process's first workspace evaluation (any wrapped call) returns."""
 
-    classes = {c for name in available() for c in type(get(name)).__mro__ if "grid_stats" in c.__dict__}
-    for cls in classes:
-        original = cls.__dict__.get("grid_stats")
-        if original is None:
-            continue
+    @functools.wraps(func)
+    def timed(*args, **kwargs):
+        out = func(*args, **kwargs)
+        if not FIRST_GRID:
+            FIRST_GRID.update(wall=time.perf_counter() - T0, cpu=time.process_time() - C0)
+        return out
 
-        def timed(self, *args, _original=original, **kwargs):
-            out = _original(self, *args, **kwargs)
-            if not FIRST_GRID:
-                FIRST_GRID.update(wall=time.perf_counter() - T0, cpu=time.process_time() - C0)
-            return out
+    return timed
 
-        cls.grid_stats = timed
+
+def _patch_mechanisms(module) -> None:
+    """Wrap ``grid_stats`` of every mechanism class as the registry registers it (importing no mechanism)."""
+    register, patched = module.register, set()
+
+    def watch(mech):
+        for cls in type(mech).__mro__:
+            if "grid_stats" in cls.__dict__ and cls not in patched:
+                patched.add(cls)
+                cls.grid_stats = _first_evaluation(cls.__dict__["grid_stats"])
+
+    def register_and_watch(mech):
+        watch(mech)
+        return register(mech)
+
+    for mech in list(module._REGISTRY.values()):
+        watch(mech)
+    module.register = register_and_watch
+
+
+def _patch_functions(*names: str):
+    """A hook that wraps these module-level functions of a module (callers that import them by name, after the
+    hook ran, get the wrapped ones)."""
+
+    def hook(module) -> None:
+        for name in names:
+            setattr(module, name, _first_evaluation(getattr(module, name)))
+
+    return hook
+
+
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Runs a hook on a module right after it is first imported, wherever and whenever that happens, so the
+    probe imports nothing the command would not (the mechanism registry loads only the modules it needs)."""
+
+    # the evaluations of the commands: workspace grid (uniform or adaptive: evaluate, optimize, plot-front),
+    # field and LCI grids (show, plot-bands, plot-task), the cycle (cycle, drives), a pose's stiffness
+    hooks = {"scalesynth.mechanisms": _patch_mechanisms,
+             "scalesynth.evaluate": _patch_functions("adaptive_population_stats"),
+             "scalesynth.kernels.grid": _patch_functions("sample_fields", "sample_grid"),
+             "scalesynth.cycle.analysis": _patch_functions("analyse"),
+             "scalesynth.stiffness.report": _patch_functions("pose_stiffness")}
+
+    def find_spec(self, name, path, target=None):
+        hook = self.hooks.get(name)
+        if hook is None:
+            return None
+        spec = next((s for f in sys.meta_path if f is not self and hasattr(f, "find_spec")
+                     for s in [f.find_spec(name, path, target)] if s is not None), None)
+        if spec is None or spec.loader is None:
+            return spec
+        exec_module = spec.loader.exec_module
+
+        def exec_and_hook(module):
+            exec_module(module)
+            hook(module)
+
+        spec.loader.exec_module = exec_and_hook
+        return spec
+
+
+def _watch_first_evaluation() -> None:
+    """Record when the process's first evaluation returns (``_AfterImport.hooks``). Modules already imported are
+    patched now."""
+    for name, hook in _AfterImport.hooks.items():
+        if name in sys.modules:
+            hook(sys.modules[name])
+    sys.meta_path.insert(0, _AfterImport())
 
 
 class CompileRecorder(event.Listener):
@@ -146,7 +216,7 @@ def main(argv: list[str]) -> None:
         from scalesynth.cli import main as cli_main  # the first command's record includes the imports
 
         if not results:
-            _watch_grid_stats()
+            _watch_first_evaluation()
 
         code = 0
         try:

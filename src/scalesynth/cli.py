@@ -5,11 +5,18 @@ Exit codes: 0 ok, 1 run failed, 2 bad input (one line on stderr naming what is w
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 from typing import Annotated
 
-import typer
+# OpenBLAS (NumPy's and SciPy's copies) starts a thread pool per library when it loads, whose threads spin: about
+# 0.1 s of wall and 0.25 s of CPU time at every CLI process's start on 2 cores (benchmarks/notes/first_evaluation.md).
+# scalesynth's parallel work is Numba's; its BLAS calls are on matrices too small for OpenBLAS to thread. Set before
+# anything imports NumPy; an explicit OPENBLAS_NUM_THREADS wins.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import typer  # noqa: E402
 
 from scalesynth.cliapp import (  # noqa: F401 - re-exported: app and the shared helpers live in cliapp
     JsonOpt,

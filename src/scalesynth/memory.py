@@ -132,7 +132,7 @@ def run_estimates(cfg, plots: bool = True) -> list[tuple[str, str, float]]:
 
 def section_estimates(cfg) -> list[tuple[str, str, float]]:
     """report.section_panels: two mid-plane sections (not the whole grid) of max(res, 128) + 1 or 2 cells."""
-    from scalesynth.report import SECTION_RESOLUTION
+    from scalesynth.workspace_view import SECTION_RESOLUTION  # not via report: that imports matplotlib
 
     n = max(cfg.grid.resolution, SECTION_RESOLUTION) + 2
     planes = 1 if len(cfg.mech.task_axes) == 2 else 2

@@ -16,10 +16,9 @@ import time
 from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from scalesynth import io as rio
 from scalesynth import memory, results, rundir
@@ -27,6 +26,9 @@ from scalesynth.config import ConstraintConfig, RunConfig
 from scalesynth.errors import ConfigError, RunError
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import RunResult
+
+if TYPE_CHECKING:  # imported where the tables are built, after the search: the first generation does not wait
+    import pandas as pd
 
 ProgressFn = Callable[[dict[str, Any]], None]
 
@@ -154,6 +156,7 @@ def _versions() -> dict[str, str]:
 
 def _pareto_frame(problem: SynthesisProblem, algorithm) -> tuple[pd.DataFrame, pd.DataFrame, int]:
     """(pareto, population, number of objective-space duplicates dropped from the front)."""
+    import pandas as pd
     from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
     cfg = problem.cfg
@@ -278,6 +281,8 @@ def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, histo
             raise RunError(f"stopped after {gens_this_call} generations (checkpoint in {ckpt_path})")
     wall = elapsed_before + time.perf_counter() - t0
     pareto, population, dropped = _pareto_frame(problem, algorithm)
+    import pandas as pd
+
     history_df = pd.DataFrame(history)
     n_feasible = int(_feasible(algorithm.pop).sum())
     manifest = {

@@ -14,7 +14,6 @@ import numpy as np
 
 from scalesynth import io as rio
 from scalesynth import labels as lab
-from scalesynth import plotting
 from scalesynth.config import RunConfig
 from scalesynth.errors import ConfigError
 from scalesynth.evaluate import evaluate_config
@@ -86,6 +85,8 @@ def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
     pop_xy = None
     if population is not None and len(population):
         pop_xy = (population[xk].to_numpy(), population[yk].to_numpy())
+    from scalesynth import plotting  # matplotlib: imported where the drawing starts, after the evaluations
+
     fig = plotting.front_figure(
         pareto[xk].to_numpy(),
         pareto[yk].to_numpy(),
@@ -122,6 +123,7 @@ def featured_designs(result: RunResult) -> list[tuple[str, int]]:
 def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
     """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
     per-band Pareto sets bands/pareto_band<k>.csv with their plots."""
+    from scalesynth import plotting
     from scalesynth.band_fronts import write_band_fronts
 
     plots = _plots_dir(result, out, fmt)
@@ -169,6 +171,8 @@ def field_sections(cfg: RunConfig, design: dict[str, float], field: str, title: 
     """plots/sections_<field>_<design>: the report's sections coloured by a per-voxel field (a stiffness map:
     deflection or stiffness_min), the colour bar labelled with its unit and the range of the shown cells in the
     title. Returns the file written."""
+    from scalesynth import plotting
+
     panels = section_panels(cfg, design, field)
     vmin, vmax = map_range(panels)
     label = lab.field_label(cfg.mech, field, cfg.units.length)

@@ -10,15 +10,17 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from scalesynth import io as rio
 from scalesynth.config import RunConfig, dump_config, load_config
 from scalesynth.errors import ConfigError
 from scalesynth.problem import SynthesisProblem
+
+if TYPE_CHECKING:  # pandas is imported where a table is read (io.read_csv) or built (optimize)
+    import pandas as pd
 
 PARETO, POPULATION, HISTORY, MANIFEST, CONFIG, REPORT = (
     "pareto.csv", "population.csv", "history.csv", "manifest.json", "config.yaml", "report.md",

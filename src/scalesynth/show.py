@@ -27,10 +27,11 @@ CONNECTIVITY = "26-connected: cells sharing a face, an edge or a corner (8 in 2-
 def load_source(source: Path, sets: Sequence[str] | None = None):
     """(config, RunResult or None) for a config file or a results directory."""
     from scalesynth.config import load_config
-    from scalesynth.results import load
 
     source = Path(source)
     if source.is_dir():
+        from scalesynth.results import load  # pandas and pymoo: only for a results directory
+
         result = load(source, require_finished=False)
         if sets:
             return load_config(source / "config.yaml", list(sets)), result

@@ -145,8 +145,6 @@ def plot_task_cmd(
 ) -> None:
     """LCI (or another field, e.g. the deflection under the load) over the task box (unreachable cells blank) with
     the task path, as a PNG."""
-    import matplotlib.pyplot as plt
-
     from scalesynth.config import load_config
 
     if fmt not in ("png", "svg", "pdf"):
@@ -163,6 +161,8 @@ def plot_task_cmd(
     if tm.values is not None:
         v = tm.values[tm.lci >= 0]
         title += f"\n{tm.label}: {v.min():.4g} ... {v.max():.4g}" if v.size else ""
+    import matplotlib.pyplot as plt  # after the map: the evaluation does not wait for matplotlib's import
+
     fig = task_figure(tm, cfg.mech.task_axes[:2], unit, title)
     if out is not None and out.suffix.lower() in (".png", ".svg", ".pdf"):
         target = out

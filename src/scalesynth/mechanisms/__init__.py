@@ -1,12 +1,16 @@
 """Registry of mechanisms. Each module in this package that defines ``MECHANISM`` is registered on import.
 
 Adding a mechanism = adding one module here (plus its config and spec-case tests); nothing else changes.
+``get(name)`` imports only the module the name suggests (``_module_name``: '2pauu-ppap' -> ``pauu_ppap``), so a
+process that uses one mechanism loads no other (their imports and Numba dispatchers cost a fresh process tens of
+milliseconds); any other name, and ``available()``, import every module.
 """
 
 from __future__ import annotations
 
 import importlib
 import pkgutil
+import re
 
 from scalesynth.errors import UnknownMechanism
 from scalesynth.mechanisms.base import Mechanism
@@ -41,8 +45,26 @@ def available() -> list[str]:
     return sorted(_REGISTRY)
 
 
+def _module_name(name: str) -> str:
+    """The module a mechanism name suggests: non-identifier characters -> '_', leading digits and '_' dropped."""
+    return re.sub(r"\W", "_", name.lower()).lstrip("0123456789_")
+
+
+def _load_one(name: str) -> None:
+    """Import and register the module ``name`` suggests, if this package has one (a cheap directory listing)."""
+    module = _module_name(name)
+    if module == "base" or module not in {info.name for info in pkgutil.iter_modules(__path__)}:
+        return
+    mech = getattr(importlib.import_module(f"{__name__}.{module}"), "MECHANISM", None)
+    if isinstance(mech, Mechanism):
+        register(mech)
+
+
 def get(name: str) -> Mechanism:
-    _load_all()
+    if name not in _REGISTRY and not _LOADED:
+        _load_one(name)
+    if name not in _REGISTRY:
+        _load_all()
     try:
         return _REGISTRY[name]
     except KeyError:
