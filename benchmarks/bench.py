@@ -625,7 +625,8 @@ def _issue15_summary(data: dict) -> list[str]:
            "One row per config in `configs/`, grouped by mechanism; the accuracy, equal-accuracy, NumPy-twin and compile "
            "columns are measured on the mechanism's benchmark config (the first row of each group; `-` on the others: "
            "not measured for that config). Every cell comes from the stored part named in its column; the parts were "
-           "measured at different dates on shared 2-core machines with one Numba thread (sources below the table); "
+           "measured at different dates on shared 2-core machines (sources below the table, each with its Numba "
+           "thread count); "
            "compare ratios within a part, not absolute times across parts. NumPy twin / Numba: the adaptive "
            "algorithm in NumPy (tests/naive.py::column_stats, vectorised over the active columns of a level, the "
            "fields by the NumPy field twins vectorised over all the points of a call: LCI, sigma_min and sigma_max, "
@@ -756,7 +757,9 @@ def _issue15_summary(data: dict) -> list[str]:
             plural = "s" if after and after[0] != 1 else ""
             when.append(f"{label} ({after[0]} commit{plural} to src/ after {after[1]}, which stored it: not "
                         f"re-measured after {'them' if plural else 'it'})" if after and after[0] else label)
-        out.append(f"- `{part}` ({notes[part]}): measured {'; '.join(when)}.")
+        threads = data[part].get("machine", {}).get("numba_threads")
+        on = f", {threads} Numba thread{'s' if threads != 1 else ''}" if threads is not None else ""
+        out.append(f"- `{part}` ({notes[part]}): measured {'; '.join(when)}{on}.")
     return out + [""]
 
 
