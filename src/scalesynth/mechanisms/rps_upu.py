@@ -233,6 +233,12 @@ def _leg_ok(qs, lo, hi):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
+def _singular_response(p):
+    """(stiffness_min, deflection) at a singular or degenerate pose: 0 and the 1e12 cap (0 under no load)."""
+    return 0.0, 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
 def _chain_columns(p, kk, ax, ay, az, bx, by, bz, f2x, f2y, f2z, m2x, m2y, m2z, rx, ry, rz):
     """K += W Phi^-1 W^T for one leg A -> B (ideal joints, the frame of stiffness_model): its two constraint
     wrenches at B are w1 = the force along the leg (it also loads the actuator spring) and w2 = (f2, m2) (N, N mm
@@ -288,7 +294,6 @@ def _stiffness(p, upu, y0, z, st, ct, sp, cp, sf, cf, rx, ry, rz):
     h = p[_H]
     c = p[_C]
     e = p[_E]
-    zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
     ux, uy, uz = cf * ct, sf * ct, -st  # R x
     vx, vy, vz = cf * st * sp - sf * cp, sf * st * sp + cf * cp, ct * sp  # R y
     b1x, b1y, b1z = -h * vx, y0 - h * vy, z - h * vz
@@ -302,18 +307,18 @@ def _stiffness(p, upu, y0, z, st, ct, sp, cp, sf, cf, rx, ry, rz):
         my, mz = -wz, wy  # x X w = (0, -wz, wy)
         mn = math.sqrt(my * my + mz * mz)
         if not mn > 1e-12:
-            return 0.0, zero
+            return _singular_response(p)
         my, mz = my / mn, mz / mn
-        # Q = A3 + s x = B3 + t w (the lines are coplanar): t = (d.x (x.w) - d.w) / (1 - (x.w)^2), d = B3 - A3
-        dx, dy, dz = b3x - e, b3y, b3z
-        t = (dx * wx - (dx * wx + dy * wy + dz * wz)) / (mn * mn)
+        # Q = A3 + s x = B3 + t w (the lines are coplanar): t = (d.x (x.w) - d.w) / (1 - (x.w)^2), d = B3 - A3;
+        # with x.w = wx the x components cancel: t = -(d_y w_y + d_z w_z) / |m|^2, |m|^2 = 1 - wx^2 (A3 has y = z = 0)
+        t = -(b3y * wy + b3z * wz) / (mn * mn)
         # the force along m through Q, about B3: (Q - B3) x m = t w x m
         ok3, kk = _chain_columns(p, kk, e, 0.0, 0.0, b3x, b3y, b3z, 0.0, my, mz, t * (wy * mz - wz * my),
                                  t * (-wx * mz), t * (wx * my), rx, ry, rz)
     else:
         ok3, kk = _chain_columns(p, kk, e, 0.0, 0.0, b3x, b3y, b3z, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, rx, ry, rz)
     if not (ok1 and ok2 and ok3):
-        return 0.0, zero
+        return _singular_response(p)
     l1 = math.sqrt(b1x * b1x + (b1y + g) * (b1y + g) + b1z * b1z)
     l2 = math.sqrt(b2x * b2x + (b2y - g) * (b2y - g) + b2z * b2z)
     l3 = math.sqrt((b3x - e) * (b3x - e) + b3y * b3y + b3z * b3z)
@@ -344,8 +349,7 @@ def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx
         ok, _, _, _, _, _, _, _, _, _, _, _, _, y0, sf, cf = _c_model_rows(p[_G], p[_H], p[_C], p[_E], upu, z, st,
                                                                          ct, sp, cp)
         if not ok:
-            zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
-            return 0.0, zero
+            return _singular_response(p)
     if at_origin:
         rx, ry, rz = 0.0, y0, z
     return _stiffness(p, upu, y0, z, st, ct, sp, cp, sf, cf, rx, ry, rz)
@@ -1225,7 +1229,6 @@ def _tool_stiffness(p, tx, ty, tz, z, th, ps):
     refuses such a T) or the pose is degenerate."""
     c = p[_C]
     d = p[_D]
-    zero = 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
     tol = _TOOL_NEWTON_RTOL * (max(p[_G], p[_H], c) + d)
     for _ in range(_TOOL_NEWTON_ITERS):
         st = math.sin(th)
@@ -1234,7 +1237,7 @@ def _tool_stiffness(p, tx, ty, tz, z, th, ps):
         cp = math.cos(ps)
         ok, fx, fy, fz, j01, j02, j11, j12, j21, j22 = _c_plane_tool(c, d, z, st, ct, sp, cp)
         if not ok:
-            return 0.0, zero
+            return _singular_response(p)
         rx, ry, rz = fx - tx, fy - ty, fz - tz
         if max(abs(rx), abs(ry), abs(rz)) <= tol:
             _, _, sf, cf, _, _, _, _, _, _ = _yaw(st, ct, sp, cp)
@@ -1242,13 +1245,13 @@ def _tool_stiffness(p, tx, ty, tz, z, th, ps):
         # J = [[0, j01, j02], [0, j11, j12], [1, j21, j22]]: the angles from the first two rows, then z
         det = j01 * j12 - j02 * j11
         if not abs(det) > 0.0:
-            return 0.0, zero
+            return _singular_response(p)
         dth = (rx * j12 - j02 * ry) / det
         dps = (j01 * ry - rx * j11) / det
         th -= dth
         ps -= dps
         z -= rz - j21 * dth - j22 * dps
-    return 0.0, zero
+    return _singular_response(p)
 
 
 @njit(cache=True, fastmath=FASTMATH)
