@@ -308,6 +308,7 @@ def bench_compile_all() -> dict:
     cache directory (compilation), then again with that cache (second process)."""
     rows = []
     env = dict(os.environ)
+    load_before = os.getloadavg()[0]
     for name, config in CONFIGS.items():
         with tempfile.TemporaryDirectory() as cache:
             env["NUMBA_CACHE_DIR"] = cache
@@ -321,12 +322,16 @@ def bench_compile_all() -> dict:
                      "second_evaluation_s": times[1][1], "first_evaluation_cpu_s": times[0][2],
                      "second_evaluation_cpu_s": times[1][2]})
         print(f"{name}: first process {times[0][1]:.2f} s to first evaluation, second {times[1][1]:.2f} s", flush=True)
-    return {"rows": rows}
+    return {"rows": rows, "load_average_1min": [load_before, os.getloadavg()[0]]}
 
 
-CONDITIONS = ("Conditions: measured with NUMBA_NUM_THREADS=1 while the 2-core machine was shared with other jobs "
-              "(load average 12 to 15), so absolute times are several times those of an idle machine; compare the "
-              "ratios, which come from one run.")
+def conditions(result: dict) -> str:
+    """The conditions sentence of the compile_all section: the load average the run stored (results stored before it
+    recorded one were measured at load 12 to 15)."""
+    lo, hi = sorted(result.get("load_average_1min", [12.0, 15.0]))
+    return (f"Conditions: measured with NUMBA_NUM_THREADS=1 on the 2-core machine, load average {lo:.1f} to {hi:.1f} "
+            "(above 2 the machine was shared with other jobs and absolute times are longer than an idle machine's); "
+            "compare the ratios, which come from one run.")
 
 
 def finer_line(f: dict | None, n_ref: int) -> list[str]:
@@ -366,7 +371,7 @@ def markdown(data: dict) -> list[str]:
     """RESULTS.md sections of the stored issue-15 parts."""
     out: list[str] = []
     if "compile_all" in data:
-        out += [CONDITIONS, "", "### Compile once (fresh processes, empty Numba cache, then the same cache)", "",
+        out += [conditions(data["compile_all"]["result"]), "", "### Compile once (fresh processes, empty Numba cache, then the same cache)", "",
                 "Wall seconds from the loaded config to the first evaluated design (CPU seconds of the process in "
                 "brackets: on a shared machine the wall time includes waiting for a core), and the imports before.",
                 "", "| mechanism | first process (empty cache) | second process (cache) | second process: imports |",
