@@ -12,6 +12,7 @@
     python benchmarks/bench.py adaptive [MECH ...]  # adaptive evaluator vs uniform grids and its NumPy twin (merged)
     python benchmarks/bench.py adaptive_twin [MECH ...]  # the NumPy twin timing alone, merged into adaptive.json
     python benchmarks/bench.py synthesis    # every config: ms/design, projected 200 x 200 NSGA-II loop, peak memory
+    python benchmarks/bench.py task_accuracy  # configs with a task box: its uniform grid against a 3x finer one
     python benchmarks/bench.py show         # `scalesynth show` at resolution 96: wall, CPU and JIT seconds per process
 
 Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
@@ -40,6 +41,7 @@ import adaptive as adaptive_bench  # noqa: E402  (benchmarks/adaptive.py: issue-
 import compile_once  # noqa: E402  (benchmarks/compile_once.py: issue 15, compile once per command)
 import show_speed  # noqa: E402  (benchmarks/show_speed.py: issue 14, show of a 3-D design)
 import synthesis  # noqa: E402  (benchmarks/synthesis.py: issue 15, per-config paper-scale table and memory)
+import task_accuracy  # noqa: E402  (benchmarks/task_accuracy.py: issue 15, the uniform task grids' accuracy)
 
 from scalesynth.config import load_config  # noqa: E402
 from scalesynth.evaluate import evaluate_population, make_grid  # noqa: E402
@@ -374,7 +376,7 @@ PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": benc
          "compile": bench_compile, "fastpath": bench_fastpath, "stiffness": bench_stiffness,
          "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all,
          "compile_commands": compile_once.bench_compile_commands, "synthesis": synthesis.bench_synthesis,
-         "show": show_speed.bench_show}
+         "task_accuracy": task_accuracy.bench_task_accuracy, "show": show_speed.bench_show}
 
 
 def write_results_md() -> None:
@@ -396,6 +398,8 @@ def write_results_md() -> None:
             ("compile_commands", "Issue 15: compile once, every command of every mechanism", compile_once),
             ("synthesis", "Issue 15: every config at paper scale (200 x 200): time per design, NSGA-II loop, "
              "peak memory", synthesis),
+            ("task_accuracy", "Issue 15: task boxes on their uniform grids: accuracy against a 3x finer grid",
+             task_accuracy),
             ("show", "Issue 14: `scalesynth show` of a 3-D design at resolution 96 (target: within 10 s with a warm "
              "cache)", show_speed)):
         if part in data and "result" in data[part]:

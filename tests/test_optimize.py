@@ -223,7 +223,7 @@ def test_designs_equal_up_to_m_minus_n_are_duplicates():
     elim = make_algorithm(small_cfg(), problem).eliminate_duplicates
     kept = elim.do(Population.new("X", X))
     assert len(kept) == 2
-    M = problem.metrics(X)
+    M = problem.complete_metrics(X, problem.metrics(X))  # every column, not only the searched families
     # identical kinematic metrics, as the invariance says; design-level ones may see m itself (the base radius)
     design = [i for i, c in enumerate(problem.metric_columns) if c in ("link_length_sum_m", "footprint_radius_m",
                                                                         "stroke_d_m")]

@@ -446,7 +446,7 @@ def test_plot_task_writes_png_with_the_task_metrics(tmp_path):
     assert [p.name for p in out.parent.iterdir()] == ["task.png"]  # no temporary file left behind
     shown = json.loads(res.stdout)
     cfg = load_config(ROOT / "configs" / "fivebar_packing.yaml")
-    cfg.grid.resolution = 40
+    cfg.task.resolution = 40  # --resolution sets the map's task-box cells
     rep = evaluate_config(cfg)  # the same cell-centred nodes as the map
     assert shown["task_coverage"] == rep.metrics["task_coverage"] == 1.0
     assert shown["task_gci"] == pytest.approx(rep.metrics["task_gci"], rel=1e-12)

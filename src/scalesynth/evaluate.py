@@ -8,7 +8,7 @@ field statistic 0, never NaN.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -222,23 +222,29 @@ def _metrics_of(
     resolved: list[dict[str, float]],
     options: dict[str, Any],
     packed: np.ndarray,
-    workspace_stats: np.ndarray,
-    cell: np.ndarray,
+    workspace_stats: np.ndarray | None,
+    cell: np.ndarray | None,
     resolution: int,
     band_edges: Sequence[float],
     unit: str,
     task: Any,
     cycle: Any = None,
+    families: Collection[str] | None = None,
 ) -> dict[str, np.ndarray]:
-    """Every catalogue metric of the designs: workspace statistics given, task statistics (on the uniform task
-    grid) and the computed families (design, path) evaluated here."""
+    """Every catalogue metric of the designs (of ``families`` only, when given): workspace statistics given (None
+    when the workspace family is not asked for), task statistics (on the uniform task grid) and the computed
+    families (design, path, cycle) evaluated here."""
     has_path = task is not None and task.path is not None
     entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
+    if families is not None:
+        entries = [m for m in entries if m.family in families]
     n_bands = len(band_edges) - 1
-    out = stats_to_metrics(mech, workspace_stats, cell, 0.0, [m for m in entries if m.family == "workspace"],
-                           n_bands)
+    out = {}
+    if workspace_stats is not None:
+        out.update(stats_to_metrics(mech, workspace_stats, cell, 0.0,
+                                    [m for m in entries if m.family == "workspace"], n_bands))
     n = packed.shape[0]
-    if task is not None:
+    if task is not None and any(m.family == "task" for m in entries):
         tg = task_grid(mech, task, resolution)
         edges = np.asarray(band_edges, dtype=float)
         # the task box always on the uniform grid (task.resolution, else grid.resolution): the column evaluator's
@@ -404,26 +410,35 @@ def evaluate_population(
     task: Any = None,
     cycle: Any = None,
     tolerance: Tolerance | None = None,
+    families: Collection[str] | None = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of many designs, column name -> (n,) array; the workspace grids in one parallel
     kernel call (no Python work per voxel); with ``task`` (a config TaskConfig) also the task-box and path
     metrics, with ``cycle`` (a config CycleConfig) the cycle metrics. With ``tolerance`` the adaptive evaluator
     replaces the uniform ``resolution`` grid and the result also has ``error_volume`` (relative) and
-    ``error_gci`` (its per-design error estimates)."""
+    ``error_gci`` (its per-design error estimates). ``families`` (catalogue families, e.g. {"task", "cycle"}):
+    only their metrics, and no workspace grid when "workspace" is not among them (the search evaluates only what
+    its objectives and constraints use)."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
     n = len(resolved)
     if n == 0:
         has_path = task is not None and task.path is not None
-        cols = _metrics.result_columns(mech, unit, len(band_edges) - 1, task is not None, has_path, options, cycle)
+        entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
+        cols = [c for m in entries if families is None or m.family in families
+                for c in m.columns(len(band_edges) - 1)]
+        if tolerance is not None and (families is None or "workspace" in families):
+            cols += ["error_volume", "error_gci"]
         return {k: np.zeros(0) for k in cols}
     packed = np.stack([mech.pack(d, options) for d in resolved])
     edges = np.asarray(band_edges, dtype=float)
+    args = (resolution, band_edges, unit, task, cycle, families)
+    if families is not None and "workspace" not in families:
+        return _metrics_of(mech, resolved, options, packed, None, None, *args)
     if tolerance is not None:
         ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, region)
-        out = _metrics_of(mech, resolved, options, packed, ad.stats, ad.cell, resolution, band_edges, unit, task,
-                          cycle)
+        out = _metrics_of(mech, resolved, options, packed, ad.stats, ad.cell, *args)
         out["error_volume"] = ad.error_volume
         out["error_gci"] = ad.error_gci
         return out
@@ -432,7 +447,7 @@ def evaluate_population(
     step = np.stack([g.step for g in grids])
     stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
     cell = np.array([g.cell_measure for g in grids])
-    return _metrics_of(mech, resolved, options, packed, stats, cell, resolution, band_edges, unit, task, cycle)
+    return _metrics_of(mech, resolved, options, packed, stats, cell, *args)
 
 
 def config_tolerance(cfg) -> Tolerance | None:
@@ -459,9 +474,11 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
     )
 
 
-def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> dict[str, np.ndarray]:
-    """All metrics of many designs under one config, in one parallel kernel call per grid. The cycle metrics
-    (seconds per design) only when an objective or constraint uses one (``cycle.config.searched``)."""
+def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]],
+                               families: Collection[str] | None = None) -> dict[str, np.ndarray]:
+    """All metrics of many designs under one config (of ``families`` only, when given), in one parallel kernel
+    call per grid. The cycle metrics (seconds per design) only when an objective or constraint uses one
+    (``cycle.config.searched``)."""
     from scalesynth.cycle.config import searched
 
     return evaluate_population(
@@ -475,4 +492,5 @@ def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> d
         task=cfg.task,
         cycle=searched(cfg),
         tolerance=config_tolerance(cfg),
+        families=families,
     )

@@ -161,7 +161,8 @@ def _pareto_frame(problem: SynthesisProblem, algorithm) -> tuple[pd.DataFrame, p
 
     cfg = problem.cfg
     pop = algorithm.pop
-    X, F, M = pop.get("X"), pop.get("F"), pop.get("M")
+    X, F = pop.get("X"), pop.get("F")
+    M = problem.complete_metrics(X, pop.get("M"))
     feas = _feasible(pop)
     rank = np.full(len(pop), -1, dtype=int)
     if feas.any():

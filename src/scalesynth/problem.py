@@ -1,8 +1,9 @@
 """The pymoo Problem: design vectors -> objectives F and constraints G (G <= 0 feasible), vectorised.
 
-Each generation's designs go to the Numba evaluator in one call (``evaluate_config_population``). Besides F and
-G the problem returns ``M``, the matrix of every metric (columns ``metric_columns``), so results can report
-all of them without re-evaluating.
+Each generation's designs go to the Numba evaluator in one call (``evaluate_config_population``), for the
+catalogue families the objectives and constraints use. Besides F and G the problem returns ``M``, the matrix of
+every metric (columns ``metric_columns``; NaN in the columns of families the search does not use), and
+``complete_metrics`` fills those columns in for the final population, so results report every metric.
 """
 
 from __future__ import annotations
@@ -56,6 +57,10 @@ class SynthesisProblem(Problem):
         self.signs = np.array([-1.0 if o.sense == "max" else 1.0 for o in cfg.objectives])
         self.constraint_keys = [metric_key(cfg, c) for c in cfg.constraints]
         self.metric_columns = result_columns(cfg)
+        # the search evaluates only the catalogue families its objectives and constraints use (a five-bar's task
+        # and cycle metrics need no workspace grid); the final population gets the other columns (complete_metrics)
+        used = {metric_entry(cfg, item).family for item in [*cfg.objectives, *cfg.constraints]}
+        self.searched_families = frozenset(used)
         n_constr = sum((c.min is not None) + (c.max is not None) for c in cfg.constraints)
         xl = np.array([cfg.bounds[k][0] for k in self.var_names], dtype=float)
         xu = np.array([cfg.bounds[k][1] for k in self.var_names], dtype=float)
@@ -70,9 +75,34 @@ class SynthesisProblem(Problem):
         return out
 
     def metrics(self, X: np.ndarray) -> np.ndarray:
-        """All metrics, shape (n, len(metric_columns))."""
-        values = evaluate_config_population(self.cfg, self.designs(X))
-        return np.column_stack([np.asarray(values[k], dtype=float) for k in self.metric_columns])
+        """Metrics of the designs X (n, n_var), shape (n, len(metric_columns)): the searched families' columns,
+        NaN in the others (``complete_metrics``)."""
+        values = evaluate_config_population(self.cfg, self.designs(X), self.searched_families)
+        n = np.atleast_2d(X).shape[0]
+        return np.column_stack([np.asarray(values[k], dtype=float) if k in values else np.full(n, np.nan)
+                                for k in self.metric_columns])
+
+    def unsearched_columns(self) -> list[str]:
+        """The metric columns of the families the search does not evaluate."""
+        n_bands = len(self.cfg.dexterity.band_edges) - 1
+        family_of = {c: m.family for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
+                     for c in m.columns(n_bands)}
+        return [k for k in self.metric_columns if family_of[k] not in self.searched_families]
+
+    def complete_metrics(self, X: np.ndarray, M: np.ndarray) -> np.ndarray:
+        """M (from ``metrics``) with the unsearched columns evaluated for the designs X; a copy. A design's
+        metrics do not depend on the designs evaluated with it, so the values equal a full evaluation's."""
+        missing = self.unsearched_columns()
+        if not missing or not len(M):
+            return M
+        n_bands = len(self.cfg.dexterity.band_edges) - 1
+        families = frozenset(m.family for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
+                             if set(m.columns(n_bands)) & set(missing))
+        values = evaluate_config_population(self.cfg, self.designs(X), families)
+        out = np.array(M, dtype=float, copy=True)
+        for k in missing:
+            out[:, self.metric_columns.index(k)] = np.asarray(values[k], dtype=float)
+        return out
 
     def objectives_from_metrics(self, M: np.ndarray) -> np.ndarray:
         cols = [self.metric_columns.index(k) for k in self.objective_keys]
