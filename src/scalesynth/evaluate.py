@@ -461,7 +461,8 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
 
 def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]]) -> dict[str, np.ndarray]:
     """All metrics of many designs under one config, in one parallel kernel call per grid. The cycle metrics
-    (seconds per design) only when an objective or constraint uses one (``cycle.config.searched``)."""
+    (batched over the designs: cycle.population) only when an objective or constraint uses one
+    (``cycle.config.searched``)."""
     from scalesynth.cycle.config import searched
 
     return evaluate_population(
