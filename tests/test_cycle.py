@@ -620,3 +620,54 @@ def test_vectorised_payload_points_equal_payload_point(name):
     poses = run(cfg, samples=30).traj.p
     np.testing.assert_allclose(mech.payload_points(design, options, poses),
                                [mech.payload_point(design, options, p) for p in poses], rtol=0, atol=1e-12)
+
+
+# ----- the population path (the optimiser's cycle metrics) against analysis.metrics per design ---------------
+def _population_designs(cfg, n=11):
+    """The config's design (a followed cycle), n designs drawn uniformly from the bounds (seed 0; many cycles
+    cannot be followed there) and a degenerate one (every bounded dimension 0)."""
+    rng = np.random.default_rng(0)
+    base = cfg.resolved_design()
+    drawn = [{**base, **{k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()}} for _ in range(n)]
+    return [base, *drawn, {**base, **dict.fromkeys(cfg.bounds, 0.0)}]
+
+
+@pytest.mark.parametrize("name, limits", [*((n, {}) for n in CASES),
+                                          ("planar-fivebar", {"speed_limits": 3.0, "force_limits": 40.0})])
+def test_population_metrics_equal_the_per_design_metrics(name, limits):
+    """cycle.population.population_metrics (the design-independent work once, the rest batched over the designs)
+    against analysis.metrics design by design: every metric bit-identical (the same element-wise operations in the
+    same order), followed and refused cycles alike; with limits also max_cycles_per_minute."""
+    from scalesynth.cycle.population import population_metrics
+
+    cfg = CASES[name]
+    cyc = cfg.cycle.model_copy(update={"samples": 40, **limits})
+    designs = _population_designs(cfg)
+    opts = cfg.resolved_options()
+    rows = [analysis.metrics(cfg.mech, d, opts, cyc, cfg.units.length) for d in designs]
+    got = population_metrics(cfg.mech, designs, opts, cyc, cfg.units.length)
+    assert set(got) == set(analysis.METRICS)
+    for key in analysis.METRICS:
+        np.testing.assert_array_equal(got[key], [r.get(key, 0.0) for r in rows], err_msg=key)
+    followed = got["cycle_max_actuator_speed"] < analysis.CYCLE_PENALTY
+    assert followed[0] and not followed[-1] and followed.sum() < len(designs) - 1  # both kinds in the draw
+    if limits:
+        assert np.all(got["max_cycles_per_minute"][followed] > 0.0)
+
+
+def test_fivebar_population_cycle_kinematics_equal_cycle_kinematics_per_design():
+    """planar-fivebar's batched kinematics (designs x poses in one NumPy pass) against cycle_kinematics of each
+    design at its own poses: bit-identical, NaN rows out of reach alike."""
+    cfg = FIVEBAR
+    mech, opts = cfg.mech, cfg.resolved_options()
+    designs = [mech.resolve_design(d) for d in _population_designs(cfg)[:-1]]
+    rng = np.random.default_rng(1)
+    lo, hi = mech.bounding_box(designs[0], opts)
+    poses = rng.uniform(lo[:2], hi[:2], size=(len(designs), 30, 2))
+    label = mech.kernel_branch(opts)
+    q, a = mech.population_cycle_kinematics(designs, opts, poses, label)
+    for d, p, qi, ai in zip(designs, poses, q, a, strict=True):
+        q_one, a_one = mech.cycle_kinematics(d, opts, p, label)
+        np.testing.assert_array_equal(qi, q_one)
+        np.testing.assert_array_equal(ai, a_one)
+    assert np.isnan(q).any() and not np.isnan(q).all()  # both reachable and unreachable poses

@@ -477,7 +477,8 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
 def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]],
                                families: Collection[str] | None = None) -> dict[str, np.ndarray]:
     """All metrics of many designs under one config (of ``families`` only, when given), in one parallel kernel
-    call per grid. The cycle metrics (seconds per design) only when an objective or constraint uses one
+    call per grid. The cycle metrics (batched over the designs: cycle.population) only when an objective or
+    constraint uses one
     (``cycle.config.searched``)."""
     from scalesynth.cycle.config import searched
 

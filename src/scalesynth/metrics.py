@@ -201,12 +201,12 @@ def _path_mean_lci(ctx: EvalContext) -> np.ndarray:
 
 
 def _cycle_values(ctx: EvalContext) -> dict[str, np.ndarray]:
-    """Every cycle metric of every design (scalesynth.cycle.analysis.metrics), computed once per context."""
+    """Every cycle metric of every design (scalesynth.cycle.analysis.metrics, batched over the population by
+    scalesynth.cycle.population), computed once per context."""
     if "cycle" not in ctx.cache:
-        from scalesynth.cycle import analysis
+        from scalesynth.cycle.population import population_metrics
 
-        rows = [analysis.metrics(ctx.mech, d, ctx.options, ctx.cycle, ctx.length_unit) for d in ctx.designs]
-        ctx.cache["cycle"] = {k: np.array([r.get(k, 0.0) for r in rows], dtype=float) for k in analysis.METRICS}
+        ctx.cache["cycle"] = population_metrics(ctx.mech, ctx.designs, ctx.options, ctx.cycle, ctx.length_unit)
     return ctx.cache["cycle"]
 
 

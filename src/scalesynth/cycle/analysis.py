@@ -335,22 +335,31 @@ def deflection_along(mech: Mechanism, design, options, poses: np.ndarray, loads:
 
 def _packed_with_loads(mech: Mechanism, design, options, loads: np.ndarray) -> np.ndarray:
     """One packed vector per load (n, k_packed): the design packed once, the load's entries found by packing the
-    unit loads (each must set exactly one entry to 1) and overwritten per row; a mechanism that packs its load
-    otherwise is packed once per load."""
-    def pack(load):
-        return mech.pack(design, {**options, "load": [float(v) for v in load]})
-
-    dim = loads.shape[1]
-    zero = pack(np.zeros(dim))
-    slots = []
-    for a in range(dim):
-        diff = np.nonzero(pack(np.eye(dim)[a]) != zero)[0]
-        if diff.size != 1 or pack(np.eye(dim)[a])[diff[0]] != 1.0 or zero[diff[0]] != 0.0:
-            return np.stack([pack(f) for f in loads])
-        slots.append(int(diff[0]))
+    unit loads (``load_slots``) and overwritten per row; a mechanism that packs its load otherwise is packed once
+    per load."""
+    zero, slots = load_slots(mech, design, options, loads.shape[1])
+    if slots is None:
+        return np.stack([mech.pack(design, {**options, "load": [float(v) for v in load]}) for load in loads])
     out = np.tile(zero, (len(loads), 1))
     out[:, slots] = loads
     return out
+
+
+def load_slots(mech: Mechanism, design, options, dim: int) -> tuple[np.ndarray, list[int] | None]:
+    """(the design packed under a zero load (k_packed,), the entry of each of the ``dim`` load axes): each unit
+    load must set exactly one entry to 1, else the slots are None (the mechanism packs its load otherwise)."""
+    def pack(load):
+        return mech.pack(design, {**options, "load": [float(v) for v in load]})
+
+    zero = pack(np.zeros(dim))
+    slots = []
+    for a in range(dim):
+        unit = pack(np.eye(dim)[a])
+        diff = np.nonzero(unit != zero)[0]
+        if diff.size != 1 or unit[diff[0]] != 1.0 or zero[diff[0]] != 0.0:
+            return zero, None
+        slots.append(int(diff[0]))
+    return zero, slots
 
 
 def _payload_motion(mech, design, options, traj, size) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -442,15 +451,20 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
     try:
         res = analyse(mech, design, options, cyc, length_unit)
     except ScalesynthError:  # CycleError, or a degenerate design's kinematics refusing a pose
-        bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
-                "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
-                "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
-        if has_deflection(mech, options):
-            bad["cycle_max_deflection"] = CYCLE_PENALTY
-        if cyc.speed_limits is not None or cyc.force_limits is not None:
-            bad["max_cycles_per_minute"] = 0.0
-        return bad
+        return failed_metrics(mech, options, cyc)
     return result_metrics(res, cyc)
+
+
+def failed_metrics(mech: Mechanism, options, cyc: ccfg.CycleConfig) -> dict[str, float]:
+    """The catalogue metrics of a cycle that cannot be followed (see ``metrics``)."""
+    bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
+           "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
+           "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
+    if has_deflection(mech, options):
+        bad["cycle_max_deflection"] = CYCLE_PENALTY
+    if cyc.speed_limits is not None or cyc.force_limits is not None:
+        bad["max_cycles_per_minute"] = 0.0
+    return bad
 
 
 def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:

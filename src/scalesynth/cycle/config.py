@@ -268,7 +268,7 @@ CYCLE_METRICS = (
 
 def searched(cfg) -> CycleConfig | None:
     """The config's cycle when an objective or constraint is a cycle metric (the optimisation then evaluates the
-    cycle of every design), else None: a cycle costs seconds per design, so it is not analysed for results columns
-    nobody optimises (``scalesynth evaluate`` and ``scalesynth cycle`` always report it)."""
+    cycle of every design), else None: a cycle costs 0.2 to a few ms per design, so it is not analysed for results
+    columns nobody optimises (``scalesynth evaluate`` and ``scalesynth cycle`` always report it)."""
     used = {item.metric for item in [*cfg.objectives, *cfg.constraints]}
     return cfg.cycle if used & set(CYCLE_METRICS) else None

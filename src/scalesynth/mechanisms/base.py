@@ -263,6 +263,16 @@ class Mechanism(ABC):
                 a[s] = self.velocity_map(design, options, pose, q[s])
         return q, a
 
+    def population_cycle_kinematics(self, designs, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """cycle_kinematics of many resolved designs, each at its own poses (D, n, k) -> q (D, n, n_joints),
+        A (D, n, n_joints, n_joints). This default calls cycle_kinematics per design; a mechanism may batch it
+        (the cycle metrics of a population, ``cycle.population``), equal to these calls to rounding."""
+        out = [self.cycle_kinematics(d, options, p, label) for d, p in zip(designs, poses, strict=True)]
+        nj = len(self.joints)
+        if not out:
+            return np.empty((0, poses.shape[1], nj)), np.empty((0, poses.shape[1], nj, nj))
+        return np.stack([q for q, _ in out]), np.stack([a for _, a in out])
+
     def payload_points(self, design, options, poses) -> np.ndarray:
         """payload_point at many poses (n, k) -> (n, 3); this default loops, a mechanism may vectorise it."""
         return np.array([self.payload_point(design, options, pose) for pose in poses], dtype=float).reshape(-1, 3)

@@ -465,27 +465,14 @@ class PlanarFivebar(Mechanism):
         """Vectorised twin of Mechanism.cycle_kinematics: the closed-form IK of inverse_kinematics in branch
         ``label`` and A = Jq^-1 Jx of velocity_map at poses (n, 2) in NumPy; NaN rows out of reach."""
         pts = np.asarray(poses, dtype=float)
-        x, y = pts[:, 0], pts[:, 1]
-        r, l1, l2 = design["r"], design["l1"], design["l2"]
-        n = len(pts)
-        q = np.empty((n, 2))
-        ok = np.ones(n, dtype=bool)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            for i, (u, sign) in enumerate(((x - r, label[0]), (x + r, label[1]))):
-                dd, ee = -2.0 * l1 * u, -2.0 * l1 * y
-                norm = np.hypot(dd, ee)
-                k = -(u * u + y * y + l1 * l1 - l2 * l2) / norm
-                ok &= (norm != 0.0) & (np.abs(k) <= 1.0 + 1e-12)
-                g = np.arccos(np.clip(k, -1.0, 1.0))
-                q[:, i] = wrap_angle(np.arctan2(ee, dd) + (-g if sign == "+" else g))
-            elbow_x = np.column_stack([r + l1 * np.cos(q[:, 0]), -r + l1 * np.cos(q[:, 1])])
-            elbow_y = l1 * np.sin(q)
-            beta = np.arctan2(y[:, None] - elbow_y, x[:, None] - elbow_x)
-            jq = l1 * np.sin(beta - q)
-            a = np.stack([np.cos(beta), np.sin(beta)], axis=-1) / jq[:, :, None]
-        q[~ok] = np.nan
-        a[~ok] = np.nan
-        return q, a
+        return _cycle_kinematics(pts[:, 0], pts[:, 1], design["r"], design["l1"], design["l2"], label)
+
+    def population_cycle_kinematics(self, designs, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """cycle_kinematics of many designs at once (the same element-wise NumPy over designs x poses): poses
+        (D, n, 2) -> q (D, n, 2), A (D, n, 2, 2)."""
+        pts = np.asarray(poses, dtype=float)
+        r, l1, l2 = (np.array([[d[name]] for d in designs], dtype=float) for name in ("r", "l1", "l2"))
+        return _cycle_kinematics(pts[..., 0], pts[..., 1], r, l1, l2, label)
 
     def resolution_index(self, design, options, pose, dalpha=(1.0, 1.0)) -> float:
         """Kinematic resolution |J dalpha| (mm per the arm increments dalpha in rad; spec §2.4, paper eq. 18) in
@@ -649,3 +636,28 @@ MECHANISM = PlanarFivebar(
     ),
     design_metrics=DESIGN_METRICS,
 )
+
+
+def _cycle_kinematics(x, y, r, l1, l2, label: str) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-form IK in branch ``label`` and A = Jq^-1 Jx at P = (x, y) (any shape S; r, l1, l2 broadcast to it,
+    mm) -> q (*S, 2) rad with NaN where out of reach, A (*S, 2, 2) rad/mm (NaN there)."""
+    shape = np.broadcast(x, r).shape
+    q = np.empty((*shape, 2))
+    ok = np.ones(shape, dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for i, (u, sign) in enumerate(((x - r, label[0]), (x + r, label[1]))):
+            dd, ee = -2.0 * l1 * u, -2.0 * l1 * y
+            norm = np.hypot(dd, ee)
+            k = -(u * u + y * y + l1 * l1 - l2 * l2) / norm
+            ok &= (norm != 0.0) & (np.abs(k) <= 1.0 + 1e-12)
+            g = np.arccos(np.clip(k, -1.0, 1.0))
+            q[..., i] = wrap_angle(np.arctan2(ee, dd) + (-g if sign == "+" else g))
+        l1e = np.asarray(l1)[..., None]  # broadcast against the arm axis
+        elbow_x = np.stack([r + l1 * np.cos(q[..., 0]), -r + l1 * np.cos(q[..., 1])], axis=-1)
+        elbow_y = l1e * np.sin(q)
+        beta = np.arctan2(y[..., None] - elbow_y, x[..., None] - elbow_x)
+        jq = l1e * np.sin(beta - q)
+        a = np.stack([np.cos(beta), np.sin(beta)], axis=-1) / jq[..., None]
+    q[~ok] = np.nan
+    a[~ok] = np.nan
+    return q, a
