@@ -276,7 +276,7 @@ class RunConfig(_Strict):
             for i, item in enumerate(items):
                 try:
                     m = resolve(mech, self.units.length, item.metric, item.band, n_bands, has_task, has_path, options,
-                                self.cycle)
+                                self.cycle, self.grid.adaptive)
                 except ValueError as err:
                     raise ValueError(f"{where}[{i}].{err}") from None
                 if where == "objectives" and item.sense == "min" and m.worst is None:

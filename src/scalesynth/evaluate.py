@@ -235,7 +235,9 @@ def _metrics_of(
     when the workspace family is not asked for), task statistics (on the uniform task grid) and the computed
     families (design, path, cycle) evaluated here."""
     has_path = task is not None and task.path is not None
-    entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
+    # the adaptive evaluator's error estimates (statistic "estimate") come with its statistics, from the caller
+    entries = [m for m in _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
+               if m.statistic != "estimate"]
     if families is not None:
         entries = [m for m in entries if m.family in families]
     n_bands = len(band_edges) - 1
@@ -425,11 +427,10 @@ def evaluate_population(
     n = len(resolved)
     if n == 0:
         has_path = task is not None and task.path is not None
-        entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
+        entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle,
+                                          tolerance is not None)
         cols = [c for m in entries if families is None or m.family in families
                 for c in m.columns(len(band_edges) - 1)]
-        if tolerance is not None and (families is None or "workspace" in families):
-            cols += ["error_volume", "error_gci"]
         return {k: np.zeros(0) for k in cols}
     packed = np.stack([mech.pack(d, options) for d in resolved])
     edges = np.asarray(band_edges, dtype=float)

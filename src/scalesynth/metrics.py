@@ -286,6 +286,14 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
     for f in mech.fields:
         if f.name != "lci":
             entries += _field_entries(mech, f, unit, "workspace")
+    entries += [
+        Metric("error_volume", "error_volume", "workspace", None, "estimate", "1", (0.0, math.inf), "min", None,
+               ("grid.tolerance",), f"the adaptive evaluator's estimate of the relative error of the workspace "
+               f"{mname} (change from its previous refinement level)"),
+        Metric("error_gci", "error_gci", "workspace", None, "estimate", "1", (0.0, math.inf), "min", None,
+               ("grid.tolerance",), "the adaptive evaluator's estimate of the absolute error of the GCI (change "
+               "from its previous refinement level)"),
+    ]
     entries.append(Metric("task_coverage", "task_coverage", "task", None, "coverage", "1", (0.0, 1.0), "max", 1.0,
                           ("task",), "share of the task box's cells reachable within all limits"))
     for f in mech.fields:
@@ -311,10 +319,13 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
 
 
 def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None,
-               cycle: Any = None) -> str | None:
+               cycle: Any = None, adaptive: bool = False) -> str | None:
     """Why ``m`` cannot be evaluated under a config (a phrase), or None if it can. ``cycle``: the config's
-    CycleConfig or None."""
+    CycleConfig or None; ``adaptive``: whether the workspace goes through the adaptive evaluator (grid.tolerance
+    without a resolution)."""
     for need in m.needs:
+        if need == "grid.tolerance" and not adaptive:
+            return "needs grid.tolerance without grid.resolution (the adaptive evaluator's estimate)"
         if need == "cycle" and cycle is None:
             return "needs a cycle section"
         if need == "cycle.limits" and cycle is not None and cycle.speed_limits is None and cycle.force_limits is None:
@@ -329,16 +340,18 @@ def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, 
 
 
 def result_metrics(mech: Mechanism, length_unit: str, has_task: bool, has_path: bool,
-                   options: Mapping[str, Any] | None = None, cycle: Any = None) -> list[Metric]:
+                   options: Mapping[str, Any] | None = None, cycle: Any = None,
+                   adaptive: bool = False) -> list[Metric]:
     """The metrics evaluated for a config (catalogue order)."""
     return [m for m in catalogue(mech, length_unit).values()
-            if applicable(m, has_task, has_path, options, cycle) is None]
+            if applicable(m, has_task, has_path, options, cycle, adaptive) is None]
 
 
 def result_columns(mech: Mechanism, length_unit: str, n_bands: int, has_task: bool, has_path: bool,
-                   options: Mapping[str, Any] | None = None, cycle: Any = None) -> list[str]:
+                   options: Mapping[str, Any] | None = None, cycle: Any = None,
+                   adaptive: bool = False) -> list[str]:
     """Every metric column of a config's results, in a fixed order."""
-    return [c for m in result_metrics(mech, length_unit, has_task, has_path, options, cycle)
+    return [c for m in result_metrics(mech, length_unit, has_task, has_path, options, cycle, adaptive)
             for c in m.columns(n_bands)]
 
 
@@ -349,7 +362,8 @@ def all_field_names() -> set[str]:
 
 
 def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_bands: int, has_task: bool,
-            has_path: bool, options: Mapping[str, Any] | None = None, cycle: Any = None) -> Metric:
+            has_path: bool, options: Mapping[str, Any] | None = None, cycle: Any = None,
+            adaptive: bool = False) -> Metric:
     """The catalogue entry of a config's objective/constraint. Raises ValueError with a message that starts with
     the sub-field it is about ('metric: ...' or 'band: ...') and lists the valid choices."""
     cat = catalogue(mech, length_unit)
@@ -361,10 +375,10 @@ def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_ba
                 if name.startswith(head) and fname in all_field_names():
                     raise ValueError(f"metric: {name}: field {fname!r} is not provided by {mech.name} "
                                      f"(fields: {', '.join(mech.field_names)})")
-        usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options, cycle) is None]
+        usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options, cycle, adaptive) is None]
         raise ValueError(f"metric: unknown metric {name!r} for {mech.name} (valid: {', '.join(usable)})")
     m = cat[name]
-    why = applicable(m, has_task, has_path, options, cycle)
+    why = applicable(m, has_task, has_path, options, cycle, adaptive)
     if why is not None:
         raise ValueError(f"metric: {name} {why}")
     if "band" in m.needs:

@@ -34,7 +34,8 @@ def result_columns(cfg: RunConfig) -> list[str]:
 
     has_task = cfg.task is not None
     return _metrics.result_columns(cfg.mech, cfg.units.length, len(cfg.dexterity.band_edges) - 1, has_task,
-                                   has_task and cfg.task.path is not None, cfg.resolved_options(), searched(cfg))
+                                   has_task and cfg.task.path is not None, cfg.resolved_options(), searched(cfg),
+                                   cfg.grid.adaptive)
 
 
 def objective_label(cfg: RunConfig, obj: ObjectiveConfig) -> str:
