@@ -185,9 +185,14 @@ def markdown(entry: dict) -> list[str]:
            "| config | mechanism | evaluator | ms/design | NSGA-II ms/evaluation (CPU) | projected 40 000-design "
            "loop, wall (CPU) | <= 30 s | peak RSS | RSS by generation (MiB) | <= 1 GiB |",
            "|---|---|---|---|---|---|---|---|---|---|"]
+    if any("measured" in row for row in r["configs"]):
+        out[0] += (" Rows measured in separate runs (`bench.py synthesis CONFIG.yaml ...`, merged) carry their own "
+                   "date and load average (1 min at the start) after the config name.")
     for row in r["configs"]:
         ev, lp = row["evaluation"], row["loop"]
-        head = (f"| {row['config']} | {row['mechanism']} | {row['evaluator']} | {1e3 * ev['s_per_design']:.2f} "
+        when = row.get("measured")
+        name = row["config"] + (f" ({when['date'][5:]}, load {when['load_average_start'][0]:g})" if when else "")
+        head = (f"| {name} | {row['mechanism']} | {row['evaluator']} | {1e3 * ev['s_per_design']:.2f} "
                 f"({1e3 * ev['cpu_s_per_design']:.2f} CPU) |")
         if "error" in lp:
             out.append(head + f" failed: {lp['error']} | | | | | |")

@@ -22,6 +22,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from synthesis import random_designs  # benchmarks/synthesis.py: designs uniform in the config's bounds
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG_DIR = ROOT / "configs"
@@ -30,17 +31,6 @@ POOL = 2000
 SLIVER = 0.01
 GOAL_GCI = 5.0e-4
 KEYS = ("task_coverage", "task_gci", "task_fci")
-
-
-def _designs(cfg, n: int, seed: int) -> list[dict[str, float]]:
-    rng = np.random.default_rng(seed)
-    base = cfg.resolved_design()
-    out = []
-    for _ in range(n):
-        d = dict(base)
-        d.update({k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()})
-        out.append(d)
-    return out
 
 
 def _task(config: Path, resolution: int, designs) -> tuple[dict[str, np.ndarray], float]:
@@ -64,12 +54,12 @@ def bench_config(config: Path) -> dict:
     cfg = load_config(config)
     n = cfg.task.resolution or cfg.grid.resolution
     row = {"config": config.name, "mechanism": cfg.mechanism, "resolution": n, "reference": 3 * n}
-    rnd = _designs(cfg, N_DESIGNS, 0)
+    rnd = random_designs(cfg, N_DESIGNS, 0)
     res, s_cfg = _task(config, n, rnd)
     ref, s_ref = _task(config, 3 * n, rnd)
     keep = ref["task_coverage"] >= SLIVER
     row["random"] = {"designs": int(keep.sum()), "errors": _errors(res, ref, keep)}
-    pool = _designs(cfg, POOL, 1)
+    pool = random_designs(cfg, POOL, 1)
     cov, _ = _task(config, 3 * n, pool)
     covering = [d for d, c in zip(pool, cov["task_coverage"], strict=True) if c == 1.0][:N_DESIGNS]
     if covering:
