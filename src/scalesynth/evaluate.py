@@ -171,7 +171,7 @@ def adaptive_population_stats(
     stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
                                                       plan.columns, plan.cells, plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
-                                                      plan.zlevels, plan.zconfirm, plan.faces)
+                                                      plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 

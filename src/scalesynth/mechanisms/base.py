@@ -202,6 +202,13 @@ class Mechanism(ABC):
         """The Numba field kernel ``kernel(p, x, y, z, out)`` writing ``n_fields`` slots (module docstring)."""
 
     @property
+    def reach_kernel(self):
+        """A Numba kernel with the field kernel's signature whose slot 0 is >= 0 exactly where the field kernel's
+        is (reachable), the other slots unspecified: the adaptive evaluator's nodes and bisections need no more.
+        Default: the field kernel itself; a mechanism overrides it with one that skips the costly fields."""
+        return self.field_kernel
+
+    @property
     def point_kernel(self):
         """Scalar LCI kernel ``f(p, x, y, z) -> LCI or -1`` derived from the field kernel (single points, plots)."""
         kernel = _LCI_KERNELS.get(self.name)
