@@ -65,6 +65,29 @@ def make_grid(
     return Grid(lo=lo, step=step, shape=shape, ndim=ndim)
 
 
+def design_boxes(
+    mech: Mechanism,
+    designs: Sequence[Mapping[str, float]],
+    options: Mapping[str, Any],
+    region: Mapping[str, Sequence[float]] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi), each (n, 3): every design's box as ``make_grid(..., 1, region)`` gives it (lo, and lo + step x
+    shape; the axes beyond the task's: 0 and 1), in one array pass instead of a Grid per design."""
+    n = len(designs)
+    ndim = len(mech.task_axes)
+    lo, hi = np.zeros((n, 3)), np.zeros((n, 3))
+    for k, d in enumerate(designs):
+        lo[k], hi[k] = mech.bounding_box(d, options)
+    for a, name in enumerate(mech.task_axes):
+        if region and name in region:
+            lo[:, a], hi[:, a] = float(region[name][0]), float(region[name][1])
+    # make_grid: step = (hi - lo) / 1, hi = lo + step x 1 (not hi itself: the same rounding)
+    top = np.ones((n, 3))
+    top[:, :ndim] = lo[:, :ndim] + (hi[:, :ndim] - lo[:, :ndim])
+    lo[:, ndim:] = 0.0
+    return lo, top
+
+
 def task_grid(mech: Mechanism, task: Any, resolution: int) -> Grid:
     """The cell-centred grid over a config's task box (``task.resolution`` cells per axis, else ``resolution``)."""
     ndim = len(mech.task_axes)
@@ -162,11 +185,10 @@ def adaptive_population_stats(
     ndim = len(mech.task_axes)
     plan = plan or adaptive_plan(mech)
     if boxes is None:
-        grids = [make_grid(mech, d, options, 1, region) for d in designs]
+        lo, hi = design_boxes(mech, designs, options, region)
     else:
-        grids = [boxes] * n
-    lo = np.stack([g.lo for g in grids]) if n else np.zeros((0, 3))
-    hi = np.stack([g.lo + g.step * g.shape for g in grids]) if n else np.zeros((0, 3))
+        lo = np.tile(boxes.lo, (n, 1))
+        hi = np.tile(boxes.lo + boxes.step * boxes.shape, (n, 1))
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
     stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
                                                       plan.columns, plan.cells, plan.bisections, plan.levels,
