@@ -11,7 +11,8 @@
     python benchmarks/bench.py compile_commands  # every CLI command per mechanism: second process compiles nothing
     python benchmarks/bench.py adaptive [MECH ...]  # adaptive evaluator vs uniform grids and its NumPy twin (merged)
     python benchmarks/bench.py adaptive_twin [MECH ...]  # the NumPy twin timing alone, merged into adaptive.json
-    python benchmarks/bench.py synthesis    # every config: ms/design, projected 200 x 200 NSGA-II loop, peak memory
+    python benchmarks/bench.py synthesis [CONFIG.yaml ...]  # every config (or these, merged into the stored part):
+                                            # ms/design, projected 200 x 200 NSGA-II loop, peak memory
     python benchmarks/bench.py show         # `scalesynth show` at resolution 96: wall, CPU and JIT seconds per process
 
 Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
@@ -788,6 +789,10 @@ def main(argv: list[str]) -> None:
         _run_part("adaptive", lambda: _merge_adaptive(adaptive_bench.bench_adaptive(argv[1:])))
         write_results_md()
         return
+    if argv and argv[0] == "synthesis" and len(argv) > 1:  # synthesis CONFIG ...: rows merged into the stored part
+        _merge_synthesis(synthesis.bench_synthesis([Path(a).name for a in argv[1:]]))
+        write_results_md()
+        return
     if argv and argv[0] == "adaptive_twin":  # the NumPy twin timing alone, merged into the stored adaptive rows
         _merge_twin(adaptive_bench.bench_twin(argv[1:]))
         write_results_md()
@@ -816,6 +821,22 @@ def _merge_adaptive(new: dict) -> dict:
     rows = {m["mechanism"]: m for m in (json.loads(path.read_text())["result"]["mechanisms"] if path.exists() else [])}
     rows.update({m["mechanism"]: m for m in new["mechanisms"]})
     return {"mechanisms": [rows[k] for k in adaptive_bench.CONFIGS if k in rows]}
+
+
+def _merge_synthesis(new: dict) -> None:
+    """Store the config rows of ``new`` (bench_synthesis on a subset) in the stored synthesis part, replacing those
+    configs' rows, each with its own date, load, thread setting and machine; the other rows and the part's own
+    date and load are kept."""
+    path = RESULTS / "synthesis.json"
+    if not path.exists():
+        raise SystemExit("no stored synthesis part: run `python benchmarks/bench.py synthesis` first")
+    entry = json.loads(path.read_text())
+    when = {"date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), "machine": machine(),
+            **{k: new[k] for k in ("load_average_start", "load_average_end", "numba_threads_env")}}
+    rows = {r["config"]: r for r in entry["result"]["configs"]}
+    rows.update({r["config"]: dict(r, measured=when) for r in new["configs"]})
+    entry["result"]["configs"] = [rows[k] for k in sorted(rows)]
+    path.write_text(json.dumps(entry, indent=2) + "\n")
 
 
 def _merge_twin(new: dict) -> None:

@@ -196,6 +196,13 @@ def markdown(entry: dict) -> list[str]:
                    f"{ok_m} |")
     out += ["", "`<= 30 s`: yes = the measured wall projection meets it; `CPU/2 only` = only an ideal 2-thread split "
             "of the measured CPU time would; NO = neither.", ""]
+    again = [row for row in r["configs"] if "measured" in row]
+    if again:  # rows re-measured alone (`bench.py synthesis CONFIG ...`), each under its own conditions
+        out += ["Re-measured alone (`python benchmarks/bench.py synthesis CONFIG`), not under the conditions above: "
+                + "; ".join(f"{row['config']} {row['measured']['date']}, load average (1, 5, 15 min) "
+                            f"{row['measured']['load_average_start']} at the start, "
+                            f"{row['measured']['load_average_end']} at the end, NUMBA_NUM_THREADS="
+                            f"{row['measured']['numba_threads_env']}" for row in again) + ".", ""]
     return out
 
 
