@@ -11,8 +11,8 @@
     python benchmarks/bench.py compile_commands  # every CLI command per mechanism: second process compiles nothing
     python benchmarks/bench.py adaptive [MECH ...]  # adaptive evaluator vs uniform grids and its NumPy twin (merged)
     python benchmarks/bench.py adaptive_twin [MECH ...]  # the NumPy twin timing alone, merged into adaptive.json
-    python benchmarks/bench.py synthesis [CONFIG.yaml ...]  # every config (or those, merged): ms/design, projected
-                                            # 200 x 200 NSGA-II loop, peak memory
+    python benchmarks/bench.py synthesis [CONFIG.yaml ...]  # every config (or these, merged into the stored part):
+                                            # ms/design, projected 200 x 200 NSGA-II loop, peak memory
     python benchmarks/bench.py task_accuracy  # configs with a task box: its uniform grid against a 3x finer one
     python benchmarks/bench.py show         # `scalesynth show` at resolution 96: wall, CPU and JIT seconds per process
 
@@ -793,8 +793,8 @@ def main(argv: list[str]) -> None:
         _run_part("adaptive", lambda: _merge_adaptive(adaptive_bench.bench_adaptive(argv[1:])))
         write_results_md()
         return
-    if argv and argv[0] == "synthesis" and len(argv) > 1:  # synthesis CONFIG.yaml ...: merged into the stored part
-        _run_part("synthesis", lambda: _merge_synthesis(synthesis.bench_synthesis(argv[1:])))
+    if argv and argv[0] == "synthesis" and len(argv) > 1:  # synthesis CONFIG ...: rows merged into the stored part
+        _merge_synthesis(synthesis.bench_synthesis([Path(a).name for a in argv[1:]]))
         write_results_md()
         return
     if argv and argv[0] == "adaptive_twin":  # the NumPy twin timing alone, merged into the stored adaptive rows
@@ -827,22 +827,20 @@ def _merge_adaptive(new: dict) -> dict:
     return {"mechanisms": [rows[k] for k in adaptive_bench.CONFIGS if k in rows]}
 
 
-def _merge_synthesis(new: dict) -> dict:
-    """The stored synthesis rows with those of ``new`` replaced or added (config order); each row keeps the date,
-    load and machine it was measured with."""
+def _merge_synthesis(new: dict) -> None:
+    """Store the config rows of ``new`` (bench_synthesis on a subset) in the stored synthesis part, replacing those
+    configs' rows, each with its own date, load, thread setting and machine; the other rows and the part's own
+    date and load are kept."""
     path = RESULTS / "synthesis.json"
-    old = json.loads(path.read_text()) if path.exists() else None
-    rows = {}
-    if old:
-        for r in old["result"]["configs"]:
-            r.setdefault("measured", {"date": old["date"], "load_average_start": old["result"]["load_average_start"],
-                                      "load_average_end": old["result"]["load_average_end"]})
-            rows[r["config"]] = r
-    stamp = {"date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), "load_average_start": new["load_average_start"],
-             "load_average_end": new["load_average_end"]}
-    for r in new["configs"]:
-        rows[r["config"]] = dict(r, measured=stamp)
-    return dict(new, configs=[rows[k] for k in sorted(rows)])
+    if not path.exists():
+        raise SystemExit("no stored synthesis part: run `python benchmarks/bench.py synthesis` first")
+    entry = json.loads(path.read_text())
+    when = {"date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"), "machine": machine(),
+            **{k: new[k] for k in ("load_average_start", "load_average_end", "numba_threads_env")}}
+    rows = {r["config"]: r for r in entry["result"]["configs"]}
+    rows.update({r["config"]: dict(r, measured=when) for r in new["configs"]})
+    entry["result"]["configs"] = [rows[k] for k in sorted(rows)]
+    path.write_text(json.dumps(entry, indent=2) + "\n")
 
 
 def _merge_twin(new: dict) -> None:

@@ -185,14 +185,10 @@ def markdown(entry: dict) -> list[str]:
            "| config | mechanism | evaluator | ms/design | NSGA-II ms/evaluation (CPU) | projected 40 000-design "
            "loop, wall (CPU) | <= 30 s | peak RSS | RSS by generation (MiB) | <= 1 GiB |",
            "|---|---|---|---|---|---|---|---|---|---|"]
-    if any("measured" in row for row in r["configs"]):
-        out[0] += (" Rows measured in separate runs (`bench.py synthesis CONFIG.yaml ...`, merged) carry their own "
-                   "date and load average (1 min at the start) after the config name.")
     for row in r["configs"]:
         ev, lp = row["evaluation"], row["loop"]
-        when = row.get("measured")
-        name = row["config"] + (f" ({when['date'][5:]}, load {when['load_average_start'][0]:g})" if when else "")
-        head = (f"| {name} | {row['mechanism']} | {row['evaluator']} | {1e3 * ev['s_per_design']:.2f} "
+        head = (f"| {row['config']}{' (*)' if 'measured' in row else ''} | {row['mechanism']} | {row['evaluator']} | "
+                f"{1e3 * ev['s_per_design']:.2f} "
                 f"({1e3 * ev['cpu_s_per_design']:.2f} CPU) |")
         if "error" in lp:
             out.append(head + f" failed: {lp['error']} | | | | | |")
@@ -206,6 +202,13 @@ def markdown(entry: dict) -> list[str]:
                    f"{ok_m} |")
     out += ["", "`<= 30 s`: yes = the measured wall projection meets it; `CPU/2 only` = only an ideal 2-thread split "
             "of the measured CPU time would; NO = neither.", ""]
+    again = [row for row in r["configs"] if "measured" in row]
+    if again:  # rows re-measured alone (`bench.py synthesis CONFIG ...`), each under its own conditions
+        out += ["(*) Re-measured alone (`python benchmarks/bench.py synthesis CONFIG`), not under the conditions above: "
+                + "; ".join(f"{row['config']} {row['measured']['date']}, load average (1, 5, 15 min) "
+                            f"{row['measured']['load_average_start']} at the start, "
+                            f"{row['measured']['load_average_end']} at the end, NUMBA_NUM_THREADS="
+                            f"{row['measured']['numba_threads_env']}" for row in again) + ".", ""]
     return out
 
 

@@ -508,6 +508,9 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     # face columns [side, L or S, index]: x = lo, hi per j; y = lo, hi per i
     fxg, fyg = np.zeros((2, 2, ny)), np.zeros((2, 2, n))
     kept_v, kept_w = [], []
+    src = None  # per active column: the previous level's column it repeats (centre children), else -1
+    p_owner = p_qv = p_qw = None  # the previous level's Gauss points: owner column, fields, weights
+    nk = 9 if ndim == 3 else 3
     prev = None
     err_v = err_g = zerr_v = zerr_g = 0.0
     level = 0
@@ -521,8 +524,19 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         area = 1.0 / scale ** (ndim - 1)
         X = lo[0] + (ci + 0.5) * hx / scale
         Y = lo[1] + (cj + 0.5) * hy / scale
-        L, S, owner, qv, qw = columns(X, Y, area, mz)
-        lg[ci, cj], sg[ci, cj] = L, S
+        if src is None:
+            L, S, owner, qv, qw = columns(X, Y, area, mz)
+            lg[ci, cj], sg[ci, cj] = L, S
+        else:  # the centre children repeat their parents' columns (values, 1/nk of the weights), the others are new
+            new = src < 0
+            L, S, o_new, v_new, w_new = columns(X[new], Y[new], area, mz)
+            lg[ci[new], cj[new]], sg[ci[new], cj[new]] = L, S  # the centre ones' L, S: the parent's (repeated)
+            pos = np.flatnonzero(new)
+            rep = np.flatnonzero(~new)
+            take = [np.flatnonzero(p_owner == src[a]) for a in rep]
+            owner = np.concatenate([pos[o_new]] + [np.full(len(t), a) for a, t in zip(rep, take, strict=True)])
+            qv = np.concatenate([v_new] + [p_qv[t] for t in take])
+            qw = np.concatenate([w_new] + [p_qw[t] / nk for t in take])
         vol, ssum = lg.sum() * area, sg.sum() * area
         gci = ssum / vol if vol > 0 else 0.0
         if level == 0 and zl > 0:
@@ -570,6 +584,9 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         if stop or not flag.any():
             break
         da, db = (v.ravel() for v in np.meshgrid(np.arange(3), np.arange(3 if ndim == 3 else 1), indexing="ij"))
+        p_owner, p_qv, p_qw = owner, qv, qw
+        centre = (da == 1) & ((db == 1) | (ndim == 2))
+        src = np.where(centre[None, :], np.flatnonzero(flag)[:, None], -1).ravel()
         ci = (3 * ci[flag][:, None] + da[None, :]).ravel()
         cj = (3 * cj[flag][:, None] + db[None, :]).ravel() if ndim == 3 else np.zeros(ci.size, dtype=np.int64)
         lg = np.repeat(np.repeat(lg, 3, axis=0), 3 if ndim == 3 else 1, axis=1)

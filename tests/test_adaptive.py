@@ -88,6 +88,40 @@ def test_column_kernel_equals_numpy_twin(name):
             assert tl >= 1  # the refinement itself was compared
 
 
+@pytest.mark.parametrize("name", [n for n in available() if get(n).reach_kernel is not get(n).field_kernel])
+def test_reach_kernel_is_the_sign_of_the_field_kernels_lci(name):
+    """The nodes and bisections use Mechanism.reach_kernel: reachable (slot 0 >= 0) at exactly the points where the
+    field kernel's LCI is >= 0, on a 24^3 grid over 1.1x the bounding box (in and out of the box) of the config's
+    design and 5 random designs in its bounds, with the config's options and, where the mechanism has the option,
+    interference_free with 15 mm links (then the clearance decides too: it removes points of the workspaces)."""
+    mech = get(name)
+    cfg = load_config(config_for(name))
+    rng = np.random.default_rng(3)
+    designs = [cfg.resolved_design()] + [mech.resolve_design({**cfg.resolved_design(), **{
+        k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()}}) for _ in range(5)]
+    variants = [cfg.resolved_options()]
+    if "interference_free" in mech.default_options():
+        variants.append({**cfg.resolved_options(), "interference_free": True, "link_radius": 15.0})
+    reach_counts = []
+    for options in variants:
+        counts = 0
+        for d in designs:
+            lo, hi = _box(mech, d, options)
+            mid, half = 0.5 * (lo + hi), 0.55 * (hi - lo)
+            axes = [np.linspace(mid[a] - half[a], mid[a] + half[a], 24) if a < len(mech.task_axes)
+                    else np.array([lo[a]]) for a in range(3)]
+            pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+            packed = mech.pack(d, options)[None, :]
+            lci = kgrid.population_points_fields(mech.field_kernel, mech.n_fields, packed, pts)[0, :, 0]
+            reach = kgrid.population_points_fields(mech.reach_kernel, mech.n_fields, packed, pts)[0, :, 0]
+            np.testing.assert_array_equal(reach >= 0.0, lci >= 0.0)
+            assert 0 < (lci >= 0).sum() < len(pts), name  # both kinds of point were compared
+            counts += int((lci >= 0).sum())
+        reach_counts.append(counts)
+    if len(reach_counts) == 2:
+        assert reach_counts[1] < reach_counts[0], name  # the clearance made points unreachable: it was compared
+
+
 @pytest.mark.parametrize("group", [0, 1, 2])
 def test_adaptive_seed000_volume_against_exact_quadrature(group):
     """Seed 000's workspace volume has an exact 1-D quadrature (spec §1.9): on Table-4 designs the adaptive

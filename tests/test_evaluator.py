@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from scalesynth.evaluate import evaluate, evaluate_population, make_grid
+from scalesynth.evaluate import design_boxes, evaluate, evaluate_population, make_grid
 from scalesynth.kernels import grid as kgrid
 from scalesynth.kernels.conditioning import lci_2x2, lci_3x3
 from scalesynth.mechanisms import get
@@ -248,3 +248,25 @@ def test_grid_volume_converges_to_exact_on_random_designs():
     vol = evaluate_population(M, designs, resolution=96)["volume_m3"]
     exact = np.array([exact_volume(**d) for d in designs])
     np.testing.assert_allclose(vol, exact, rtol=0.0015)  # measured errors -0.005 % .. +0.073 % (2026-12-01)
+
+
+@pytest.mark.parametrize("name", ["ups-sspr", "rps-upu", "planar-fivebar"])
+def test_design_boxes_are_make_grids_boxes(name):
+    """design_boxes (the adaptive evaluator's boxes, one array pass) gives bit for bit the boxes of
+    make_grid(..., 1, region): lo, and lo + step x shape (1 beyond the task axes), for 12 random designs in the
+    config's bounds, with and without a region on the first axis."""
+    from scalesynth.config import load_config
+    from test_registry import config_for
+
+    cfg = load_config(config_for(name))
+    mech, options = cfg.mech, cfg.resolved_options()
+    rng = np.random.default_rng(2)
+    designs = [mech.resolve_design({**cfg.resolved_design(), **{k: float(rng.uniform(lo, hi))
+                                                               for k, (lo, hi) in cfg.bounds.items()}})
+               for _ in range(12)]
+    first = mech.task_axes[0]
+    for region in (None, {first: (0.1, 0.3)}):
+        lo, hi = design_boxes(mech, designs, options, region)
+        grids = [make_grid(mech, d, options, 1, region) for d in designs]
+        np.testing.assert_array_equal(lo, np.stack([g.lo for g in grids]))
+        np.testing.assert_array_equal(hi, np.stack([g.lo + g.step * g.shape for g in grids]))

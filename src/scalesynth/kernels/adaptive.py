@@ -10,10 +10,10 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    can miss the same shell twice, hence the confirmations (issue 15: 2pauu-ppap's lobe tips, pprs-rprs's and
    rps-upu-tool's thin slabs, 1-24 % of the volume at m = 8).
 1. Columns run along the last task axis ("z"; planar mechanisms: y) over a cell-centred grid of the other axes
-   (n x n columns; planar: n). Along a column the fields are evaluated at the m + 1 nodes ``zlo + k hz``; where
-   reachability changes between two nodes, ``nbis`` bisection steps locate the boundary (estimate: the midpoint of
-   the last bracket, error <= hz / 2^(nbis+1)). So the column's reachable length is exact to that precision, not
-   a voxel count.
+   (n x n columns; planar: n). Along a column reachability is evaluated at the m + 1 nodes ``zlo + k hz`` (the
+   mechanism's reach kernel: slot 0 alone); where reachability changes between two nodes, ``nbis`` bisection
+   steps locate the boundary (estimate: the midpoint of the last bracket, error <= hz / 2^(nbis+1)). So the
+   column's reachable length is exact to that precision, not a voxel count.
 2. Each reachable piece of a z-cell is integrated by the 2-point Gauss-Legendre rule: every field at its two points,
    each with half the piece's length (a point that turns out unreachable gives its weight to the other; a piece
    with neither reachable is dropped). The points' fields and weights feed the shared statistics accumulator
@@ -26,7 +26,8 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    face (x = lo or hi; y = lo or hi) next to it: a wall between an edge column's centre and the box face (a task
    box cutting the workspace: rps-upu-tool) is otherwise invisible. A column whose indicator x cell area / 24
    exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3 (planar: 3) cells,
-   each with its own column (the centre one recomputed). The next level repeats steps 1-3 on the new columns, with
+   each with its own column (the centre one is its parent's column: the same point, reused with 1/9 of
+   the weight, not recomputed). The next level repeats steps 1-3 on the new columns, with
    the others held at their coarser values.
 4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
    (absolute) from level l-1; the design stops at the first level whose estimate meets the tolerance, or at
@@ -53,8 +54,13 @@ from scalesynth.kernels.bind import bind
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.kernels.grid import accumulate_cells, init_row
 
-# placeholders: kernels.bind gives each bound copy one mechanism's field kernel and field count
+# placeholders: kernels.bind gives each bound copy one mechanism's field kernel and field count, and (``_column``)
+# its reach kernel: same signature, slot 0 >= 0 exactly where the field kernel's is, the other slots not written
+# (Mechanism.reach_kernel; the field kernel itself where a mechanism has none). Nodes and bisection points need
+# reachability alone: a reach kernel skips the conditioning, clearance and stiffness there (the Gauss points get
+# every field).
 FIELD_KERNEL = None
+REACH_KERNEL = None
 N_FIELDS = 0
 
 GAUSS_X = 1.0 / math.sqrt(3.0)  # 2-point Gauss-Legendre abscissa on [-1, 1] (weights 1)
@@ -177,18 +183,17 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
     for k in range(mz + 1):
         zk = _add_product(zlo, END_NUDGE if k == 0 else (mz - END_NUDGE if k == mz else k), hz)
         if ndim == 3:
-            FIELD_KERNEL(p, x, y, zk, cell)
+            REACH_KERNEL(p, x, y, zk, cell)
         else:
-            FIELD_KERNEL(p, x, zk, zfix, cell)
-        for f in range(n_fields):
-            nodes[k, f] = cell[f]
+            REACH_KERNEL(p, x, zk, zfix, cell)
+        nodes[k] = cell[0]
     evals += mz + 1
     npts = 0
     col_l = 0.0
     col_s = 0.0
     for k in range(mz):
-        r0 = nodes[k, 0] >= 0.0
-        r1 = nodes[k + 1, 0] >= 0.0
+        r0 = nodes[k] >= 0.0
+        r1 = nodes[k + 1] >= 0.0
         if not r0 and not r1:
             continue
         za = _add_product(zlo, k, hz)
@@ -200,9 +205,9 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
             for _ in range(nbis):
                 mid = 0.5 * (ba + bb)
                 if ndim == 3:
-                    FIELD_KERNEL(p, x, y, mid, cell)
+                    REACH_KERNEL(p, x, y, mid, cell)
                 else:
-                    FIELD_KERNEL(p, x, mid, zfix, cell)
+                    REACH_KERNEL(p, x, mid, zfix, cell)
                 if (cell[0] >= 0.0) == r0:
                     ba = mid
                 else:
@@ -270,7 +275,7 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     for _ in range(zlevels):
         mmax *= 2
     cell = np.empty(n_fields)
-    nodes = np.empty((mmax + 1, n_fields))
+    nodes = np.empty(mmax + 1)  # slot 0 (reachability) of each node
     buf = np.empty((n_fields, 2 * mmax))
     wbuf = np.empty(2 * mmax)
     q0 = np.empty(n_fields)
@@ -285,6 +290,10 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     for a in range(n_active):
         ci[a] = a // ny
         cj[a] = a - (a // ny) * ny
+    # src[a]: the parent (index into the previous level's rows) whose column active column a repeats, else -1
+    src = np.full(n_active, -1, dtype=np.int64)
+    prev_rows = np.empty((0, ncol))
+    nk = 9 if ndim == 3 else 3
     lg = np.zeros((n, ny))
     sg = np.zeros((n, ny))
     # box-face columns (step 3): measure and LCI sum of the column on the face x = lo, x = hi (per j), y = lo,
@@ -309,6 +318,18 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
         area = 1.0 / (scale * scale) if ndim == 3 else 1.0 / scale
         rows = np.empty((n_active, ncol))
         for a in range(n_active):
+            if src[a] >= 0:
+                # the centre child is its parent's column (same x, y and z-cells): its L and S are already in lg,
+                # sg (refine_grid), its row is the parent's with 1/nk of the weight (min and max unchanged)
+                for c in range(ncol):
+                    rows[a, c] = prev_rows[src[a], c]
+                rows[a, 0] /= nk
+                for f in range(n_fields):
+                    rows[a, 1 + 4 * f] /= nk
+                    rows[a, 2 + 4 * f] /= nk
+                for c in range(1 + 4 * n_fields, ncol):
+                    rows[a, c] /= nk
+                continue
             x = _centre(lo_d[0], ci[a], hx, scale)
             y = _centre(lo_d[1], cj[a], hy, scale)
             FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
@@ -382,10 +403,10 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
                 add_row(row, rows[a], n_fields)
         if stop or n_flag == 0:
             break
-        # 3. children of the flagged cells, in (parent, a, b) order
-        nk = 9 if ndim == 3 else 3
+        # 3. children of the flagged cells, in (parent, a, b) order; the centre one repeats its parent's column
         ni = np.empty(n_flag * nk, dtype=np.int64)
         nj = np.empty(n_flag * nk, dtype=np.int64)
+        ns = np.empty(n_flag * nk, dtype=np.int64)
         t = 0
         for a in range(n_active):
             if flags[a]:
@@ -393,9 +414,12 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
                     for db in range(3 if ndim == 3 else 1):
                         ni[t] = 3 * ci[a] + da
                         nj[t] = 3 * cj[a] + db if ndim == 3 else 0
+                        ns[t] = a if da == 1 and (db == 1 or ndim == 2) else -1
                         t += 1
         ci = ni
         cj = nj
+        src = ns
+        prev_rows = rows
         n_active = t
         lg = refine_grid(lg, ndim)
         sg = refine_grid(sg, ndim)
@@ -420,7 +444,7 @@ def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, 
 
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
-                 beta=1.0, zlevels=0, zconfirm=1, faces=False):
+                 beta=1.0, zlevels=0, zconfirm=1, faces=False, reach_kernel=None):
     """Statistics rows of every design by the column algorithm (module docstring).
 
     params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
@@ -428,9 +452,11 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     levels; tol_v, tol_g: relative measure and absolute GCI tolerance; edges: band edges; beta: share of the
     tolerance one coarse column's error indicator may take before it is refined. Returns (stats (d,
     stat_columns), error_volume (d,), error_gci (d,), levels (d,) int64, evaluations (d,)): counts in units of the
-    coarse cell (hx hy hz with hx = (hi - lo)[0] / n, ...; planar hx hz).
+    coarse cell (hx hy hz with hx = (hi - lo)[0] / n, ...; planar hx hz). reach_kernel: the nodes' and bisection
+    points' kernel (module header; default the field kernel). Evaluations count calls of either kernel.
     """
-    col = bind(_column, field_kernel, n_fields, fastmath=FASTMATH)
+    reach = field_kernel if reach_kernel is None else reach_kernel
+    col = bind(_column, field_kernel, n_fields, extra={"REACH_KERNEL": reach}, fastmath=FASTMATH)
     one = bind(_design_stats, col, n_fields, fastmath=FASTMATH)
     run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
     stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),

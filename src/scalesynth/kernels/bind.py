@@ -46,10 +46,13 @@ def _sources_hash(kernel_file: str) -> str:
     return h
 
 
-def bind(template: Callable, field_kernel: Any, n_fields: int, **jit_options) -> Any:
+def bind(template: Callable, field_kernel: Any, n_fields: int, extra: dict[str, Any] | None = None,
+         **jit_options) -> Any:
     """The template compiled for ``field_kernel`` (an @njit dispatcher) with ``n_fields`` slots; memoised per
-    process, disk-cached when the kernel comes from a real source file."""
-    key = (field_kernel, int(n_fields), template.__name__)
+    process, disk-cached when the kernel comes from a real source file. ``extra``: more globals of the copy
+    (e.g. ``REACH_KERNEL``), kernels from the field kernel's file or kernels/ (the cache follows those files)."""
+    extra = dict(extra or {})
+    key = (field_kernel, int(n_fields), template.__name__, tuple(sorted(extra.items(), key=lambda kv: kv[0])))
     out = _BOUND.get(key)
     if out is not None:
         return out
@@ -59,13 +62,21 @@ def bind(template: Callable, field_kernel: Any, n_fields: int, **jit_options) ->
     module = re.sub(r"\W", "_", getattr(py, "__module__", "") or "kernel")
     qual = re.sub(r"\W", "_", py.__qualname__)
     name = f"{template.__name__.lstrip('_')}__{module}__{qual}__{n_fields}"
-    if cacheable:
-        name += f"__{_sources_hash(kernel_file)}"
+    tag = _sources_hash(kernel_file) if cacheable else ""
+    if extra:  # the extra kernels' names folded into the 12-digit tag: another one is another copy, and the cache
+        # file names (near the 255-byte limit of a file name for the nested copies) get no longer
+        fns = {k: getattr(v, "py_func", v) for k, v in extra.items()}
+        names = ",".join(f"{k}={getattr(f, '__module__', '')}.{getattr(f, '__qualname__', repr(f))}"
+                         for k, f in sorted(fns.items()))
+        tag = hashlib.sha256(f"{tag};{names}".encode()).hexdigest()[:12]
+    if tag:
+        name += f"__{tag}"
     code = template.__code__.replace(co_name=name, co_qualname=name,
                                      co_filename=kernel_file if cacheable else template.__code__.co_filename)
     env = dict(template.__globals__)
     env["FIELD_KERNEL"] = field_kernel
     env["N_FIELDS"] = int(n_fields)
+    env.update(extra)
     fn = types.FunctionType(code, env, name, template.__defaults__)
     fn.__qualname__ = name
     fn.__module__ = template.__module__

@@ -338,6 +338,14 @@ def kinematic_fields(p, x, y, z, out):
     _fields(p, x, y, z, out, False)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def point_reach(p, x, y, z, out):
+    """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same leg checks and,
+    with interference_free, the same clearance), -1 elsewhere; no conditioning, stiffness or (without
+    interference_free) clearance. The adaptive evaluator's nodes and bisections (Mechanism.reach_kernel)."""
+    _fields(p, x, y, z, out, False, False)
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
 def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx, ry, rz):
     """(stiffness_min, deflection) at the constraint-consistent placement of (z, theta, psi): the configured
@@ -356,14 +364,15 @@ def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, stiffness):
+def _fields(p, x, y, z, out, stiffness, every=True):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
     length leaves the stroke limits or the parametrisation is degenerate (C-model). Fields (kernels.grid contract):
     LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless); 3 clearance (mm) of the link capsules
     (with interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, 4 stiffness_min
     (N/mm) and 5 deflection (mm) of O' under the packed load on the frame at the constraint-consistent placement
     of the pose (ideal joints; _stiffness), computed at every reachable pose whether or not that placement's own
-    legs are within the stroke limits (docs/stiffness.md)."""
+    legs are within the stroke limits (docs/stiffness.md). ``every`` False (a constant, point_reach): slot 0 alone,
+    0 where reachable, -1 elsewhere."""
     g = p[_G]
     h = p[_H]
     c = p[_C]
@@ -389,6 +398,11 @@ def _fields(p, x, y, z, out, stiffness):
     ok3, q3 = _leg_ok(q3s, lo, hi)
     if not (ok1 and ok2 and ok3):
         _grid.write_unreachable(out)
+        return
+    if not every:
+        out[0] = 0.0
+        if p[_FREE_ONLY] > 0.0 and _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0) < 0.0:
+            out[0] = -1.0
         return
     gap = _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0)
     if gap < 0.0 and p[_FREE_ONLY] > 0.0:
@@ -815,6 +829,10 @@ class RpsUpu(Mechanism):
     @property
     def field_kernel(self):
         return point_fields
+
+    @property
+    def reach_kernel(self):
+        return point_reach
 
     def kernel_branch(self, options) -> str:
         return BRANCH
@@ -1396,6 +1414,10 @@ class RpsUpuTool(RpsUpu):
     @property
     def field_kernel(self):
         return tool_point_fields
+
+    @property
+    def reach_kernel(self):
+        return tool_point_fields  # no reach kernel of its own (RpsUpu's is for point_fields)
 
     def kernel_branch(self, options) -> str:
         return "++"

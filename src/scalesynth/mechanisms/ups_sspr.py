@@ -109,13 +109,24 @@ def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
     return ln, ja, jb, jy
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def point_reach(p, alpha, beta, yy, out):
+    """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same limit checks and,
+    with interference_free, the same clearance), -1 elsewhere; no conditioning, stiffness or (without
+    interference_free) clearance. The adaptive evaluator's nodes and bisections (Mechanism.reach_kernel)."""
+    ok, sa, ca, sb, cb, px, pz, _ = _kinematics(p, alpha, beta, yy, out, False)
+    if ok and p[_FREE_ONLY] > 0.0 and _clearance(p, sa, ca, sb, cb, px, yy, pz) < 0.0:
+        out[0] = -1.0
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _kinematics(p, alpha, beta, yy, out):
+def _kinematics(p, alpha, beta, yy, out, conditioning=True):
     """Slots 0-2 at task point (alpha [rad], beta [rad], Y [mm]): LCI if it lies in the workspace box with every
     actuator length within its limits, else -1 (write_unreachable). LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the
     angle columns divided by the characteristic length; sigma_min, sigma_max of J = dx/dq, x = (L alpha, L beta, Y)
     (dimensionless). Returns (ok, sin alpha, cos alpha, sin beta, cos beta, P_x, P_z, longest leg); ok False where
-    slots 0-2 say unreachable or singular (the other slots are then written too)."""
+    slots 0-2 say unreachable or singular (the other slots are then written too). ``conditioning`` (a constant):
+    False stops after the limit checks with slot 0 = 0 where they pass (point_reach)."""
     if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
         _grid.write_unreachable(out)
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -155,6 +166,9 @@ def _kinematics(p, alpha, beta, yy, out):
     if l2 <= 0.0 or l3 <= 0.0:
         _grid.write_singular(out)  # zero-length leg: inverse singularity (stiffness fields 0)
         return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    if not conditioning:
+        out[0] = 0.0  # reachable (point_reach): slots 0-2 not computed
+        return True, sa, ca, sb, cb, px, pz, 0.0
     s = p[_INV_L]
     lci, smin, smax = sv_3x3(0.0, 0.0, K0 * am / l1, j2a * s, j2b * s, j2y, j3a * s, j3b * s, j3y)
     out[0] = lci
@@ -430,6 +444,10 @@ class UpsSspr(Mechanism):
     @property
     def field_kernel(self):
         return point_fields
+
+    @property
+    def reach_kernel(self):
+        return point_reach
 
     # ----- stiffness (scalesynth.stiffness; per voxel: point_fields slots 3, 4, the same frame) ---------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
