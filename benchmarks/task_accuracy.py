@@ -11,7 +11,7 @@ sets of 20 random designs in the bounds (seed 0):
   the ones a ``task_coverage >= 1`` constraint keeps on the front;
 
 the largest error of task coverage and task GCI (absolute) and task FCI (absolute) against the uniform task grid
-3x finer, and the time per design of the task metrics at the config's resolution and at the reference.
+3x finer (on the covering designs also the relative error of the config's other searched task metrics), and the time per design of the task metrics at the config's resolution and at the reference.
 """
 
 from __future__ import annotations
@@ -66,6 +66,13 @@ def bench_config(config: Path) -> dict:
         res_c, _ = _task(config, n, covering)
         ref_c, _ = _task(config, 3 * n, covering)
         row["covering"] = {"designs": len(covering), "errors": _errors(res_c, ref_c, np.ones(len(covering), bool))}
+        # the config's other searched task metrics (e.g. stiffness extremes), relative errors
+        from scalesynth.problem import SynthesisProblem
+
+        searched = [k for k in SynthesisProblem(cfg).objective_keys + SynthesisProblem(cfg).constraint_keys
+                    if k.startswith("task_") and k not in KEYS]
+        row["covering"]["relative_errors"] = {
+            k: float((np.abs(res_c[k] - ref_c[k]) / np.maximum(np.abs(ref_c[k]), 1e-300)).max()) for k in searched}
     else:
         row["covering"] = {"designs": 0, "errors": {}}
     row["ms_per_design"] = 1e3 * s_cfg
@@ -105,8 +112,9 @@ def markdown(entry: dict) -> list[str]:
             e = part["errors"]
             if not e:
                 return "none found"
+            rel = "".join(f"; {k} {v:.1e} (relative)" for k, v in part.get("relative_errors", {}).items())
             return (f"{part['designs']} designs: {e['task_coverage']:.1e}, {e['task_gci']:.1e}, "
-                    f"{e['task_fci']:.1e}")
+                    f"{e['task_fci']:.1e}{rel}")
         cov = row["covering"]["errors"]
         met = "yes" if cov and cov["task_gci"] <= GOAL_GCI else "**NO**"
         out.append(f"| {row['config']} | {row['resolution']} | {cell(row['random'])} | {cell(row['covering'])} | "
