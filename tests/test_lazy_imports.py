@@ -1,7 +1,8 @@
 """A fresh process imports what its command needs, and its first evaluation waits for nothing else (issue 15:
 time to the first evaluation). Checked in subprocesses through ``sys.modules``, never by timing: the mechanism
 registry loads only the mechanism asked for; ``evaluate`` and ``show`` of a config import neither pandas, pymoo
-nor (before drawing) matplotlib; ``optimize`` evaluates its first population before pandas or matplotlib."""
+nor (before drawing) matplotlib; ``optimize`` evaluates its first population before pandas or matplotlib;
+``plot-bands`` evaluates its sections before pandas or matplotlib."""
 
 import json
 import os
@@ -83,15 +84,17 @@ def test_show_of_a_config_imports_no_results_machinery(root, tmp_path):
     assert [m for m in ("pandas", "pymoo") if m in out["modules"]] == []
 
 
-FIRST_POPULATION = """
+FIRST_CALL = """
 import importlib, json, sys
-ev = importlib.import_module("scalesynth.evaluate")  # the module (scalesynth.evaluate is also the API function)
+module = importlib.import_module(sys.argv.pop(1))  # before the modules that import its functions by name
 seen = {}
-population = ev.evaluate_config_population
-def first(*args, **kwargs):
-    seen.setdefault("modules", sorted(sys.modules))
-    return population(*args, **kwargs)
-ev.evaluate_config_population = first  # before scalesynth.problem imports it by name
+def watch(func):
+    def first(*args, **kwargs):
+        seen.setdefault("modules", sorted(sys.modules))
+        return func(*args, **kwargs)
+    return first
+for name in sys.argv.pop(1).split(","):
+    setattr(module, name, watch(getattr(module, name)))
 from scalesynth.cli import main
 try:
     main(sys.argv[1:])
@@ -102,13 +105,28 @@ print(json.dumps({"code": code, "modules": seen.get("modules", [])}), file=sys.s
 
 
 def test_optimize_evaluates_its_first_population_before_pandas_and_matplotlib(root, tmp_path):
-    out = _python(FIRST_POPULATION, "optimize", str(root / "configs" / "fivebar_packing.yaml"), "--out",
-                  str(tmp_path / "run"), "-q", "--set", "grid.resolution=8", "--set",
-                  "algorithm.pop_size=4", "--set", "algorithm.n_gen=1")
+    out = _python(FIRST_CALL, "scalesynth.evaluate", "evaluate_config_population", "optimize",
+                  str(root / "configs" / "fivebar_packing.yaml"), "--out", str(tmp_path / "run"), "-q", "--set",
+                  "grid.resolution=8", "--set", "algorithm.pop_size=4", "--set", "algorithm.n_gen=1")
     assert out["code"] in (0, None)
     assert "pymoo" in out["modules"]  # the hook saw the search's first evaluation
     assert [m for m in ("pandas", "matplotlib") if m in out["modules"]] == []
     assert (tmp_path / "run" / "pareto.csv").exists()
+
+
+@pytest.mark.parametrize("config", ["fivebar_packing.yaml", "ups_sspr.yaml"])  # planar: one map; 3-D, stiffness
+def test_plot_bands_evaluates_its_sections_before_reading_tables_and_drawing(root, tmp_path, config):
+    """plot-bands' first evaluation (a section's field grid, kernels.grid) comes before pandas (the results tables)
+    and matplotlib (the figures); ups-sspr: 3-D sections and stiffness maps."""
+    run = tmp_path / "run"
+    opt = _python(RUN_CLI, "optimize", str(root / "configs" / config), "--out", str(run), "-q", "--no-plots",
+                  "--set", "grid.resolution=8", "--set", "algorithm.pop_size=4", "--set", "algorithm.n_gen=1")
+    assert opt["code"] in (0, None)
+    out = _python(FIRST_CALL, "scalesynth.kernels.grid", "sample_fields,sample_grid", "plot-bands", str(run))
+    assert out["code"] in (0, None)
+    assert "scalesynth.report" in out["modules"]  # the hook saw plot-bands' first evaluation
+    assert [m for m in HEAVY if m != "pymoo" and m in out["modules"]] == []  # pymoo: the run's problem (columns)
+    assert (run / "plots" / "bands_front.png").is_file() and (run / "bands" / "pareto_band0.csv").is_file()
 
 
 def test_cli_runs_openblas_single_threaded_unless_told_otherwise():

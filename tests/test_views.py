@@ -379,6 +379,31 @@ def test_plot_commands_take_out_and_format(small_run, tmp_path):
     assert res.exit_code == 2 and "--format: must be one of png, svg, pdf" in res.stderr
 
 
+def test_plot_bands_evaluates_its_sections_once_from_the_files(small_run, tmp_path, monkeypatch):
+    """plot-bands evaluates its sections from config.yaml and pareto.csv read without pandas (results.read_front,
+    before pandas and matplotlib load): the same front, bit for bit, as results.load reads, so plot_bands draws
+    those sections (band_sections runs once) and writes the same bytes as plot_bands of the loaded run alone."""
+    from scalesynth import report
+    from scalesynth.results import load, read_front
+
+    early, loaded = read_front(small_run), load(small_run).front()
+    assert len(early.F) >= 2
+    np.testing.assert_array_equal(early.X, loaded.X)
+    np.testing.assert_array_equal(early.F, loaded.F)
+    calls = []
+    band_sections = report.band_sections
+    monkeypatch.setattr(report, "band_sections", lambda front: calls.append(front) or band_sections(front))
+    res = runner.invoke(app, ["plot-bands", str(small_run), "--out", str(tmp_path / "cli")])
+    assert res.exit_code == 0, res.output
+    assert len(calls) == 1
+    info = report.plot_bands(load(small_run, require_finished=False), tmp_path / "alone")  # evaluates in plot_bands
+    assert len(calls) == 2
+    names = sorted(str(p.relative_to(tmp_path / "alone")) for p in (tmp_path / "alone").rglob("*") if p.is_file())
+    assert len(names) == len(info["files"]) + len(info["band_files"])
+    for name in names:
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "alone" / name).read_bytes(), name
+
+
 def test_reference_labels_do_not_overlap():
     from matplotlib.text import Text
 

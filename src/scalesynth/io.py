@@ -187,6 +187,28 @@ def read_results_csv(path: Path, required: tuple[str, ...] | list[str] = ()):
     return frame
 
 
+def read_csv_columns(path: Path, columns: tuple[str, ...] | list[str]):
+    """``columns`` of a results CSV as float arrays (dict name -> (n_rows,)), read without pandas (whose import a
+    command can then put after its first evaluation); None if the file is missing, not CSV, lacks a column or
+    holds a value that is not a finite number: the caller then reads it with :func:`read_results_csv`, which says
+    what is wrong."""
+    import csv
+
+    import numpy as np
+
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+        header = rows[0]
+        idx = [header.index(c) for c in columns]
+        values = np.array([[float(r[i]) for i in idx] for r in rows[1:]], dtype=float).reshape(-1, len(idx))
+    except (OSError, UnicodeDecodeError, csv.Error, ValueError, IndexError):
+        return None
+    if not np.isfinite(values).all():
+        return None
+    return {c: values[:, k] for k, c in enumerate(columns)}
+
+
 def read_manifest(path: Path) -> dict[str, Any]:
     """manifest.json as a dict with its resolved config; ConfigError naming the file if damaged."""
     from scalesynth.errors import ConfigError

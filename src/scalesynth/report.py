@@ -7,6 +7,7 @@ same figures; the ``plot-*`` commands pass ``results.load(run_dir)``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,7 @@ from scalesynth.config import RunConfig
 from scalesynth.errors import ConfigError
 from scalesynth.evaluate import evaluate_config
 from scalesynth.problem import SynthesisProblem
-from scalesynth.results import PLOTS, REPORT, RunResult, infeasibility_lines
+from scalesynth.results import PLOTS, REPORT, Front, RunResult, infeasibility_lines, load, read_front
 from scalesynth.selection import choose, extremes
 from scalesynth.workspace_view import (  # SECTION_RESOLUTION, section_panels: also report's (memory, tests)
     SECTION_RESOLUTION,  # noqa: F401
@@ -108,26 +109,69 @@ def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
     return {"references": refs, "files": files}
 
 
-def featured_designs(result: RunResult) -> list[tuple[str, int]]:
-    """The knee and the best design of each objective on the front, as (label, row index), without repeats."""
-    problem = result.problem
-    F = result.objective_matrix()
+def featured_designs(F: np.ndarray, objective_keys: list[str]) -> list[tuple[str, int]]:
+    """The knee and the best design of each objective of a front ``F`` (n_front, n_obj; minimisation form), as
+    (label, row index), without repeats."""
     out = [("knee", choose(F, "knee"))]
     for obj_idx, row in enumerate(extremes(F)):
-        label = f"best {problem.objective_keys[obj_idx] if obj_idx < len(problem.objective_keys) else obj_idx}"
+        label = f"best {objective_keys[obj_idx] if obj_idx < len(objective_keys) else obj_idx}"
         if row not in [r for _, r in out]:
             out.append((label, row))
     return out
 
 
-def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
-    """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
-    per-band Pareto sets bands/pareto_band<k>.csv with their plots."""
-    from scalesynth import plotting
-    from scalesynth.band_fronts import write_band_fronts
+@dataclass
+class BandSections:
+    """plot-bands' evaluations, made before anything is drawn: the featured designs of a front (label, row index,
+    full design) and per design its section panels, field -> panels (``"lci"`` and each stiffness map field).
+    ``X``, ``F``: the front they were computed from (design variables, objectives in minimisation form)."""
 
+    featured: list[tuple[str, int, dict[str, float]]]
+    panels: list[dict[str, list[dict[str, Any]]]]
+    X: np.ndarray
+    F: np.ndarray
+
+    def of(self, X: np.ndarray, F: np.ndarray) -> bool:
+        """True if computed from this front (the same numbers, bit for bit)."""
+        return np.array_equal(self.X, X) and np.array_equal(self.F, F)
+
+
+def band_sections(front: Front) -> BandSections:
+    """The section panels of the featured designs of a front (``results.Front``): every workspace evaluation of
+    plot-bands (the per-band Pareto sets and the band plots only read the tables)."""
+    cfg, problem = front.cfg, front.problem
+    featured, panels = [], []
+    for name, i in featured_designs(front.F, problem.objective_keys) if len(front.F) else []:
+        design = front.design(i)
+        featured.append((name, i, design))
+        panels.append({field: section_panels(cfg, design, field) for field in ("lci", *stiffness_map_fields(cfg))})
+    return BandSections(featured, panels, front.X, front.F)
+
+
+def plot_bands_run(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
+    """:func:`plot_bands` of a results directory, its sections evaluated first, from config.yaml and pareto.csv
+    read without pandas (issue 15: a fresh process reaches its first evaluation before the pandas and matplotlib
+    imports and the drawing). Where that read fails, or --format is invalid, plot_bands after results.load
+    reports what is wrong, as before."""
+    front = read_front(run_dir) if fmt in rio.FIGURE_FORMATS else None
+    sections = None if front is None else band_sections(front)
+    return plot_bands(load(run_dir, require_finished=False), out, fmt, sections)
+
+
+def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png",
+               sections: BandSections | None = None) -> dict[str, Any]:
+    """plots/bands_front, plots/band_shares and plots/sections_<design> (paper Figs. 7-10, Table 5), and the
+    per-band Pareto sets bands/pareto_band<k>.csv with their plots. ``sections``: the front's band_sections,
+    computed earlier (used only if computed from this result's front; otherwise computed here)."""
     plots = _plots_dir(result, out, fmt)
     cfg, pareto, problem = result.cfg, result.pareto, result.problem
+    if len(pareto):
+        front = result.front()
+        if sections is None or not sections.of(front.X, front.F):
+            sections = band_sections(front)
+    from scalesynth import plotting  # matplotlib: imported where the drawing starts, after the evaluations
+    from scalesynth.band_fronts import write_band_fronts
+
     label = lab.labeller(cfg)
     edges = cfg.dexterity.band_edges
     labels = band_labels(edges)
@@ -145,35 +189,35 @@ def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
     rio.save_figure(fig, plots / f"bands_front.{fmt}")
     plotting.close(fig)
     files.append(_rel(result.out_dir, plots / f"bands_front.{fmt}"))
-    featured = featured_designs(result)
+    featured = [(name, i) for name, i, _ in sections.featured]
     bar = np.array([[pareto[f"band{b}_share"].iloc[i] for b in range(nb)] for _, i in featured])
     fig = plotting.band_shares_figure([name for name, _ in featured], bar, labels)
     rio.save_figure(fig, plots / f"band_shares.{fmt}")
     plotting.close(fig)
     files.append(_rel(result.out_dir, plots / f"band_shares.{fmt}"))
-    for name, i in featured:
-        design = result.design_of(pareto.iloc[i])
-        panels = section_panels(cfg, design)
+    for (name, _, design), panels in zip(sections.featured, sections.panels, strict=True):
         title = f"{name}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
-        fig = plotting.sections_figure(panels, edges, title)
+        fig = plotting.sections_figure(panels["lci"], edges, title)
         fname = "sections_" + name.replace(" ", "_") + f".{fmt}"
         rio.save_figure(fig, plots / fname)
         plotting.close(fig)
         files.append(_rel(result.out_dir, plots / fname))
         for field in stiffness_map_fields(cfg):
-            files.append(_rel(result.out_dir, field_sections(cfg, design, field, title, plots, name, fmt)))
+            files.append(_rel(result.out_dir, field_sections(cfg, design, field, title, plots, name, fmt,
+                                                             panels[field])))
     return {"files": files, "featured": [(name, int(i)) for name, i in featured], "band_files": band_rel,
             "band_sizes": band_info["sizes"]}
 
 
 def field_sections(cfg: RunConfig, design: dict[str, float], field: str, title: str, plots: Path, name: str,
-                   fmt: str) -> Path:
+                   fmt: str, panels: list[dict[str, Any]] | None = None) -> Path:
     """plots/sections_<field>_<design>: the report's sections coloured by a per-voxel field (a stiffness map:
     deflection or stiffness_min), the colour bar labelled with its unit and the range of the shown cells in the
-    title. Returns the file written."""
+    title. ``panels``: section_panels(cfg, design, field), if already computed. Returns the file written."""
     from scalesynth import plotting
 
-    panels = section_panels(cfg, design, field)
+    if panels is None:
+        panels = section_panels(cfg, design, field)
     vmin, vmax = map_range(panels)
     label = lab.field_label(cfg.mech, field, cfg.units.length)
     v = np.concatenate([np.asarray(p["values"], dtype=float).ravel() for p in panels])

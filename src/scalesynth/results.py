@@ -54,6 +54,11 @@ class RunResult:
         frame = self.pareto if frame is None else frame
         return frame[self.problem.objective_keys].to_numpy(dtype=float) * self.problem.signs
 
+    def front(self) -> Front:
+        """The front's design variables and objectives (as read_front gives them without pandas)."""
+        X = self.pareto[self.problem.var_names].to_numpy(dtype=float)
+        return Front(self.cfg, self.problem, X, self.objective_matrix())
+
     def design_of(self, row: pd.Series) -> dict[str, float]:
         """The full design of a results row (design variables over the config's fixed parameters)."""
         d = dict(self.problem.base_design)
@@ -127,6 +132,42 @@ def load(out_dir: Path, *, require_finished: bool = True) -> RunResult:
                   if (out / POPULATION).is_file() else None)
     return RunResult(out_dir=out, cfg=cfg, pareto=pareto, history=history, manifest=manifest or {},
                      population=population, problem=problem)
+
+
+@dataclass
+class Front:
+    """A run's front read without pandas: its config and problem, pareto.csv's design variables ``X``
+    (n_front, n_var) and objectives ``F`` (n_front, n_obj) in minimisation form, as RunResult.objective_matrix."""
+
+    cfg: RunConfig
+    problem: SynthesisProblem
+    X: np.ndarray
+    F: np.ndarray
+
+    def design(self, i: int) -> dict[str, float]:
+        """The full design of front row i, as RunResult.design_of."""
+        return self.problem.designs(self.X[i])[0]
+
+
+def read_front(out_dir: Path) -> Front | None:
+    """config.yaml and pareto.csv's design variables and objectives, read without pandas (a command can evaluate
+    before importing it); None where either is missing or damaged: :func:`load` then says what is wrong."""
+    from scalesynth.errors import ScalesynthError
+
+    out = Path(out_dir)
+    if not (out / CONFIG).is_file():
+        return None
+    try:
+        cfg = load_config(out / CONFIG)
+        problem = SynthesisProblem(cfg)
+    except ScalesynthError:
+        return None
+    cols = rio.read_csv_columns(out / PARETO, list(dict.fromkeys([*problem.var_names, *problem.objective_keys])))
+    if cols is None:
+        return None
+    X = np.column_stack([cols[k] for k in problem.var_names])
+    F = np.column_stack([cols[k] for k in problem.objective_keys]) * problem.signs
+    return Front(cfg, problem, X, F)
 
 
 def infeasibility_lines(manifest: dict[str, Any]) -> list[str]:

@@ -73,10 +73,9 @@ def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directo
                    out: PlotOut = None, fmt: PlotFormat = "png") -> None:
     """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs;
     per-band Pareto sets (bands/pareto_band<k>.csv and their plots)."""
-    from scalesynth.report import plot_bands
-    from scalesynth.results import load
+    from scalesynth.report import plot_bands_run
 
-    info = plot_bands(load(run_dir, require_finished=False), out, fmt)
+    info = plot_bands_run(run_dir, out, fmt)
     _echo_files(run_dir, info["files"] + info["band_files"])
 
 
