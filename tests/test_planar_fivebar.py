@@ -192,13 +192,14 @@ def test_packing_config_task_metrics():
     assert opts["mode"] == "+-"
     np.testing.assert_allclose(opts["alpha1_limits"], LIMITS["alpha1_limits"], rtol=1e-15)
     np.testing.assert_allclose(opts["alpha2_limits"], LIMITS["alpha2_limits"], rtol=1e-15)
-    cfg.grid.resolution = 64  # the check below does not need the config's fine grid
+    n = cfg.task.resolution  # the task box's own uniform grid (the workspace is in the tolerance form)
+    assert n == 32
     rep = evaluate_config(cfg)
     assert rep.measure_key == "area_mm2"
     assert rep.metrics["task_coverage"] == 1.0
-    step = np.array([1000.0, 250.0]) / 64
-    xs = -500 + (np.arange(64) + 0.5) * step[0]
-    ys = -850 + (np.arange(64) + 0.5) * step[1]
+    step = np.array([1000.0, 250.0]) / n
+    xs = -500 + (np.arange(n) + 0.5) * step[0]
+    ys = -850 + (np.arange(n) + 0.5) * step[1]
     twin = fivebar_lci(DESIGN, opts, *np.meshgrid(xs, ys, indexing="ij"))
     assert rep.metrics["task_gci"] == pytest.approx(twin.mean(), rel=1e-9)
     assert rep.metrics["task_fci"] == pytest.approx(twin.std(), rel=1e-7)
