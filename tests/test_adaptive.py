@@ -92,34 +92,81 @@ def test_column_kernel_equals_numpy_twin(name):
 def test_reach_kernel_is_the_sign_of_the_field_kernels_lci(name):
     """The nodes and bisections use Mechanism.reach_kernel: reachable (slot 0 >= 0) at exactly the points where the
     field kernel's LCI is >= 0, on a 24^3 grid over 1.1x the bounding box (in and out of the box) of the config's
-    design and 5 random designs in its bounds, with the config's options and, where the mechanism has the option,
-    interference_free with 15 mm links (then the clearance decides too: it removes points of the workspaces)."""
+    design and 5 random designs in its bounds (planar: a 96^2 grid), with the config's options and, where the
+    mechanism has the option, interference_free (_interference_free; then the clearance decides too: it removes
+    points of the workspaces)."""
     mech = get(name)
     cfg = load_config(config_for(name))
-    rng = np.random.default_rng(3)
-    designs = [cfg.resolved_design()] + [mech.resolve_design({**cfg.resolved_design(), **{
-        k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()}}) for _ in range(5)]
+    designs = _random_designs(mech, cfg, 5, 3)
     variants = [cfg.resolved_options()]
     if "interference_free" in mech.default_options():
-        variants.append({**cfg.resolved_options(), "interference_free": True, "link_radius": 15.0})
+        variants.append(_interference_free(mech, cfg))
     reach_counts = []
     for options in variants:
         counts = 0
         for d in designs:
             lo, hi = _box(mech, d, options)
             mid, half = 0.5 * (lo + hi), 0.55 * (hi - lo)
-            axes = [np.linspace(mid[a] - half[a], mid[a] + half[a], 24) if a < len(mech.task_axes)
+            npt = 24 if len(mech.task_axes) == 3 else 96
+            axes = [np.linspace(mid[a] - half[a], mid[a] + half[a], npt) if a < len(mech.task_axes)
                     else np.array([lo[a]]) for a in range(3)]
             pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
             packed = mech.pack(d, options)[None, :]
             lci = kgrid.population_points_fields(mech.field_kernel, mech.n_fields, packed, pts)[0, :, 0]
             reach = kgrid.population_points_fields(mech.reach_kernel, mech.n_fields, packed, pts)[0, :, 0]
             np.testing.assert_array_equal(reach >= 0.0, lci >= 0.0)
-            assert 0 < (lci >= 0).sum() < len(pts), name  # both kinds of point were compared
+            assert (lci >= 0).sum() < len(pts), name
             counts += int((lci >= 0).sum())
+        assert counts > 0, name  # both kinds of point were compared (a random design's workspace may be empty)
         reach_counts.append(counts)
     if len(reach_counts) == 2:
         assert reach_counts[1] < reach_counts[0], name  # the clearance made points unreachable: it was compared
+
+
+def _random_designs(mech, cfg, count, seed):
+    """The config's design and ``count`` random ones in its bounds (uniform, numpy default_rng(seed))."""
+    rng = np.random.default_rng(seed)
+    return [cfg.resolved_design()] + [mech.resolve_design({**cfg.resolved_design(), **{
+        k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()}}) for _ in range(count)]
+
+
+# link radius with which interference_free removes part of the test designs' workspaces (tried on seed 3's designs
+# below: 15 mm leaves pprs-rprs's and the five-bar's untouched, 60 mm would empty pprs-rprs's, 80 mm a five-bar's)
+INTERFERENCE_RADIUS = {"2pauu-ppap": 0.015, "pprs-rprs": 30.0, "planar-fivebar": 60.0}  # default 15 (mm)
+
+
+def _interference_free(mech, cfg):
+    """The config's options with interference_free and INTERFERENCE_RADIUS links (the mechanism's length unit)."""
+    return {**cfg.resolved_options(), "interference_free": True,
+            "link_radius": INTERFERENCE_RADIUS.get(mech.name, 15.0)}
+
+
+@pytest.mark.parametrize("name", [n for n in available() if get(n).reach_kernel is not get(n).field_kernel])
+def test_reach_kernel_leaves_the_adaptive_rows_bit_identical(name, monkeypatch):
+    """The reach kernel only replaces the nodes' and bisections' reachability decisions, so
+    adaptive_population_stats with it gives byte-identical rows, error estimates, levels and evaluation counts to
+    the same evaluator with the field kernel at those points (the default Mechanism.reach_kernel), on the config's
+    design and 3 random designs in its bounds, with the config's options and, where the mechanism has the option,
+    interference_free (_interference_free; the mechanism's default plan: z-levels and box faces where it has them)."""
+    mech = get(name)
+    cfg = load_config(config_for(name))
+    designs = _random_designs(mech, cfg, 3, 7)
+    variants = [cfg.resolved_options()]
+    if "interference_free" in mech.default_options():
+        variants.append(_interference_free(mech, cfg))
+    runs = []
+    for reach in (mech.reach_kernel, mech.field_kernel):
+        monkeypatch.setattr(type(mech), "reach_kernel", property(lambda self, k=reach: k))
+        assert mech.reach_kernel is reach
+        out = []
+        for options in variants:
+            packed = np.stack([mech.pack(d, options) for d in designs])
+            out.append(adaptive_population_stats(mech, designs, options, packed, Tolerance(), EDGES))
+        runs.append(out)
+    for new, old in zip(*runs, strict=True):
+        assert new.stats[:, 0].sum() > 0, name  # not only empty workspaces were compared
+        for attr in ("stats", "error_volume", "error_gci", "levels", "evaluations"):
+            assert getattr(new, attr).tobytes() == getattr(old, attr).tobytes(), (name, attr)
 
 
 @pytest.mark.parametrize("group", [0, 1, 2])

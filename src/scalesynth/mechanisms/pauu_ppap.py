@@ -228,11 +228,21 @@ def kinematic_fields(p, x, y, z, out):
     _fields(p, x, y, z, out, False, False)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def point_reach(p, x, y, z, out):
+    """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same working mode,
+    stroke and theta checks and, with interference_free, the same clearance), -1 elsewhere; no conditioning,
+    stiffness or (without interference_free) clearance. The adaptive evaluator's nodes and bisections
+    (Mechanism.reach_kernel)."""
+    _fields(p, x, y, z, out, False, False, False)
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, with_clearance, with_stiffness):
+def _fields(p, x, y, z, out, with_clearance, with_stiffness, every=True):
     """point_fields (both True) or kinematic_fields (both False; constants, so each copy keeps its branches). The
     stiffness fields are computed only when the packed options ask for them (options.stiffness_metrics), so that
-    the generic kernel run for the clearance metrics alone does not pay for them (they stay 0 otherwise)."""
+    the generic kernel run for the clearance metrics alone does not pay for them (they stay 0 otherwise).
+    ``every`` False (a constant, point_reach): slot 0 alone, 0 where point_fields' is >= 0, -1 elsewhere."""
     if z < p[_ZMIN] or y < p[_DLO] or y > p[_DHI]:
         _grid.write_unreachable(out)
         return
@@ -258,6 +268,11 @@ def _fields(p, x, y, z, out, with_clearance, with_stiffness):
         if not _angle_in(c1, s1, p[_T1LO], p[_T1HI]) or not _angle_in(c2, s2, p[_T2LO], p[_T2HI]):
             _grid.write_unreachable(out)
             return
+    if not every:
+        out[0] = 0.0
+        if p[_FREE_ONLY] > 0.0 and _clearance(p, x, y, z, c1, s1, c2, s2) < 0.0:
+            out[0] = -1.0
+        return
     gap = _clearance(p, x, y, z, c1, s1, c2, s2) if with_clearance else 0.0
     if gap < 0.0 and p[_FREE_ONLY] > 0.0:
         _grid.write_unreachable(out)
@@ -665,6 +680,10 @@ class PauuPpap(Mechanism):
     @property
     def field_kernel(self):
         return point_fields
+
+    @property
+    def reach_kernel(self):
+        return point_reach
 
     def kernel_branch(self, options) -> str:
         return options["mode"]

@@ -117,9 +117,11 @@ def _arc_ok(p, k, c, s):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _kinematics(p, x, y, out):
+def _kinematics(p, x, y, out, conditioning=True):
     """Slots 0-2 at P = (x, y) in the packed working mode: LCI (sigma_min/sigma_max of J), sigma_min and sigma_max
-    of J = dx/dq (mm/rad); unreachable: write_unreachable. Returns (ok, cos, sin of alpha1, cos, sin of alpha2)."""
+    of J = dx/dq (mm/rad); unreachable: write_unreachable. Returns (ok, cos, sin of alpha1, cos, sin of alpha2).
+    ``conditioning`` (a constant): False stops after the reach and arm-limit checks with slot 0 = 0 where they
+    pass (point_reach)."""
     r = p[_R]
     l1 = p[_L1]
     l2 = p[_L2]
@@ -130,6 +132,9 @@ def _kinematics(p, x, y, out):
     if not ok1 or not ok2 or not _arc_ok(p, _LIM1, c1, s1) or not _arc_ok(p, _LIM2, c2, s2):
         _grid.write_unreachable(out)
         return False, 0.0, 0.0, 0.0, 0.0
+    if not conditioning:
+        out[0] = 0.0  # reachable (point_reach): slots 1-2 not computed
+        return True, c1, s1, c2, s2
     # forearm vectors w_i = P - Q_i = l2 (cos beta_i, sin beta_i)
     w1x = u1 - l1 * c1
     w1y = y - l1 * s1
@@ -229,6 +234,16 @@ def point_fields(p, x, y, z, out):
     _fields(p, x, y, out, True)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def point_reach(p, x, y, z, out):
+    """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same working mode and
+    arm limits and, with interference_free, the same clearance), -1 elsewhere; no conditioning, stiffness or
+    (without interference_free) clearance. The adaptive evaluator's nodes and bisections (Mechanism.reach_kernel)."""
+    ok, c1, s1, c2, s2 = _kinematics(p, x, y, out, False)
+    if ok and p[_FREE_ONLY] > 0.0 and _clearance(p, x, y, c1, s1, c2, s2) < 0.0:
+        out[0] = -1.0
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
 def _fields(p, x, y, out, stiffness):
     """point_fields, with the stiffness slots only when ``stiffness`` (a constant: each caller's copy keeps its
@@ -315,6 +330,10 @@ class PlanarFivebar(Mechanism):
     @property
     def field_kernel(self):
         return point_fields
+
+    @property
+    def reach_kernel(self):
+        return point_reach
 
     def kernel_branch(self, options) -> str:
         return options["mode"]

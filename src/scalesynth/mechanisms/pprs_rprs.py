@@ -264,14 +264,24 @@ def kinematic_fields(p, x, y, z, out):
     _fields(p, x, y, z, out, False)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def point_reach(p, x, y, z, out):
+    """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same branch, rail,
+    beta and stroke checks and, with interference_free, the same clearance), -1 elsewhere; no conditioning,
+    stiffness or (without interference_free) clearance. The adaptive evaluator's nodes and bisections
+    (Mechanism.reach_kernel)."""
+    _fields(p, x, y, z, out, False, False)
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, stiffness):
+def _fields(p, x, y, z, out, stiffness, every=True):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
     IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
     Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq, x = (O1, angle_length x angular
     velocity), the beta input times beta_length (dimensionless); clearance (mm) of the link capsules (with
     interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, stiffness_min (N/mm) and
-    deflection (mm) at O1 under the packed load (ideal joints, docs/stiffness.md; _stiffness)."""
+    deflection (mm) at O1 under the packed load (ideal joints, docs/stiffness.md; _stiffness). ``every`` False (a
+    constant, point_reach): slot 0 alone, 0 where reachable, -1 elsewhere."""
     c1x = x + p[_R1]
     c1y = y + p[_R1 + 1]
     c1z = z + p[_R1 + 2]
@@ -348,6 +358,9 @@ def _fields(p, x, y, z, out, stiffness):
     if s3 < slo or s3 > shi:
         _grid.write_unreachable(out)
         return
+    if not every and not p[_FREE_ONLY] > 0.0:
+        out[0] = 0.0  # reachable (point_reach); the clearance decides only with interference_free
+        return
     # clearance (field 3) of the capsules of link_geometry: B_i = (u_i . C_i) u_i carries the slider to
     # D_i = B_i + s_i z; chain 3's prismatic runs from B3 = R u3 along d3 = (-rho3 u3 + h3 z) / mu3
     seg = np.empty((12, 6))
@@ -379,6 +392,9 @@ def _fields(p, x, y, z, out, stiffness):
         gap = min(gap, d - p[_RAD + _SEGMENT_BODY[i]] - p[_RAD + _SEGMENT_BODY[j]])
     if gap < 0.0 and p[_FREE_ONLY] > 0.0:
         _grid.write_unreachable(out)
+        return
+    if not every:
+        out[0] = 0.0
         return
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
         _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
@@ -728,6 +744,10 @@ class PprsRprs(Mechanism):
     @property
     def field_kernel(self):
         return point_fields
+
+    @property
+    def reach_kernel(self):
+        return point_reach
 
     def kernel_branch(self, options) -> str:
         return options["sigma"]

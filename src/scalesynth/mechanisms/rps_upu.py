@@ -1284,8 +1284,17 @@ def tool_kinematic_fields(p, x, y, z, out):
     _tool_fields(p, x, y, z, out, False)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def tool_point_reach(p, x, y, z, out):
+    """Slot 0 of tool_point_fields up to its value: >= 0 exactly where tool_point_fields' LCI is (the same branch,
+    pose ranges and leg checks and, with interference_free, the same clearance), -1 elsewhere; no conditioning,
+    stiffness (its per-point Newton solve) or (without interference_free) clearance. The adaptive evaluator's nodes
+    and bisections (Mechanism.reach_kernel)."""
+    _tool_fields(p, x, y, z, out, False, False)
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _tool_fields(p, x, y, z, out, stiffness):
+def _tool_fields(p, x, y, z, out, stiffness, every=True):
     """LCI of dq/dT (dimensionless) at tool point T = (x, y, z) mm of the P-model, principal branch
     (cos theta > 0, cos psi > 0), or -1 when T is out of reach of that branch, its pose leaves the z/theta/psi
     ranges or a leg leaves the stroke limits.
@@ -1296,7 +1305,8 @@ def _tool_fields(p, x, y, z, out, stiffness):
     link capsules and the tool O' -> T (with interference_free, overlapping capsules make the pose unreachable);
     with ``stiffness``, 4 stiffness_min (N/mm) and 5 deflection (mm) of T under the packed load, on the frame at
     the C-model pose that puts the tool at T (_tool_stiffness), whether or not that pose is within the pose ranges
-    and stroke limits (docs/stiffness.md).
+    and stroke limits (docs/stiffness.md). ``every`` False (a constant, tool_point_reach): slot 0 alone, 0 where
+    reachable, -1 elsewhere.
     """
     d = p[_D]
     sp = y / d
@@ -1328,6 +1338,12 @@ def _tool_fields(p, x, y, z, out, stiffness):
     ok3, q3 = _leg_ok(q3s, lo, hi)
     if not (ok1 and ok2 and ok3):
         _grid.write_unreachable(out)
+        return
+    if not every:
+        out[0] = 0.0
+        if p[_FREE_ONLY] > 0.0 and _clearance(p, 0.0, z0, st, ct, sp, cp, 0.0, 1.0, _PAIRS_TOOL, x, y, z,
+                                              p[_RAD_TOOL]) < 0.0:
+            out[0] = -1.0
         return
     gap = _clearance(p, 0.0, z0, st, ct, sp, cp, 0.0, 1.0, _PAIRS_TOOL, x, y, z, p[_RAD_TOOL])
     if gap < 0.0 and p[_FREE_ONLY] > 0.0:
@@ -1417,7 +1433,7 @@ class RpsUpuTool(RpsUpu):
 
     @property
     def reach_kernel(self):
-        return tool_point_fields  # no reach kernel of its own (RpsUpu's is for point_fields)
+        return tool_point_reach
 
     def kernel_branch(self, options) -> str:
         return "++"
