@@ -98,11 +98,8 @@ def test_reach_kernel_is_the_sign_of_the_field_kernels_lci(name):
     mech = get(name)
     cfg = load_config(config_for(name))
     designs = _random_designs(mech, cfg, 5, 3)
-    variants = [cfg.resolved_options()]
-    if "interference_free" in mech.default_options():
-        variants.append(_interference_free(mech, cfg))
     reach_counts = []
-    for options in variants:
+    for options in _option_variants(mech, cfg):
         counts = 0
         for d in designs:
             lo, hi = _box(mech, d, options)
@@ -135,6 +132,14 @@ def _random_designs(mech, cfg, count, seed):
 INTERFERENCE_RADIUS = {"2pauu-ppap": 0.015, "pprs-rprs": 30.0, "planar-fivebar": 60.0}  # default 15 (mm)
 
 
+def _option_variants(mech, cfg):
+    """The config's options, and with interference_free where the mechanism has that option."""
+    variants = [cfg.resolved_options()]
+    if "interference_free" in mech.default_options():
+        variants.append(_interference_free(mech, cfg))
+    return variants
+
+
 def _interference_free(mech, cfg):
     """The config's options with interference_free and INTERFERENCE_RADIUS links (the mechanism's length unit)."""
     return {**cfg.resolved_options(), "interference_free": True,
@@ -151,9 +156,7 @@ def test_reach_kernel_leaves_the_adaptive_rows_bit_identical(name, monkeypatch):
     mech = get(name)
     cfg = load_config(config_for(name))
     designs = _random_designs(mech, cfg, 3, 7)
-    variants = [cfg.resolved_options()]
-    if "interference_free" in mech.default_options():
-        variants.append(_interference_free(mech, cfg))
+    variants = _option_variants(mech, cfg)
     runs = []
     for reach in (mech.reach_kernel, mech.field_kernel):
         monkeypatch.setattr(type(mech), "reach_kernel", property(lambda self, k=reach: k))
