@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_serializer, model_validator
 
 from scalesynth.cycle import config as cycle_config
 from scalesynth.errors import ConfigError, ScalesynthError
@@ -57,6 +57,15 @@ class GridConfig(_Strict):
     def adaptive(self) -> bool:
         """Whether the adaptive evaluator runs: a tolerance is given and no resolution is."""
         return self.tolerance is not None and "resolution" not in self.model_fields_set
+
+    @model_serializer(mode="wrap")
+    def _dump(self, handler):
+        # a tolerance-form grid is dumped without its default resolution: every dump that is loaded again (the
+        # run's config.yaml and manifest, batch tasks, `select`, API overrides) must stay adaptive
+        data = handler(self)
+        if self.adaptive:
+            data.pop("resolution", None)
+        return data
 
 
 def _magnitude(key: str, *values: float) -> None:
