@@ -83,11 +83,15 @@ class SynthesisProblem(Problem):
         return np.column_stack([np.asarray(values[k], dtype=float) if k in values else np.full(n, np.nan)
                                 for k in self.metric_columns])
 
+    def _family_of(self) -> dict[str, str]:
+        """Catalogue family of every metric column."""
+        n_bands = len(self.cfg.dexterity.band_edges) - 1
+        return {c: m.family for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
+                for c in m.columns(n_bands)}
+
     def unsearched_columns(self) -> list[str]:
         """The metric columns of the families the search does not evaluate."""
-        n_bands = len(self.cfg.dexterity.band_edges) - 1
-        family_of = {c: m.family for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
-                     for c in m.columns(n_bands)}
+        family_of = self._family_of()
         return [k for k in self.metric_columns if family_of[k] not in self.searched_families]
 
     def complete_metrics(self, X: np.ndarray, M: np.ndarray) -> np.ndarray:
@@ -96,10 +100,8 @@ class SynthesisProblem(Problem):
         missing = self.unsearched_columns()
         if not missing or not len(M):
             return M
-        n_bands = len(self.cfg.dexterity.band_edges) - 1
-        families = frozenset(m.family for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
-                             if set(m.columns(n_bands)) & set(missing))
-        values = evaluate_config_population(self.cfg, self.designs(X), families)
+        family_of = self._family_of()
+        values = evaluate_config_population(self.cfg, self.designs(X), frozenset(family_of[k] for k in missing))
         out = np.array(M, dtype=float, copy=True)
         for k in missing:
             out[:, self.metric_columns.index(k)] = np.asarray(values[k], dtype=float)
