@@ -5,10 +5,11 @@ short run at population 200 projected to 40 000 designs (200 x 200), and the pea
 
 Per config:
 
-* evaluator: ``evaluate_config_population`` for the searched families (exactly what the NSGA-II loop calls per
-  generation: the workspace grid or, with ``grid.tolerance``, the adaptive evaluator, when a workspace metric is
-  searched; task box, path, design and cycle metrics when one of theirs is) on
-  ``N_DESIGNS`` random designs within the bounds in one call, in this process after a warm-up; seconds per design.
+* evaluator: ``evaluate_config_population`` for the searched families and fields (exactly what the NSGA-II loop
+  calls per generation, SynthesisProblem.metrics: the workspace grid or, with ``grid.tolerance``, the adaptive
+  evaluator, when a workspace metric is searched, with the mechanism's LCI kernel when those metrics are the LCI's
+  alone; task box, path, design and cycle metrics when one of theirs is) on ``N_DESIGNS`` random designs within the
+  bounds in one call, in this process after a warm-up; seconds per design.
 * NSGA-II: ``scalesynth optimize`` in a fresh process (tests-free snippet below) with ``algorithm.pop_size=200``
   and ``GENERATIONS`` generations, plots and report included (what a user runs); per generation it records the
   loop's wall and CPU seconds and the process's current and peak RSS, so the table shows whether memory grows
@@ -89,14 +90,15 @@ def time_evaluator(cfg) -> dict:
     from scalesynth.evaluate import evaluate_config_population
     from scalesynth.problem import SynthesisProblem
 
-    families = SynthesisProblem(cfg).searched_families
+    problem = SynthesisProblem(cfg)
+    families, fields = problem.searched_families, problem.searched_fields
     designs = random_designs(cfg, N_DESIGNS)
-    evaluate_config_population(cfg, designs[:2], families)  # compile or load the kernels
+    evaluate_config_population(cfg, designs[:2], families, fields)  # compile or load the kernels
     best = float("inf")
     cpu = float("inf")
     for _ in range(2):
         t0, c0 = time.perf_counter(), time.process_time()
-        evaluate_config_population(cfg, designs, families)
+        evaluate_config_population(cfg, designs, families, fields)
         best = min(best, time.perf_counter() - t0)
         cpu = min(cpu, time.process_time() - c0)
     return {"designs": N_DESIGNS, "s_per_design": best / N_DESIGNS, "cpu_s_per_design": cpu / N_DESIGNS}

@@ -183,10 +183,13 @@ def adaptive_population_stats(
     region: Mapping[str, Sequence[float]] | None = None,
     boxes: Grid | None = None,
     plan: ColumnPlan | None = None,
+    lci_only: bool = False,
 ) -> AdaptiveResult:
     """Statistics of every design by the adaptive column evaluator (kernels.adaptive), refined per design until
     its error estimate (change from the previous level) meets ``tolerance`` or the plan's last level is reached.
-    ``boxes``: one fixed box for every design (the task box) instead of each design's bounding box."""
+    ``boxes``: one fixed box for every design (the task box) instead of each design's bounding box. ``lci_only``:
+    the Gauss points run ``Mechanism.lci_kernel`` (only the count, LCI statistics, bands and estimates are
+    meaningful; they equal the full kernel's bit for bit: the refinement reads slot 0 alone)."""
     from scalesynth.kernels.adaptive import column_stats
 
     n = len(designs)
@@ -198,7 +201,8 @@ def adaptive_population_stats(
         lo = np.tile(boxes.lo, (n, 1))
         hi = np.tile(boxes.lo + boxes.step * boxes.shape, (n, 1))
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
-    stats, err_v, err_g, levels, evals = column_stats(mech.field_kernel, mech.n_fields, packed, lo, hi, ndim,
+    kernel = mech.lci_kernel if lci_only else mech.field_kernel
+    stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, lo, hi, ndim,
                                                       plan.columns, plan.cells, plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
                                                       plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel)
@@ -260,10 +264,11 @@ def _metrics_of(
     task: Any,
     cycle: Any = None,
     families: Collection[str] | None = None,
+    fields: Collection[str] | None = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of the designs (of ``families`` only, when given): workspace statistics given (None
-    when the workspace family is not asked for), task statistics (on the uniform task grid) and the computed
-    families (design, path, cycle) evaluated here."""
+    when the workspace family is not asked for; of ``fields`` only, when given), task statistics (on the uniform
+    task grid) and the computed families (design, path, cycle) evaluated here."""
     has_path = task is not None and task.path is not None
     # the adaptive evaluator's error estimates (statistic "estimate") come with its statistics, from the caller
     entries = [m for m in _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle)
@@ -274,7 +279,8 @@ def _metrics_of(
     out = {}
     if workspace_stats is not None:
         out.update(stats_to_metrics(mech, workspace_stats, cell, 0.0,
-                                    [m for m in entries if m.family == "workspace"], n_bands))
+                                    [m for m in entries if m.family == "workspace"
+                                     and (fields is None or _metrics.field_of(m) in fields)], n_bands))
     n = packed.shape[0]
     if task is not None and any(m.family == "task" for m in entries):
         tg = task_grid(mech, task, resolution)
@@ -445,6 +451,7 @@ def evaluate_population(
     cycle: Any = None,
     tolerance: Tolerance | None = None,
     families: Collection[str] | None = None,
+    fields: Collection[str] | None = None,
 ) -> dict[str, np.ndarray]:
     """Every catalogue metric of many designs, column name -> (n,) array; the workspace grids in one parallel
     kernel call (no Python work per voxel); with ``task`` (a config TaskConfig) also the task-box and path
@@ -452,7 +459,9 @@ def evaluate_population(
     replaces the uniform ``resolution`` grid and the result also has ``error_volume`` (relative) and
     ``error_gci`` (its per-design error estimates). ``families`` (catalogue families, e.g. {"task", "cycle"}):
     only their metrics, and no workspace grid when "workspace" is not among them (the search evaluates only what
-    its objectives and constraints use)."""
+    its objectives and constraints use). ``fields`` (per-voxel field names, e.g. {"lci"}): the workspace metrics of
+    those fields only (``metrics.field_of``); {"lci"} runs the mechanism's cheaper ``lci_kernel``, whose measure,
+    LCI statistics, bands and error estimates equal the field kernel's bit for bit."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
@@ -461,16 +470,18 @@ def evaluate_population(
         has_path = task is not None and task.path is not None
         entries = _metrics.result_metrics(mech, unit, task is not None, has_path, options, cycle,
                                           tolerance is not None)
-        cols = [c for m in entries if families is None or m.family in families
+        cols = [c for m in entries if (families is None or m.family in families)
+                and (fields is None or m.family != "workspace" or _metrics.field_of(m) in fields)
                 for c in m.columns(len(band_edges) - 1)]
         return {k: np.zeros(0) for k in cols}
     packed = np.stack([mech.pack(d, options) for d in resolved])
     edges = np.asarray(band_edges, dtype=float)
-    args = (resolution, band_edges, unit, task, cycle, families)
+    args = (resolution, band_edges, unit, task, cycle, families, fields)
     if families is not None and "workspace" not in families:
         return _metrics_of(mech, resolved, options, packed, None, None, *args)
+    lci_only = fields is not None and set(fields) <= {"lci"}
     if tolerance is not None:
-        ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, region)
+        ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, region, lci_only=lci_only)
         out = _metrics_of(mech, resolved, options, packed, ad.stats, ad.cell, *args)
         out["error_volume"] = ad.error_volume
         out["error_gci"] = ad.error_gci
@@ -478,7 +489,7 @@ def evaluate_population(
     grids = [make_grid(mech, d, options, resolution, region) for d in resolved]
     lo = np.stack([g.lo for g in grids])
     step = np.stack([g.step for g in grids])
-    stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges)
+    stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges, lci_only=lci_only)
     cell = np.array([g.cell_measure for g in grids])
     return _metrics_of(mech, resolved, options, packed, stats, cell, *args)
 
@@ -508,7 +519,8 @@ def evaluate_config(cfg, design: Mapping[str, float] | None = None, *, keep_grid
 
 
 def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]],
-                               families: Collection[str] | None = None) -> dict[str, np.ndarray]:
+                               families: Collection[str] | None = None,
+                               fields: Collection[str] | None = None) -> dict[str, np.ndarray]:
     """All metrics of many designs under one config (of ``families`` only, when given), in one parallel kernel
     call per grid. The cycle metrics (batched over the designs: cycle.population) only when an objective or
     constraint uses one
@@ -527,4 +539,5 @@ def evaluate_config_population(cfg, designs: Sequence[Mapping[str, float]],
         cycle=searched(cfg),
         tolerance=config_tolerance(cfg),
         families=families,
+        fields=fields,
     )

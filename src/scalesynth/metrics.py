@@ -318,6 +318,14 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
     return out
 
 
+def field_of(m: Metric) -> str | None:
+    """The per-voxel field a workspace or task metric needs: its own field, and the LCI for the measure, count,
+    coverage and error estimates (reachability is the LCI's sign); None for the computed families."""
+    if m.family not in ("workspace", "task"):
+        return None
+    return m.field or "lci"
+
+
 def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, Any] | None = None,
                cycle: Any = None, adaptive: bool = False) -> str | None:
     """Why ``m`` cannot be evaluated under a config (a phrase), or None if it can. ``cycle``: the config's

@@ -1,9 +1,11 @@
 """The pymoo Problem: design vectors -> objectives F and constraints G (G <= 0 feasible), vectorised.
 
 Each generation's designs go to the Numba evaluator in one call (``evaluate_config_population``), for the
-catalogue families the objectives and constraints use. Besides F and G the problem returns ``M``, the matrix of
-every metric (columns ``metric_columns``; NaN in the columns of families the search does not use), and
-``complete_metrics`` fills those columns in for the final population, so results report every metric.
+catalogue families the objectives and constraints use, and, when their workspace metrics are the LCI's alone
+(measure, GCI, bands), with the mechanism's LCI kernel (no clearance, stiffness or sigma per point). Besides F and
+G the problem returns ``M``, the matrix of every metric (columns ``metric_columns``; NaN in the columns the search
+does not evaluate), and ``complete_metrics`` fills those columns in for the final population, so results report
+every metric.
 """
 
 from __future__ import annotations
@@ -60,8 +62,11 @@ class SynthesisProblem(Problem):
         self.metric_columns = result_columns(cfg)
         # the search evaluates only the catalogue families its objectives and constraints use (a five-bar's task
         # and cycle metrics need no workspace grid); the final population gets the other columns (complete_metrics)
-        used = {metric_entry(cfg, item).family for item in [*cfg.objectives, *cfg.constraints]}
-        self.searched_families = frozenset(used)
+        entries = [metric_entry(cfg, item) for item in [*cfg.objectives, *cfg.constraints]]
+        self.searched_families = frozenset(m.family for m in entries)
+        # the per-voxel fields of the searched workspace metrics: None (every field) unless they are the LCI's alone
+        wfields = {_metrics.field_of(m) for m in entries if m.family == "workspace"}
+        self.searched_fields = frozenset(wfields) if wfields <= {"lci"} else None
         n_constr = sum((c.min is not None) + (c.max is not None) for c in cfg.constraints)
         xl = np.array([cfg.bounds[k][0] for k in self.var_names], dtype=float)
         xu = np.array([cfg.bounds[k][1] for k in self.var_names], dtype=float)
@@ -78,21 +83,33 @@ class SynthesisProblem(Problem):
     def metrics(self, X: np.ndarray) -> np.ndarray:
         """Metrics of the designs X (n, n_var), shape (n, len(metric_columns)): the searched families' columns,
         NaN in the others (``complete_metrics``)."""
-        values = evaluate_config_population(self.cfg, self.designs(X), self.searched_families)
+        values = evaluate_config_population(self.cfg, self.designs(X), self.searched_families, self.searched_fields)
         n = np.atleast_2d(X).shape[0]
         return np.column_stack([np.asarray(values[k], dtype=float) if k in values else np.full(n, np.nan)
                                 for k in self.metric_columns])
 
-    def _family_of(self) -> dict[str, str]:
-        """Catalogue family of every metric column."""
+    def _entry_of(self) -> dict[str, _metrics.Metric]:
+        """Catalogue entry of every metric column."""
         n_bands = len(self.cfg.dexterity.band_edges) - 1
-        return {c: m.family for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
+        return {c: m for m in _metrics.catalogue(self.cfg.mech, self.cfg.units.length).values()
                 for c in m.columns(n_bands)}
 
+    def _family_of(self) -> dict[str, str]:
+        """Catalogue family of every metric column."""
+        return {c: m.family for c, m in self._entry_of().items()}
+
     def unsearched_columns(self) -> list[str]:
-        """The metric columns of the families the search does not evaluate."""
-        family_of = self._family_of()
-        return [k for k in self.metric_columns if family_of[k] not in self.searched_families]
+        """The metric columns the search does not evaluate: those of the families it does not use and, when it
+        runs the LCI kernel, the workspace statistics of the other fields."""
+        entry_of = self._entry_of()
+
+        def searched(m: _metrics.Metric) -> bool:
+            if m.family not in self.searched_families:
+                return False
+            fields = self.searched_fields
+            return m.family != "workspace" or fields is None or _metrics.field_of(m) in fields
+
+        return [k for k in self.metric_columns if not searched(entry_of[k])]
 
     def complete_metrics(self, X: np.ndarray, M: np.ndarray) -> np.ndarray:
         """M (from ``metrics``) with the unsearched columns evaluated for the designs X; a copy. A design's

@@ -210,6 +210,14 @@ class Mechanism(ABC):
         return self.field_kernel
 
     @property
+    def lci_kernel(self):
+        """A Numba kernel with the field kernel's signature whose slot 0 is the field kernel's, bit for bit (the LCI
+        or -1), the other slots unspecified: a search whose workspace metrics are the LCI's alone (measure, GCI,
+        bands) runs it (``grid_stats(lci_only=True)``, evaluate_population's ``fields``). Default: the field
+        kernel itself; a mechanism overrides it with one that skips the costly fields."""
+        return self.field_kernel
+
+    @property
     def point_kernel(self):
         """Scalar LCI kernel ``f(p, x, y, z) -> LCI or -1`` derived from the field kernel (single points, plots)."""
         kernel = _LCI_KERNELS.get(self.name)
@@ -291,12 +299,15 @@ class Mechanism(ABC):
         point); the cycle analysis differentiates it to get the payload's velocity and acceleration."""
         raise InvalidParameter(f"mechanism: {self.name} has no payload point yet (cycles on its task axes need it)")
 
-    def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray):
-        """Statistics rows of every field for many designs (layout in kernels.grid). A mechanism may override this
-        with a faster kernel that feeds the same accumulator (kernels.grid.gather_column, accumulate_cells)."""
+    def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray,
+                   lci_only: bool = False):
+        """Statistics rows of every field for many designs (layout in kernels.grid); ``lci_only``: only the count,
+        the LCI's statistics and the bands are meaningful (``lci_kernel``). A mechanism may override this with a
+        faster kernel that feeds the same accumulator (kernels.grid.gather_column, accumulate_cells)."""
         from scalesynth.kernels import grid as _grid
 
-        return _grid.population_stats(self.field_kernel, self.n_fields, packed, lo, step, shape, edges)
+        kernel = self.lci_kernel if lci_only else self.field_kernel
+        return _grid.population_stats(kernel, self.n_fields, packed, lo, step, shape, edges)
 
     def derived_columns(self, design: Mapping[str, float]) -> dict[str, float]:
         """Extra result columns derived from a design (e.g. m_minus_n); none by default."""

@@ -688,13 +688,14 @@ class PauuPpap(Mechanism):
     def kernel_branch(self, options) -> str:
         return options["mode"]
 
-    def grid_stats(self, packed, lo, step, shape, edges):
+    def grid_stats(self, packed, lo, step, shape, edges, lci_only=False):
         """The column-interval and symmetry evaluator (population_stats_fast; the same numbers as the generic one)
-        when no design needs the statistics of the clearance or stiffness fields: its rows then carry empty columns
-        for them (sums 0, min +inf, max -inf), which no metric reads because their metrics need
+        when no design needs the statistics of the clearance or stiffness fields (or ``lci_only``): its rows then
+        carry empty columns for them (sums 0, min +inf, max -inf), which no metric reads because their metrics need
         options.link_radius (CLEARANCE) or options.stiffness_metrics (STIFFNESS_FIELDS). With link_radius,
         interference_free or stiffness_metrics: the generic kernel over point_fields."""
-        if np.any(packed[:, _CLEARANCE_STATS] > 0.0) or np.any(packed[:, _STIFFNESS_STATS] > 0.0):
+        needs_fields = np.any(packed[:, _CLEARANCE_STATS] > 0.0) or np.any(packed[:, _STIFFNESS_STATS] > 0.0)
+        if needs_fields and not (lci_only and not np.any(packed[:, _FREE_ONLY] > 0.0)):
             return _grid.population_stats(point_fields, N_KERNEL_FIELDS, packed, lo, step, shape, edges)
         return widen_rows(population_stats_fast(packed, lo, step, shape, edges), N_FIELDS, N_KERNEL_FIELDS)
 

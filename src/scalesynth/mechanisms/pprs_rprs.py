@@ -265,6 +265,14 @@ def kinematic_fields(p, x, y, z, out):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def lci_fields(p, x, y, z, out):
+    """Slot 0 of point_fields alone, computed as there (the LCI or -1; with interference_free the clearance still
+    decides reachability), the other slots not written: the search's kernel when it needs only the LCI's metrics
+    (Mechanism.lci_kernel); no capsule clearance, stiffness or sigma."""
+    _fields(p, x, y, z, out, False, True, False)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def point_reach(p, x, y, z, out):
     """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same branch, rail,
     beta and stroke checks and, with interference_free, the same clearance), -1 elsewhere; no conditioning,
@@ -273,15 +281,72 @@ def point_reach(p, x, y, z, out):
     _fields(p, x, y, z, out, False, False)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def _conditioning(p, conv_r, u3x, u3y, e3x, e3y, rho3, h3, mu3sq, mu3, lam1, k1, lam2, k2, lam3, k3):
+    """(LCI, sigma_min, sigma_max) of the scaled twist Jacobian (_fields). Not inlined: point_fields and lci_fields
+    then run the same compiled code, so their LCIs agree bit for bit (inlined, the optimiser contracts the rows'
+    products differently next to the clearance and stiffness code: 1-ulp differences)."""
+    # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
+    inv_alen = 1.0 / p[_ALEN]
+    a = np.empty((6, 6))
+    wsign = -1.0 if conv_r else 1.0
+    r1x, r1y, r1z = p[_R1], p[_R1 + 1], p[_R1 + 2]
+    r2x, r2y, r2z = p[_R2], p[_R2 + 1], p[_R2 + 2]
+    r3x, r3y, r3z = p[_R3], p[_R3 + 1], p[_R3 + 2]
+    _put_row(a, 0, wsign, 1.0, 0.0, 0.0, r1x, r1y, r1z, inv_alen)
+    _put_row(a, 1, wsign, -0.5, SQRT3_2, 0.0, r2x, r2y, r2z, inv_alen)
+    inv_mu2 = 1.0 / mu3sq
+    _put_row(a, 2, p[_BLEN], h3 * u3x * inv_mu2, h3 * u3y * inv_mu2, rho3 * inv_mu2, r3x, r3y, r3z, inv_alen)
+    t1 = p[_SG1] * lam1 / k1
+    _put_row(a, 3, 1.0, 0.0, t1, 1.0, r1x, r1y, r1z, inv_alen)
+    t2 = p[_SG2] * lam2 / k2
+    _put_row(a, 4, 1.0, -SQRT3_2 * t2, -0.5 * t2, 1.0, r2x, r2y, r2z, inv_alen)
+    t3 = p[_SG3] * lam3 / k3
+    inv_mu = 1.0 / mu3
+    # g = d3 + t3 e3 with d3 = (-rho3 u3 + h3 z) / mu3
+    gx = -rho3 * u3x * inv_mu + t3 * e3x
+    gy = -rho3 * u3y * inv_mu + t3 * e3y
+    _put_row(a, 5, 1.0, gx, gy, h3 * inv_mu, r3x, r3y, r3z, inv_alen)
+    return _sv_6x6(a)
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, stiffness, every=True):
+def _capsule_gap(p, rail, u3x, u3y, b3x, b3y, p2x, p2y, s1, s2, d3x, d3y, d3z, c1x, c1y, c1z, c2x, c2y, c2z, c3x, c3y,
+                 c3z):
+    """Clearance (field 3, mm) of the capsules of link_geometry at one pose (_fields' points)."""
+    seg = np.empty((12, 6))
+    _put_seg(seg, 0, 0.0, 0.0, 0.0, rail, 0.0, 0.0)
+    _put_seg(seg, 1, 0.0, 0.0, 0.0, -0.5 * rail, SQRT3_2 * rail, 0.0)
+    _put_seg(seg, 2, 0.0, 0.0, 0.0, b3x, b3y, 0.0)
+    _put_seg(seg, 3, c1x, 0.0, 0.0, c1x, 0.0, s1)
+    _put_seg(seg, 4, p2x, p2y, 0.0, p2x, p2y, s2)
+    _put_seg(seg, 5, b3x, b3y, 0.0, d3x, d3y, d3z)
+    _put_seg(seg, 6, c1x, 0.0, s1, c1x, c1y, c1z)
+    _put_seg(seg, 7, p2x, p2y, s2, c2x, c2y, c2z)
+    _put_seg(seg, 8, d3x, d3y, d3z, c3x, c3y, c3z)
+    _put_seg(seg, 9, c1x, c1y, c1z, c2x, c2y, c2z)
+    _put_seg(seg, 10, c2x, c2y, c2z, c3x, c3y, c3z)
+    _put_seg(seg, 11, c3x, c3y, c3z, c1x, c1y, c1z)
+    gap = math.inf
+    for k in range(_PAIRS.shape[0]):
+        i = _PAIRS[k, 0]
+        j = _PAIRS[k, 1]
+        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
+                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
+        gap = min(gap, d - p[_RAD + _SEGMENT_BODY[i]] - p[_RAD + _SEGMENT_BODY[j]])
+    return gap
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _fields(p, x, y, z, out, stiffness, every=True, others=True):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
     IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
     Fields (kernels.grid contract): LCI, sigma_min, sigma_max of J = dx/dq, x = (O1, angle_length x angular
     velocity), the beta input times beta_length (dimensionless); clearance (mm) of the link capsules (with
     interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, stiffness_min (N/mm) and
     deflection (mm) at O1 under the packed load (ideal joints, docs/stiffness.md; _stiffness). ``every`` False (a
-    constant, point_reach): slot 0 alone, 0 where reachable, -1 elsewhere."""
+    constant, point_reach): slot 0 alone, 0 where reachable, -1 elsewhere; ``others`` False (a constant,
+    lci_fields): slot 0 alone, the LCI as with True."""
     c1x = x + p[_R1]
     c1y = y + p[_R1 + 1]
     c1z = z + p[_R1 + 2]
@@ -363,7 +428,6 @@ def _fields(p, x, y, z, out, stiffness, every=True):
         return
     # clearance (field 3) of the capsules of link_geometry: B_i = (u_i . C_i) u_i carries the slider to
     # D_i = B_i + s_i z; chain 3's prismatic runs from B3 = R u3 along d3 = (-rho3 u3 + h3 z) / mu3
-    seg = np.empty((12, 6))
     b3x = rail * u3x
     b3y = rail * u3y
     d3x = b3x - s3 * rho3 * u3x / mu3
@@ -371,66 +435,34 @@ def _fields(p, x, y, z, out, stiffness, every=True):
     d3z = s3 * h3 / mu3
     p2x = -0.5 * p2
     p2y = SQRT3_2 * p2
-    _put_seg(seg, 0, 0.0, 0.0, 0.0, rail, 0.0, 0.0)
-    _put_seg(seg, 1, 0.0, 0.0, 0.0, -0.5 * rail, SQRT3_2 * rail, 0.0)
-    _put_seg(seg, 2, 0.0, 0.0, 0.0, b3x, b3y, 0.0)
-    _put_seg(seg, 3, c1x, 0.0, 0.0, c1x, 0.0, s1)
-    _put_seg(seg, 4, p2x, p2y, 0.0, p2x, p2y, s2)
-    _put_seg(seg, 5, b3x, b3y, 0.0, d3x, d3y, d3z)
-    _put_seg(seg, 6, c1x, 0.0, s1, c1x, c1y, c1z)
-    _put_seg(seg, 7, p2x, p2y, s2, c2x, c2y, c2z)
-    _put_seg(seg, 8, d3x, d3y, d3z, c3x, c3y, c3z)
-    _put_seg(seg, 9, c1x, c1y, c1z, c2x, c2y, c2z)
-    _put_seg(seg, 10, c2x, c2y, c2z, c3x, c3y, c3z)
-    _put_seg(seg, 11, c3x, c3y, c3z, c1x, c1y, c1z)
-    gap = math.inf
-    for k in range(_PAIRS.shape[0]):
-        i = _PAIRS[k, 0]
-        j = _PAIRS[k, 1]
-        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
-                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
-        gap = min(gap, d - p[_RAD + _SEGMENT_BODY[i]] - p[_RAD + _SEGMENT_BODY[j]])
-    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
-        _grid.write_unreachable(out)
-        return
+    gap = 0.0
+    if others or p[_FREE_ONLY] > 0.0:
+        gap = _capsule_gap(p, rail, u3x, u3y, b3x, b3y, p2x, p2y, s1, s2, d3x, d3y, d3z, c1x, c1y, c1z, c2x, c2y,
+                           c2z, c3x, c3y, c3z)
+        if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+            _grid.write_unreachable(out)
+            return
     if not every:
         out[0] = 0.0
         return
     if k1 == 0.0 or k2 == 0.0 or k3 == 0.0:
         _grid.write_singular(out)  # serial singularity: a link D_iC_i lies along e_i, J_t has an unbounded row
+        if not others:
+            return
         out[_F_CLEARANCE] = gap
         if stiffness and (p[_FX] != 0.0 or p[_FX + 1] != 0.0 or p[_FX + 2] != 0.0):
             out[_F_DEFLECTION] = _legs_k.DEFLECTION_CAP  # stiffness_min 0
         return
-    out[_F_CLEARANCE] = gap
-    if stiffness:
+    if others:
+        out[_F_CLEARANCE] = gap
+    if stiffness and others:
         out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _stiffness(
             p, x, y, z, c1x, c1y, c1z, s1, c2x, c2y, c2z, p2x, p2y, s2, c3x, c3y, c3z, b3x, b3y, d3x, d3y, d3z, s3,
             -rho3 * u3x / mu3, -rho3 * u3y / mu3, h3 / mu3, e3x, e3y)
-    # rows [g, r x g] of J_t (spec §1.5), beta row times beta_length, angular columns over angle_length
-    inv_alen = 1.0 / p[_ALEN]
-    a = np.empty((6, 6))
-    wsign = -1.0 if conv_r else 1.0
-    r1x, r1y, r1z = p[_R1], p[_R1 + 1], p[_R1 + 2]
-    r2x, r2y, r2z = p[_R2], p[_R2 + 1], p[_R2 + 2]
-    r3x, r3y, r3z = p[_R3], p[_R3 + 1], p[_R3 + 2]
-    _put_row(a, 0, wsign, 1.0, 0.0, 0.0, r1x, r1y, r1z, inv_alen)
-    _put_row(a, 1, wsign, -0.5, SQRT3_2, 0.0, r2x, r2y, r2z, inv_alen)
-    inv_mu2 = 1.0 / mu3sq
-    _put_row(a, 2, p[_BLEN], h3 * u3x * inv_mu2, h3 * u3y * inv_mu2, rho3 * inv_mu2, r3x, r3y, r3z, inv_alen)
-    t1 = p[_SG1] * lam1 / k1
-    _put_row(a, 3, 1.0, 0.0, t1, 1.0, r1x, r1y, r1z, inv_alen)
-    t2 = p[_SG2] * lam2 / k2
-    _put_row(a, 4, 1.0, -SQRT3_2 * t2, -0.5 * t2, 1.0, r2x, r2y, r2z, inv_alen)
-    t3 = p[_SG3] * lam3 / k3
-    inv_mu = 1.0 / mu3
-    # g = d3 + t3 e3 with d3 = (-rho3 u3 + h3 z) / mu3
-    gx = -rho3 * u3x * inv_mu + t3 * e3x
-    gy = -rho3 * u3y * inv_mu + t3 * e3y
-    _put_row(a, 5, 1.0, gx, gy, h3 * inv_mu, r3x, r3y, r3z, inv_alen)
-    lci, smin, smax = _sv_6x6(a)
+    lci, smin, smax = _conditioning(p, conv_r, u3x, u3y, e3x, e3y, rho3, h3, mu3sq, mu3, lam1, k1, lam2, k2, lam3, k3)
     out[0] = lci
-    out[1], out[2] = inverse_singular_values(smin, smax)
+    if others:
+        out[1], out[2] = inverse_singular_values(smin, smax)
 
 
 # ----- NumPy kinematics ----------------------------------------------------------------------------------
@@ -748,6 +780,10 @@ class PprsRprs(Mechanism):
     @property
     def reach_kernel(self):
         return point_reach
+
+    @property
+    def lci_kernel(self):
+        return lci_fields
 
     def kernel_branch(self, options) -> str:
         return options["sigma"]

@@ -339,6 +339,14 @@ def kinematic_fields(p, x, y, z, out):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def lci_fields(p, x, y, z, out):
+    """Slot 0 of point_fields alone, computed as there (the LCI or -1; with interference_free the clearance still
+    decides reachability), the other slots not written: the search's kernel when it needs only the LCI's metrics
+    (Mechanism.lci_kernel)."""
+    _fields(p, x, y, z, out, False, True, False)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def point_reach(p, x, y, z, out):
     """Slot 0 of point_fields up to its value: >= 0 exactly where point_fields' LCI is (the same leg checks and,
     with interference_free, the same clearance), -1 elsewhere; no conditioning, stiffness or (without
@@ -364,9 +372,10 @@ def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, x, y, z, out, stiffness, every=True):
+def _fields(p, x, y, z, out, stiffness, every=True, others=True):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
-    length leaves the stroke limits or the parametrisation is degenerate (C-model). Fields (kernels.grid contract):
+    length leaves the stroke limits or the parametrisation is degenerate (C-model). ``others`` False (a constant,
+    lci_fields): slot 0 alone, the LCI as with True. Fields (kernels.grid contract):
     LCI, sigma_min, sigma_max of J = its inverse, dx/dq (dimensionless); 3 clearance (mm) of the link capsules
     (with interference_free, overlapping capsules make the pose unreachable); with ``stiffness``, 4 stiffness_min
     (N/mm) and 5 deflection (mm) of O' under the packed load on the frame at the constraint-consistent placement
@@ -404,10 +413,12 @@ def _fields(p, x, y, z, out, stiffness, every=True):
         if p[_FREE_ONLY] > 0.0 and _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0) < 0.0:
             out[0] = -1.0
         return
-    gap = _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0)
-    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
-        _grid.write_unreachable(out)
-        return
+    gap = 0.0
+    if others or p[_FREE_ONLY] > 0.0:
+        gap = _clearance(p, y0, x, st, ct, sp, cp, sf, cf, _PAIRS, 0.0, 0.0, 0.0, 0.0)
+        if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+            _grid.write_unreachable(out)
+            return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0:
         _grid.write_singular(out)  # inverse singularity: a leg of zero length has no direction
     else:
@@ -422,7 +433,11 @@ def _fields(p, x, y, z, out, stiffness, every=True):
             a31 * i3, a32 * i3 * il, a33 * i3 * il,
         )  # fmt: skip
         out[0] = lci
+        if not others:
+            return
         out[1], out[2] = inverse_singular_values(smin, smax)
+    if not others:
+        return
     out[_F_CLEARANCE] = gap
     if stiffness:
         out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _placement_stiffness(
@@ -833,6 +848,10 @@ class RpsUpu(Mechanism):
     @property
     def reach_kernel(self):
         return point_reach
+
+    @property
+    def lci_kernel(self):
+        return lci_fields
 
     def kernel_branch(self, options) -> str:
         return BRANCH
@@ -1285,6 +1304,14 @@ def tool_kinematic_fields(p, x, y, z, out):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def tool_lci_fields(p, x, y, z, out):
+    """Slot 0 of tool_point_fields alone, computed as there (the LCI or -1; with interference_free the clearance
+    still decides reachability), the other slots not written: the search's kernel when it needs only the LCI's
+    metrics (Mechanism.lci_kernel); no per-point Newton solve of the stiffness placement."""
+    _tool_fields(p, x, y, z, out, False, True, False)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def tool_point_reach(p, x, y, z, out):
     """Slot 0 of tool_point_fields up to its value: >= 0 exactly where tool_point_fields' LCI is (the same branch,
     pose ranges and leg checks and, with interference_free, the same clearance), -1 elsewhere; no conditioning,
@@ -1294,7 +1321,7 @@ def tool_point_reach(p, x, y, z, out):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _tool_fields(p, x, y, z, out, stiffness, every=True):
+def _tool_fields(p, x, y, z, out, stiffness, every=True, others=True):
     """LCI of dq/dT (dimensionless) at tool point T = (x, y, z) mm of the P-model, principal branch
     (cos theta > 0, cos psi > 0), or -1 when T is out of reach of that branch, its pose leaves the z/theta/psi
     ranges or a leg leaves the stroke limits.
@@ -1306,7 +1333,7 @@ def _tool_fields(p, x, y, z, out, stiffness, every=True):
     with ``stiffness``, 4 stiffness_min (N/mm) and 5 deflection (mm) of T under the packed load, on the frame at
     the C-model pose that puts the tool at T (_tool_stiffness), whether or not that pose is within the pose ranges
     and stroke limits (docs/stiffness.md). ``every`` False (a constant, tool_point_reach): slot 0 alone, 0 where
-    reachable, -1 elsewhere.
+    reachable, -1 elsewhere. ``others`` False (a constant, tool_lci_fields): slot 0 alone, the LCI as with True.
     """
     d = p[_D]
     sp = y / d
@@ -1345,12 +1372,16 @@ def _tool_fields(p, x, y, z, out, stiffness, every=True):
                                               p[_RAD_TOOL]) < 0.0:
             out[0] = -1.0
         return
-    gap = _clearance(p, 0.0, z0, st, ct, sp, cp, 0.0, 1.0, _PAIRS_TOOL, x, y, z, p[_RAD_TOOL])
-    if gap < 0.0 and p[_FREE_ONLY] > 0.0:
-        _grid.write_unreachable(out)
-        return
+    gap = 0.0
+    if others or p[_FREE_ONLY] > 0.0:
+        gap = _clearance(p, 0.0, z0, st, ct, sp, cp, 0.0, 1.0, _PAIRS_TOOL, x, y, z, p[_RAD_TOOL])
+        if gap < 0.0 and p[_FREE_ONLY] > 0.0:
+            _grid.write_unreachable(out)
+            return
     if q1 == 0.0 or q2 == 0.0 or q3 == 0.0 or ct <= 1e-12:
         _grid.write_singular(out)  # a zero leg (inverse singularity) or cos theta = 0 (T no longer fixes theta)
+        if not others:
+            return
         out[_F_CLEARANCE] = gap
         if stiffness:
             out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _tool_stiffness(p, x, y, z, z0, th, ps)
@@ -1372,6 +1403,8 @@ def _tool_fields(p, x, y, z, out, stiffness, every=True):
         (a31 * m11 + a32 * m21) * i3, (a31 * m12 + a32 * m22 + a33 * m32) * i3, a31 * i3,
     )  # fmt: skip
     out[0] = lci
+    if not others:
+        return
     out[1], out[2] = inverse_singular_values(smin, smax)
     out[_F_CLEARANCE] = gap
     if stiffness:
@@ -1434,6 +1467,10 @@ class RpsUpuTool(RpsUpu):
     @property
     def reach_kernel(self):
         return tool_point_reach
+
+    @property
+    def lci_kernel(self):
+        return tool_lci_fields
 
     def kernel_branch(self, options) -> str:
         return "++"

@@ -184,6 +184,14 @@ def kinematic_fields(p, alpha, beta, yy, out):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def lci_fields(p, alpha, beta, yy, out):
+    """Slot 0 of point_fields alone, computed as there (the LCI or -1; with interference_free the clearance still
+    decides reachability), the other slots not written: the search's kernel when it needs only the LCI's metrics
+    (Mechanism.lci_kernel)."""
+    _fields(p, alpha, beta, yy, out, False, False)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, alpha, beta, yy, out):
     """Fields at task point (alpha [rad], beta [rad], Y [mm]) (kernels.grid contract): slots 0-2 LCI, sigma_min,
     sigma_max of J = dx/dq, x = (L alpha, L beta, Y) (dimensionless); _F_STIFFNESS_MIN (N/mm) and _F_DEFLECTION
@@ -194,11 +202,15 @@ def point_fields(p, alpha, beta, yy, out):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
-def _fields(p, alpha, beta, yy, out, stiffness):
+def _fields(p, alpha, beta, yy, out, stiffness, others=True):
     """point_fields, with the stiffness slots only when ``stiffness`` (a constant: each caller's copy keeps its
-    branch)."""
+    branch); ``others`` False (a constant, lci_fields): slot 0 alone."""
     ok, sa, ca, sb, cb, px, pz, lmax = _kinematics(p, alpha, beta, yy, out)
     if ok:
+        if not others:
+            if p[_FREE_ONLY] > 0.0 and _clearance(p, sa, ca, sb, cb, px, yy, pz) < 0.0:
+                out[0] = -1.0
+            return
         gap = _clearance(p, sa, ca, sb, cb, px, yy, pz)
         if gap < 0.0 and p[_FREE_ONLY] > 0.0:
             _grid.write_unreachable(out)
@@ -448,6 +460,10 @@ class UpsSspr(Mechanism):
     @property
     def reach_kernel(self):
         return point_reach
+
+    @property
+    def lci_kernel(self):
+        return lci_fields
 
     # ----- stiffness (scalesynth.stiffness; per voxel: point_fields slots 3, 4, the same frame) ---------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
