@@ -658,14 +658,19 @@ def _issue15_summary(data: dict) -> list[str]:
             # adaptive evaluator only for its final population, so its loop's cost is the synthesis part's
             from scalesynth.problem import SynthesisProblem
 
-            searches_workspace = "workspace" in SynthesisProblem(cfg).searched_families
-            if adaptive_now and first and searches_workspace:
-                ms = f"{1e3 * a['adaptive']['s_per_design']:.2f} (adaptive part: the evaluator alone)"
-            elif s and s["evaluator"] == label:
-                ms = (f"{1e3 * s['evaluation']['s_per_design']:.2f} (synthesis part"
-                      + ("" if searches_workspace else ": the searched task, path, design and cycle metrics") + ")")
+            problem = SynthesisProblem(cfg)
+            searches_workspace = "workspace" in problem.searched_families
+            full = (f"{1e3 * a['adaptive']['s_per_design']:.2f} (adaptive part: the evaluator with every field, "
+                    "1 thread)") if adaptive_now and first and searches_workspace else None
+            if s and s["evaluator"] == label:
+                what = ("the searched task, path, design and cycle metrics" if not searches_workspace else
+                        "the search's evaluation: the LCI's statistics alone" if problem.searched_fields is not None else
+                        "the search's evaluation")
+                ms = f"{1e3 * s['evaluation']['s_per_design']:.2f} (synthesis part: {what})"
+                if full:
+                    ms += f"; {full}"
             else:
-                ms = "not measured"
+                ms = full or "not measured"
             # accuracy of the config's evaluator (errors without slivers)
             acc = "-"
             if first and "volume_error_solid" in a["adaptive"]:
