@@ -101,8 +101,15 @@ def evaluate_cmd(
             b = int(key[4:-6])
             label = f"{key} (band {b}: LCI in {'[' if b == 0 else '('}{edges[b]:g}, {edges[b + 1]:g}])"
         typer.echo(f"  {label:<34} {value:.6g}")
-    if "error_volume" in out:  # adaptive evaluator (grid.tolerance): error_volume / error_gci printed above
-        typer.echo(f"  adaptive grid: {out['grid_cells']} kernel calls, {out['seconds']:.3f} s")
+    if "error_volume" in out:  # grid.tolerance: error_volume / error_gci printed above
+        from scalesynth.evaluate import config_tolerance, uniform_resolution
+
+        n = uniform_resolution(mech, config_tolerance(cfg))
+        if n is None:
+            typer.echo(f"  adaptive grid: {out['grid_cells']} kernel calls, {out['seconds']:.3f} s")
+        else:
+            typer.echo(f"  calibrated uniform grid: resolution {n} (estimates against {2 * n}), "
+                       f"{out['grid_cells']} cells, {out['seconds']:.3f} s")
     else:
         typer.echo(
             f"  voxels {out['voxels']} of {out['grid_cells']} (resolution {out['resolution']}), {out['seconds']:.3f} s"

@@ -159,6 +159,39 @@ def adaptive_plan(mech: Mechanism) -> ColumnPlan:
     return ADAPTIVE_PLAN_OF.get(mech.name, ADAPTIVE_PLAN[len(mech.task_axes)])
 
 
+@dataclass(frozen=True)
+class UniformPlan:
+    """The tolerance form on a uniform grid, for a mechanism whose uniform evaluator is far cheaper than the adaptive
+    one at equal accuracy: ``steps`` (volume tolerance, GCI tolerance, N), each N the coarsest of a ladder whose
+    worst errors on two sets of 20 random designs within the config's bounds stayed within 0.8x that tolerance
+    against the benchmark's 3x finer reference (``benchmarks/uniform_ladder.py``, seeds 0 and 1)."""
+
+    steps: tuple[tuple[float, float, int], ...]
+
+    def resolution_for(self, tolerance: Tolerance) -> int | None:
+        """N of the coarsest step calibrated for a tolerance at least as tight as ``tolerance``; None when no step
+        is (the adaptive evaluator then meets it)."""
+        ok = [n for tv, tg, n in self.steps if tv <= tolerance.volume and tg <= tolerance.gci]
+        return min(ok) if ok else None
+
+
+# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/30 of the adaptive evaluator at
+# (0.2 %, 5e-4) (2 ms against 65 ms per design) and 1/100 at (3 %, 5e-3). Ladders on the config's bounds
+# (paper_2pauu_ppap.yaml; quick.yaml has the same), worst volume / GCI error as multiples of the tolerance on seed 0 |
+# seed 1 (benchmarks/notes/uniform_plans.md): N = 72 at (0.2 %, 5e-4): 0.41, 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 |
+# 1.06, 1.04; N = 64: 1.04 on seed 0); N = 32 at (1 %, 2.5e-3): 0.68, 0.32 | 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57,
+# 0.46 | 0.50, 0.74 (N = 20: 0.85, 0.88 on seed 0)
+UNIFORM_PLAN_OF: dict[str, UniformPlan] = {
+    "2pauu-ppap": UniformPlan(((0.002, 5.0e-4, 72), (0.01, 2.5e-3, 32), (0.03, 5.0e-3, 24))),
+}
+
+
+def uniform_resolution(mech: Mechanism, tolerance: Tolerance) -> int | None:
+    """The uniform grid the tolerance form uses for ``mech`` (UNIFORM_PLAN_OF), or None: the adaptive evaluator."""
+    plan = UNIFORM_PLAN_OF.get(mech.name)
+    return None if plan is None else plan.resolution_for(tolerance)
+
+
 @dataclass
 class AdaptiveResult:
     """Statistics of designs from ``adaptive_population_stats``: counts in coarse-cell units (``cell`` the coarse
@@ -207,6 +240,58 @@ def adaptive_population_stats(
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
                                                       plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
+
+
+def tolerance_population_stats(
+    mech: Mechanism,
+    designs: Sequence[Mapping[str, float]],
+    options: Mapping[str, Any],
+    packed: np.ndarray,
+    tolerance: Tolerance,
+    edges: np.ndarray,
+    region: Mapping[str, Sequence[float]] | None = None,
+    lci_only: bool = False,
+    estimates: bool = True,
+) -> AdaptiveResult:
+    """Statistics of every design under the tolerance form: the adaptive evaluator, or, for a mechanism with a
+    calibrated uniform plan (UNIFORM_PLAN_OF), its uniform grid for ``tolerance``. There the error estimates are
+    the change to the grid twice as fine (relative for the measure, absolute for the GCI), computed only with
+    ``estimates`` (NaN without); the adaptive evaluator's come with its statistics."""
+    n_uniform = uniform_resolution(mech, tolerance)
+    if n_uniform is None:
+        return adaptive_population_stats(mech, designs, options, packed, tolerance, edges, region, lci_only=lci_only)
+    ndim = len(mech.task_axes)
+
+    def on_grid(n: int, lci: bool) -> tuple[np.ndarray, np.ndarray]:
+        grids = [make_grid(mech, d, options, n, region) for d in designs]
+        lo = np.stack([g.lo for g in grids])
+        step = np.stack([g.step for g in grids])
+        return mech.grid_stats(packed, lo, step, grids[0].shape, edges, lci_only=lci), np.array(
+            [g.cell_measure for g in grids])
+
+    stats, cell = on_grid(n_uniform, lci_only)
+    n = len(designs)
+    err_v = np.full(n, np.nan)
+    err_g = np.full(n, np.nan)
+    calls = float(n_uniform**ndim)
+    if estimates:
+        fine, fine_cell = on_grid(2 * n_uniform, True)
+        vol, vol_f = stats[:, _grid.COL_COUNT] * cell, fine[:, _grid.COL_COUNT] * fine_cell
+        # relative to the reported measure, as the adaptive evaluator's; nothing reachable: 0, or 1 if the finer
+        # grid finds something
+        err_v = np.where(vol > 0.0, np.abs(vol - vol_f) / np.where(vol > 0.0, vol, 1.0),
+                         np.where(vol_f > 0.0, 1.0, 0.0))
+        err_g = np.abs(_gci_of(stats) - _gci_of(fine))
+        calls += float((2 * n_uniform) ** ndim)
+    return AdaptiveResult(stats, cell, err_v, err_g, np.zeros(n, dtype=np.int64), np.full(n, calls),
+                          n_uniform**ndim)
+
+
+def _gci_of(stats: np.ndarray) -> np.ndarray:
+    """GCI (mean LCI over the reachable cells) of statistics rows; 0 where nothing is reachable."""
+    count = stats[:, _grid.COL_COUNT]
+    total = stats[:, _grid.field_column(0, _grid.STAT_SUM)]
+    return np.where(count > 0.0, total / np.where(count > 0.0, count, 1.0), 0.0)
 
 
 def stats_to_metrics(
@@ -389,9 +474,9 @@ def evaluate(
     edges = np.asarray(band_edges, dtype=float)
     packed = mech.pack(design, options)[None, :]
     if tolerance is not None:
-        adaptive_population_stats(mech, [design], options, packed, tolerance, edges, region)  # compile or load
+        tolerance_population_stats(mech, [design], options, packed, tolerance, edges, region)  # compile or load
         t0 = time.perf_counter()
-        ad = adaptive_population_stats(mech, [design], options, packed, tolerance, edges, region)
+        ad = tolerance_population_stats(mech, [design], options, packed, tolerance, edges, region)
         seconds = time.perf_counter() - t0
         values = _metrics_of(mech, [design], options, packed, ad.stats, ad.cell, resolution, band_edges, unit, task,
                              cycle)
@@ -459,9 +544,10 @@ def evaluate_population(
     replaces the uniform ``resolution`` grid and the result also has ``error_volume`` (relative) and
     ``error_gci`` (its per-design error estimates). ``families`` (catalogue families, e.g. {"task", "cycle"}):
     only their metrics, and no workspace grid when "workspace" is not among them (the search evaluates only what
-    its objectives and constraints use). ``fields`` (per-voxel field names, e.g. {"lci"}): the workspace metrics of
-    those fields only (``metrics.field_of``); {"lci"} runs the mechanism's cheaper ``lci_kernel``, whose measure,
-    LCI statistics, bands and error estimates equal the field kernel's bit for bit."""
+    its objectives and constraints use). ``fields`` (per-voxel field names and "estimate", e.g. {"lci"}): the
+    workspace metrics that need only those (``metrics.field_of``); within {"lci", "estimate"} the mechanism's cheaper
+    ``lci_kernel`` runs, whose measure, LCI statistics, bands and error estimates equal the field kernel's bit for
+    bit; the error estimates only with "estimate" (a calibrated uniform grid computes them on a second grid)."""
     options = mech.resolve_options(options)
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
@@ -479,12 +565,15 @@ def evaluate_population(
     args = (resolution, band_edges, unit, task, cycle, families, fields)
     if families is not None and "workspace" not in families:
         return _metrics_of(mech, resolved, options, packed, None, None, *args)
-    lci_only = fields is not None and set(fields) <= {"lci"}
+    lci_only = fields is not None and set(fields) <= {"lci", "estimate"}
     if tolerance is not None:
-        ad = adaptive_population_stats(mech, resolved, options, packed, tolerance, edges, region, lci_only=lci_only)
+        estimates = fields is None or "estimate" in fields
+        ad = tolerance_population_stats(mech, resolved, options, packed, tolerance, edges, region,
+                                        lci_only=lci_only, estimates=estimates)
         out = _metrics_of(mech, resolved, options, packed, ad.stats, ad.cell, *args)
-        out["error_volume"] = ad.error_volume
-        out["error_gci"] = ad.error_gci
+        if estimates:
+            out["error_volume"] = ad.error_volume
+            out["error_gci"] = ad.error_gci
         return out
     grids = [make_grid(mech, d, options, resolution, region) for d in resolved]
     lo = np.stack([g.lo for g in grids])
@@ -492,6 +581,17 @@ def evaluate_population(
     stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges, lci_only=lci_only)
     cell = np.array([g.cell_measure for g in grids])
     return _metrics_of(mech, resolved, options, packed, stats, cell, *args)
+
+
+def evaluator_description(cfg) -> str:
+    """One line naming the workspace evaluator a config runs (reports and manifests): the uniform grid, or the
+    tolerance form's adaptive evaluator or calibrated uniform grid."""
+    tol = config_tolerance(cfg)
+    if tol is None:
+        return f"uniform grid, {cfg.grid.resolution} cells per axis"
+    n = uniform_resolution(cfg.mech, tol)
+    how = "adaptive evaluator" if n is None else f"calibrated uniform grid, {n} cells per axis"
+    return f"tolerance volume {tol.volume:g}, GCI {tol.gci:g}: {how}"
 
 
 def config_tolerance(cfg) -> Tolerance | None:

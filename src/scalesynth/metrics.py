@@ -288,11 +288,13 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
             entries += _field_entries(mech, f, unit, "workspace")
     entries += [
         Metric("error_volume", "error_volume", "workspace", None, "estimate", "1", (0.0, math.inf), "min", None,
-               ("grid.tolerance",), f"the adaptive evaluator's estimate of the relative error of the workspace "
-               f"{mname} (change from its previous refinement level)"),
+               ("grid.tolerance",), f"the tolerance form's estimate of the relative error of the workspace "
+               f"{mname} (adaptive evaluator: change from its previous refinement level; calibrated uniform grid: "
+               "change to the grid twice as fine)"),
         Metric("error_gci", "error_gci", "workspace", None, "estimate", "1", (0.0, math.inf), "min", None,
-               ("grid.tolerance",), "the adaptive evaluator's estimate of the absolute error of the GCI (change "
-               "from its previous refinement level)"),
+               ("grid.tolerance",), "the tolerance form's estimate of the absolute error of the GCI (adaptive "
+               "evaluator: change from its previous refinement level; calibrated uniform grid: change to the grid "
+               "twice as fine)"),
     ]
     entries.append(Metric("task_coverage", "task_coverage", "task", None, "coverage", "1", (0.0, 1.0), "max", 1.0,
                           ("task",), "share of the task box's cells reachable within all limits"))
@@ -319,10 +321,13 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
 
 
 def field_of(m: Metric) -> str | None:
-    """The per-voxel field a workspace or task metric needs: its own field, and the LCI for the measure, count,
-    coverage and error estimates (reachability is the LCI's sign); None for the computed families."""
+    """What a workspace or task metric needs from the evaluator: its per-voxel field, the LCI for the measure, count
+    and coverage (reachability is the LCI's sign), "estimate" for the error estimates (evaluate_population's
+    ``fields``); None for the computed families."""
     if m.family not in ("workspace", "task"):
         return None
+    if m.statistic == "estimate":
+        return "estimate"
     return m.field or "lci"
 
 
@@ -333,7 +338,7 @@ def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, 
     without a resolution)."""
     for need in m.needs:
         if need == "grid.tolerance" and not adaptive:
-            return "needs grid.tolerance without grid.resolution (the adaptive evaluator's estimate)"
+            return "needs grid.tolerance without grid.resolution (the tolerance form's estimate)"
         if need == "cycle" and cycle is None:
             return "needs a cycle section"
         if need == "cycle.limits" and cycle is not None and cycle.speed_limits is None and cycle.force_limits is None:

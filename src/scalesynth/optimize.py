@@ -24,6 +24,7 @@ from scalesynth import io as rio
 from scalesynth import memory, results, rundir
 from scalesynth.config import ConstraintConfig, RunConfig
 from scalesynth.errors import ConfigError, RunError
+from scalesynth.evaluate import evaluator_description
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import RunResult
 
@@ -299,6 +300,7 @@ def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, histo
         "evaluations": int(algorithm.evaluator.n_eval),
         "pop_size": cfg.algorithm.pop_size,
         "grid_resolution": cfg.grid.resolution,
+        "workspace_evaluator": evaluator_description(cfg),
         "objectives": [f"{o.sense} {k}" for o, k in zip(cfg.objectives, problem.objective_keys, strict=True)],
         "hv_reference": [float(v) for v in ref],
         "hv_reference_note": "in minimisation form: maximised objectives enter negated",

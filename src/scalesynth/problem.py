@@ -64,9 +64,9 @@ class SynthesisProblem(Problem):
         # and cycle metrics need no workspace grid); the final population gets the other columns (complete_metrics)
         entries = [metric_entry(cfg, item) for item in [*cfg.objectives, *cfg.constraints]]
         self.searched_families = frozenset(m.family for m in entries)
-        # the per-voxel fields of the searched workspace metrics: None (every field) unless they are the LCI's alone
+        # what the searched workspace metrics need: None (every field) unless the LCI (and the error estimates) alone
         wfields = {_metrics.field_of(m) for m in entries if m.family == "workspace"}
-        self.searched_fields = frozenset(wfields) if wfields <= {"lci"} else None
+        self.searched_fields = frozenset(wfields) if wfields <= {"lci", "estimate"} else None
         n_constr = sum((c.min is not None) + (c.max is not None) for c in cfg.constraints)
         xl = np.array([cfg.bounds[k][0] for k in self.var_names], dtype=float)
         xu = np.array([cfg.bounds[k][1] for k in self.var_names], dtype=float)

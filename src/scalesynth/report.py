@@ -17,7 +17,7 @@ from scalesynth import io as rio
 from scalesynth import labels as lab
 from scalesynth.config import RunConfig
 from scalesynth.errors import ConfigError
-from scalesynth.evaluate import evaluate_config
+from scalesynth.evaluate import evaluate_config, evaluator_description
 from scalesynth.problem import SynthesisProblem
 from scalesynth.results import PLOTS, REPORT, Front, RunResult, infeasibility_lines, load, read_front
 from scalesynth.selection import choose, extremes
@@ -243,7 +243,7 @@ def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[
         "",
         f"- NSGA-II: population {cfg.algorithm.pop_size}, {int(history['generation'].iloc[-1])} generations, "
         f"{int(history['evaluations'].iloc[-1])} evaluations, seed {cfg.algorithm.seed}",
-        f"- grid: {cfg.grid.resolution} cells per axis; dexterity bands {bands}",
+        f"- workspace: {evaluator_description(cfg)}; dexterity bands {bands}",
         f"- objectives: {objectives}",
     ]
     if cfg.constraints:

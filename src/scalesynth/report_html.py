@@ -12,6 +12,7 @@ from scalesynth import interactive as ia
 from scalesynth import io as rio
 from scalesynth import labels as lab
 from scalesynth import workspace_view as wv
+from scalesynth.evaluate import evaluator_description
 
 VIEW_RESOLUTION = 40  # cells per axis of the featured designs' 3-D views (40^3 = 64k cells, ~0.05 s each)
 
@@ -96,7 +97,7 @@ def _summary(cfg, problem, pareto, history, manifest, label) -> str:
     items = [
         f"mechanism {cfg.mechanism}; NSGA-II population {cfg.algorithm.pop_size}, "
         f"{int(history['generation'].iloc[-1]) if len(history) else 0} generations, seed {cfg.algorithm.seed}",
-        f"grid {cfg.grid.resolution} cells per axis; dexterity bands "
+        f"workspace: {evaluator_description(cfg)}; dexterity bands "
         + ", ".join(wv.band_labels(cfg.dexterity.band_edges)),
         f"objectives: {objectives}",
         f"final hypervolume {float(history['hypervolume'].iloc[-1]) if len(history) else 0.0:.6g}; "
