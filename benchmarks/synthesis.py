@@ -79,8 +79,15 @@ def random_designs(cfg, n: int, seed: int = 0) -> list[dict[str, float]]:
 
 
 def evaluator_label(cfg) -> str:
-    tol = getattr(cfg.grid, "tolerance", None)
-    if getattr(cfg.grid, "adaptive", False) and tol is not None:
+    """'adaptive, tolerance ...', 'calibrated uniform N = n, tolerance ...' (the tolerance form on a mechanism's
+    calibrated grid, evaluate.UNIFORM_PLAN_OF) or 'uniform N = n'."""
+    from scalesynth.evaluate import config_tolerance, uniform_resolution
+
+    tol = config_tolerance(cfg)
+    if tol is not None:
+        n = uniform_resolution(cfg.mech, tol)
+        if n is not None:
+            return f"calibrated uniform N = {n}, tolerance volume {tol.volume:g}, GCI {tol.gci:g}"
         return f"adaptive, tolerance volume {tol.volume:g}, GCI {tol.gci:g}"
     return f"uniform N = {cfg.grid.resolution}"
 

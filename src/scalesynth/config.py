@@ -25,19 +25,20 @@ class _Strict(BaseModel):
 
 
 class ToleranceConfig(_Strict):
-    """Accuracy target of the adaptive evaluator (per design, from its own error estimate)."""
+    """Accuracy target of the tolerance form: the adaptive evaluator (per design, from its own error estimate), or a
+    mechanism's calibrated uniform grid (evaluate.UNIFORM_PLAN_OF)."""
 
     volume: float = Field(0.002, gt=0.0, le=0.5, description="relative error of the workspace measure")
     gci: float = Field(5.0e-4, gt=0.0, le=0.5, description="absolute error of the GCI")
 
 
 class GridConfig(_Strict):
-    """Either ``tolerance`` (adaptive evaluator) or ``resolution`` (uniform grid). A given ``resolution`` wins
-    (``--resolution N`` forces the uniform reference grid); ``resolution`` also sets the uniform grids of plots,
-    the report's sections and task boxes without their own resolution."""
+    """Either ``tolerance`` (the tolerance form: adaptive evaluator or calibrated grid) or ``resolution`` (uniform
+    grid). A given ``resolution`` wins (``--resolution N`` forces the uniform reference grid); ``resolution`` also
+    sets the uniform grids of plots, the report's sections and task boxes without their own resolution."""
 
     resolution: int = Field(64, ge=4, le=1024, description="cells per axis")
-    tolerance: ToleranceConfig | None = Field(None, description="accuracy target: adaptive evaluator")
+    tolerance: ToleranceConfig | None = Field(None, description="accuracy target (tolerance form)")
     region: dict[str, tuple[float, float]] | None = Field(
         None, description="override of the mechanism's bounding box, per task axis name: [lo, hi]"
     )
@@ -55,7 +56,8 @@ class GridConfig(_Strict):
 
     @property
     def adaptive(self) -> bool:
-        """Whether the adaptive evaluator runs: a tolerance is given and no resolution is."""
+        """Whether the tolerance form runs (adaptive evaluator or calibrated grid): a tolerance is given and no
+        resolution is."""
         return self.tolerance is not None and "resolution" not in self.model_fields_set
 
     @model_serializer(mode="wrap")

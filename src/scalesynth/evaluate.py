@@ -194,8 +194,9 @@ def uniform_resolution(mech: Mechanism, tolerance: Tolerance) -> int | None:
 
 @dataclass
 class AdaptiveResult:
-    """Statistics of designs from ``adaptive_population_stats``: counts in coarse-cell units (``cell`` the coarse
-    cell measure per design), per-design error estimates and cost."""
+    """Statistics of designs from ``adaptive_population_stats`` (or ``tolerance_population_stats``): counts in
+    coarse-cell units (``cell`` the coarse cell measure per design; a calibrated uniform grid's cell), per-design
+    error estimates and cost (kernel calls; a calibrated uniform grid: its cells, and those of the estimate's)."""
 
     stats: np.ndarray
     cell: np.ndarray
@@ -595,7 +596,7 @@ def evaluator_description(cfg) -> str:
 
 
 def config_tolerance(cfg) -> Tolerance | None:
-    """The config's accuracy target when it asks for the adaptive evaluator (``GridConfig.adaptive``), else None."""
+    """The config's accuracy target when it is in the tolerance form (``GridConfig.adaptive``), else None."""
     if not cfg.grid.adaptive:
         return None
     return Tolerance(volume=cfg.grid.tolerance.volume, gci=cfg.grid.tolerance.gci)
