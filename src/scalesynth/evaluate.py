@@ -164,8 +164,9 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
     # face columns or z-levels no plan passes seed 0 (the task box's wall and thin slabs).
     "rps-upu-tool": ColumnPlan(12, 12, 4, 2, beta=1.0, zlevels=2, zconfirm=1, faces=True),
     # pprs-rprs keeps the 3-D default: none of 332 plans searched (against N = 192, since N = 96 is off) is within
-    # 0.8x on seed 0, the default included (0.96x); against N = 384 even the default is 1.82x on a seed-1 design,
-    # and N = 192 is itself up to 1.35x off N = 384 (benchmarks/notes/adaptive_plans.md): its reference is open
+    # 0.8x on seed 0, the default included (0.96x); N = 192 is itself up to 1.35x off N = 384 on seed-0 designs, and
+    # the default is 1.9x off N = 768 on a seed-1 design (0.36 % too large, its own estimate 0.88x: it stops early;
+    # benchmarks/notes/adaptive_plans.md)
 }
 
 
