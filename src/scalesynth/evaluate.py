@@ -190,8 +190,8 @@ class UniformPlan:
         return min(ok) if ok else None
 
 
-# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/30 of the adaptive evaluator at
-# (0.2 %, 5e-4) (2 ms against 65 ms per design) and 1/100 at (3 %, 5e-3). Ladders on the config's bounds
+# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/50 of the adaptive evaluator
+# at (0.2 %, 5e-4) (N = 72: 1.5 ms against 72 ms per design, one thread). Ladders on the config's bounds
 # (paper_2pauu_ppap.yaml; quick.yaml has the same), worst volume / GCI error as multiples of the tolerance on seed 0 |
 # seed 1 (benchmarks/notes/uniform_plans.md): N = 72 at (0.2 %, 5e-4): 0.41, 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 |
 # 1.06, 1.04; N = 64: 1.04 on seed 0); N = 32 at (1 %, 2.5e-3): 0.68, 0.32 | 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57,
@@ -297,17 +297,18 @@ def tolerance_population_stats(
         # grid finds something
         err_v = np.where(vol > 0.0, np.abs(vol - vol_f) / np.where(vol > 0.0, vol, 1.0),
                          np.where(vol_f > 0.0, 1.0, 0.0))
-        err_g = np.abs(_gci_of(stats) - _gci_of(fine))
+        err_g = np.abs(_field_mean(stats, 0) - _field_mean(fine, 0))
         calls += float((2 * n_uniform) ** ndim)
     return AdaptiveResult(stats, cell, err_v, err_g, np.zeros(n, dtype=np.int64), np.full(n, calls),
                           n_uniform**ndim)
 
 
-def _gci_of(stats: np.ndarray) -> np.ndarray:
-    """GCI (mean LCI over the reachable cells) of statistics rows; 0 where nothing is reachable."""
+def _field_mean(stats: np.ndarray, f: int) -> np.ndarray:
+    """Mean of field slot ``f`` over the reachable cells of statistics rows (slot 0: the GCI); 0 where nothing is
+    reachable."""
     count = stats[:, _grid.COL_COUNT]
-    total = stats[:, _grid.field_column(0, _grid.STAT_SUM)]
-    return np.where(count > 0.0, total / np.where(count > 0.0, count, 1.0), 0.0)
+    has = count > 0
+    return np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUM)] / np.where(has, count, 1.0), 0.0)
 
 
 def stats_to_metrics(
@@ -340,7 +341,7 @@ def stats_to_metrics(
                 out[m.column_for(b)] = np.where(has, band / safe, 0.0) if st == "band_share" else band * cell_measure
         else:
             f = slots[m.field]
-            mean = np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUM)] / safe, 0.0)
+            mean = _field_mean(stats, f)
             if st == "mean":
                 out[m.column] = mean
             elif st == "std":
