@@ -442,9 +442,11 @@ def rps_upu_tool_fields(design, options, x, y, z):
 
 
 def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, beta=1.0, zlevels=0,
-                 zconfirm=1, faces=False):
+                 zconfirm=1, faces=False, ny=None, mirror=(False, False)):
     """NumPy twin of kernels.adaptive.column_stats for one design, vectorised over the active columns of a level:
-    ``fields(points (k, 3)) -> (k, n_fields)`` (field 0 LCI, -1 unreachable); lo, hi: the design's box (3,).
+    ``fields(points (k, 3)) -> (k, n_fields)`` (field 0 LCI, -1 unreachable); lo, hi: the design's box (3,); n, ny:
+    coarse columns along cross axes 0, 1 (ny default n; planar: unused); mirror: the lo face of cross axis 0, 1 is
+    a mirror plane (clamped neighbour, no face column there even with ``faces``).
     Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
     level, evaluations)."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
@@ -452,8 +454,9 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     zlo = lo[ca]
     hz0 = (hi[ca] - zlo) / m
     nudge = 2.0**-20  # kernels.adaptive.END_NUDGE: the end nodes are evaluated just inside the box
+    ny = (n if ny is None else ny) if ndim == 3 else 1
     hx = (hi[0] - lo[0]) / n
-    hy = (hi[1] - lo[1]) / n if ndim == 3 else 1.0
+    hy = (hi[1] - lo[1]) / ny if ndim == 3 else 1.0
     gx = 1.0 / np.sqrt(3.0)
     evals = 0
     nb = len(edges) - 1
@@ -502,7 +505,6 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         S = np.bincount(pc, weights=(w * np.where(ok, q[:, :, 0], 0.0)).sum(axis=1), minlength=nc)
         return L, S, np.repeat(pc, 2), q.reshape(-1, n_fields), w.ravel() * area
 
-    ny = n if ndim == 3 else 1
     ci, cj = (v.ravel() for v in np.meshgrid(np.arange(n), np.arange(ny), indexing="ij"))
     lg, sg = np.zeros((n, ny)), np.zeros((n, ny))
     # face columns [side, L or S, index]: x = lo, hi per j; y = lo, hi per i
@@ -557,10 +559,12 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
                     idx, other = (ci, cj) if axis == 0 else (cj, ci)
                     fg = fxg if axis == 0 else fyg
                     for side in (0, 1):
+                        if side == 0 and mirror[axis]:
+                            continue  # a mirror plane: the edge column is its own neighbour (clamped)
                         e = idx == (0 if side == 0 else lg.shape[axis] - 1)
                         if not e.any():
                             continue
-                        face = lo[axis] + (nudge if side == 0 else n - nudge) * (hx if axis == 0 else hy)
+                        face = lo[axis] + (nudge if side == 0 else (n, ny)[axis] - nudge) * (hx if axis == 0 else hy)
                         FX = np.full(e.sum(), face) if axis == 0 else X[e]
                         FY = np.full(e.sum(), face) if axis == 1 else Y[e]
                         fl, fs, *_ = columns(FX, FY, area, mz)
@@ -574,7 +578,8 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
                 for t, (g, tol) in enumerate(((lg, tol_v), (sg, tol_g))):
                     c, below, above = g[ci, cj], g[lo_i], g[hi_i]
                     if faces:  # ghost neighbour 2 F - c beyond the box face (F: the face column)
-                        below = np.where(idx == 0, 2.0 * fg[0, t, other] - c, below)
+                        if not mirror[axis]:
+                            below = np.where(idx == 0, 2.0 * fg[0, t, other] - c, below)
                         above = np.where(idx == sh - 1, 2.0 * fg[1, t, other] - c, above)
                     d2 = np.abs(above + below - 2.0 * c)
                     flag |= d2 * area / 24.0 > tol * vol * beta / (n * ny)

@@ -1,6 +1,6 @@
 """The accuracy-targeted (adaptive, column) evaluator: the Numba kernel against its NumPy twin (tests/naive.py, the
-same algorithm level by level), the seed-000 volume against the exact quadrature, determinism, degenerate designs
-and the config form."""
+same algorithm level by level), the seed-000 volume against the exact quadrature, the half box with a mirror plane
+against the full box of a symmetric workspace, determinism, degenerate designs and the config form."""
 
 import os
 import subprocess
@@ -45,7 +45,8 @@ def test_column_kernel_equals_numpy_twin(name):
     compilations of it (fused multiply-adds): 1e-12 relative for the count, the LCI statistics and the band
     measures; the other fields' statistics within 1e-12 plus 4x their change when the twin evaluates those fields
     one ulp away from the same points (~1e-16 relative except next to a singular surface). Plans with and without
-    z-levels and box-face columns. The twin evaluates the fields through the
+    z-levels and box-face columns, and one with ny = n - 2 (3-D) and mirror planes on every cross axis (with box-face
+    columns, where the mirror matters). The twin evaluates the fields through the
     mechanism's kernel (population_points_fields) so that only the algorithm is compared; the field kernels
     themselves are checked against NumPy SVD twins in test_fields.py."""
     mech = get(name)
@@ -59,9 +60,11 @@ def test_column_kernel_equals_numpy_twin(name):
         return kgrid.population_points_fields(mech.field_kernel, mech.n_fields, packed[None, :], pts)[0]
 
     n = 6 if ndim == 3 else 12
-    for maxlev, beta, zlevels, zconfirm, faces in ((0, 1.0, 0, 1, False), (2, 1.0, 0, 1, False),
-                                                   (2, 3.0, 0, 1, False), (2, 1.0, 2, 2, True)):
-        opt = dict(zlevels=zlevels, zconfirm=zconfirm, faces=faces)
+    mirror = dict(ny=n - 2, mirror=(True, ndim == 3))
+    for maxlev, beta, zlevels, zconfirm, faces, more in ((0, 1.0, 0, 1, False, {}), (2, 1.0, 0, 1, False, {}),
+                                                         (2, 3.0, 0, 1, False, {}), (2, 1.0, 2, 2, True, {}),
+                                                         (2, 1.0, 0, 1, True, mirror)):
+        opt = dict(zlevels=zlevels, zconfirm=zconfirm, faces=faces, **more)
         s, ev, eg, lv, ne = column_stats(mech.field_kernel, mech.n_fields, packed[None, :], lo[None, :],
                                          hi[None, :], ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt)
         row, tv, tg, tl, tn = column_twin(fields, mech.n_fields, lo, hi, ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES,
@@ -257,6 +260,167 @@ def test_box_face_columns_see_a_wall_inside_the_edge_columns():
     assert volume == pytest.approx(157 / 162, rel=1e-12)
     assert abs(volume - 0.97) <= 1 / 162
     assert est == pytest.approx(abs(157 / 162 - 26 / 27) / (157 / 162), rel=1e-12)
+
+
+@njit(cache=True)
+def _ellipsoid_field(p, x, y, z, out):
+    """Synthetic field kernel, mirror-symmetric about x = p[0] and about y = p[1]: LCI 1 - r^2 inside the ellipsoid
+    r^2 = sum(((x, y, z) - p[0:3]) / p[3:6])^2) < 1, else -1; slot 1 (x - p[0])^2 + (y - p[1])^2 + z; slot 2 r."""
+    u = (x - p[0]) / p[3]
+    v = (y - p[1]) / p[4]
+    w = (z - p[2]) / p[5]
+    r2 = u * u + v * v + w * w
+    out[0] = 1.0 - r2 if r2 < 1.0 else -1.0
+    dx = x - p[0]
+    dy = y - p[1]
+    out[1] = dx * dx + dy * dy + z
+    out[2] = np.sqrt(r2)
+
+
+def _ellipsoid_fields(p):
+    """NumPy twin of _ellipsoid_field: points (k, 3) -> fields (k, 3)."""
+    def fields(pts):
+        d = pts - p[:3]
+        r2 = ((d / p[3:6]) ** 2).sum(axis=1)
+        return np.c_[np.where(r2 < 1.0, 1.0 - r2, -1.0), d[:, 0] ** 2 + d[:, 1] ** 2 + pts[:, 2], np.sqrt(r2)]
+    return fields
+
+
+def test_per_axis_columns_and_mirror_planes_equal_the_numpy_twin():
+    """ny != n and a mirror plane on each cross axis (and both), with and without box-face columns: the kernel
+    equals its NumPy twin (same level and number of evaluations, estimates to 1e-10, rows to 1e-12 relative as in
+    test_column_kernel_equals_numpy_twin) on an ellipsoid cut by the box on every cross face (3-D, 6 x 4 columns,
+    refining to level 2) and an ellipse (planar, 8 columns; ny is ignored there). Without face columns a mirror
+    plane changes nothing (the clamped neighbour is what the box edge uses anyway): byte-identical rows. With
+    them, it drops that face's ghost columns and so changes the refinement (the evaluation counts below)."""
+    lo, hi = np.array([-0.6, -0.3, 0.0]), np.array([0.8, 0.7, 1.0])
+    for ndim, n, ny, mirrors in ((3, 6, 4, ((False, False), (True, False), (False, True), (True, True))),
+                                 (2, 8, 5, ((False, False), (True, False)))):
+        # planar: the plane z = lo[2] = 0 through the centre
+        p = np.array([0.1, 0.2, 0.5 if ndim == 3 else 0.0, 0.9, 0.6, 0.45])
+        runs = {}
+        for mirror in mirrors:
+            for faces in (False, True):
+                opt = dict(zlevels=1, zconfirm=1, faces=faces, ny=ny, mirror=mirror)
+                s, ev, eg, lv, ne = column_stats(_ellipsoid_field, 3, p[None], lo[None], hi[None], ndim, n, 6, 6, 2,
+                                                 2e-4, 2e-4, EDGES, 1.0, **opt)
+                row, tv, tg, tl, tn = column_twin(_ellipsoid_fields(p), 3, lo, hi, ndim, n, 6, 6, 2, 2e-4, 2e-4,
+                                                  EDGES, 1.0, **opt)
+                assert (lv[0], ne[0]) == (tl, tn), (ndim, mirror, faces)
+                assert lv[0] == 2  # the refinement, and the mirror's role in it at level 1, were compared
+                assert ev[0] == pytest.approx(tv, rel=1e-10, abs=1e-15)
+                assert eg[0] == pytest.approx(tg, rel=1e-10, abs=1e-15)
+                np.testing.assert_allclose(s[0], row, rtol=1e-12, atol=1e-12 * np.abs(row).max())
+                runs[mirror, faces] = (s[0], ne[0])
+        for mirror in mirrors[1:]:
+            assert runs[mirror, False][0].tobytes() == runs[(False, False), False][0].tobytes()
+        # with face columns the mirror planes drop the lo faces' ghosts and so change the refinement: evaluations
+        # (both kernel and twin) 64 976 without, 65 096 / 64 288 / 64 408 with mirror x / y / both (3-D); 1 856
+        # against 1 766 with mirror x (planar)
+        calls = [int(runs[mirror, True][1]) for mirror in mirrors]
+        assert calls == ([64976, 65096, 64288, 64408] if ndim == 3 else [1856, 1766])
+    # planar: axis 1 is the column axis, not a cross axis, so a mirror plane there is refused
+    with pytest.raises(ValueError, match="mirror on axis 1 of a planar task"):
+        column_stats(_ellipsoid_field, 3, p[None], lo[None], hi[None], 2, 8, 6, 6, 2, 2e-4, 2e-4, EDGES,
+                     mirror=(False, True))
+
+
+def _mirror_pair(kernel, n_fields, packed, lo, hi, ndim, axis, n, m, nbis, maxlev, tol_v, tol_g, beta,
+                 reach_kernel=None, **opt):
+    """column_stats of the box made symmetric about 0 on cross axis ``axis`` ([-a, a], a = max(-lo, hi) there;
+    n x n columns) and of its half [0, a] (n / 2 columns on that axis, its lo face a mirror plane):
+    (full, half), each column_stats's 5-tuple for one design."""
+    lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+    a = max(-lo[axis], hi[axis])
+    lo[axis], hi[axis] = -a, a
+    full = column_stats(kernel, n_fields, packed[None], lo[None], hi[None], ndim, n, m, nbis, maxlev, tol_v, tol_g,
+                        EDGES, beta, reach_kernel=reach_kernel, **opt)
+    lo[axis] = 0.0
+    nx, ny = (n // 2, n) if axis == 0 else (n, n // 2)
+    half = column_stats(kernel, n_fields, packed[None], lo[None], hi[None], ndim, nx, m, nbis, maxlev, tol_v, tol_g,
+                        EDGES, beta, reach_kernel=reach_kernel, ny=ny, mirror=(axis == 0, axis == 1), **opt)
+    return full, half
+
+
+def _assert_half_is_half(full, half, n_fields):
+    """The half box's row (counts in its coarse cells, which are the full box's) doubled equals the full box's:
+    count, every field's sum and sum of squares and the band measures to 1e-9 relative (the same columns at the
+    same points up to the rounding of their coordinates, summed in another order: measured <= 2e-13); min and max
+    to 1e-12 of the field's magnitude (a minimum near 0, e.g. an LCI of 2e-5 next to the boundary, differs in
+    the last bits of its point: 1e-16 absolute); the same refinement level and error estimates (relative
+    quantities: 1e-9); kernel calls exactly half (the full box's columns are the half box's and their mirror
+    images, with as many calls each; the mirror face's ghost columns are not evaluated): measured 0.5000 on
+    every case here."""
+    sf, sh = full[0][0], half[0][0]
+    mm = [c for f in range(n_fields) for c in (3 + 4 * f, 4 + 4 * f)]
+    ext = [c for c in range(len(sf)) if c not in mm]
+    np.testing.assert_allclose(2.0 * sh[ext], sf[ext], rtol=1e-9, atol=0.0)
+    scale = np.repeat(np.maximum(np.abs(sf[3::4][:n_fields]), np.abs(sf[4::4][:n_fields])), 2)
+    assert np.all(np.abs(sh[mm] - sf[mm]) <= 1e-12 * scale)
+    assert sf[0] > 0
+    assert half[3][0] == full[3][0]
+    assert half[1][0] == pytest.approx(full[1][0], rel=1e-9)
+    assert half[2][0] == pytest.approx(full[2][0], rel=1e-9)
+    assert half[4][0] == 0.5 * full[4][0]
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+@pytest.mark.parametrize("faces", [False, True])
+def test_mirror_half_box_equals_the_full_box_synthetic(axis, faces):
+    """An ellipsoid centred on the plane x = 0 (axis 0) or y = 0 (axis 1), cut by the box's faces on that axis
+    (box +-0.8 against semi-axis 1, +-0.6 against 0.7): the full box with 6 x 6 columns and the half box with 3 on
+    that axis and a mirror plane at 0 agree (_assert_half_is_half), refining to level 3 (tolerance 2e-4, one
+    z-level); also planar (an ellipse symmetric about x = 0, 8 columns, up to 4 levels: it stops at level 3, with
+    face columns at 2). Measured calls full / half: x 109 360 / 54 680 (with faces 114 204 / 57 102), y 81 568 /
+    40 784 (86 436 / 43 218), planar 4 460 / 2 230 (4 566 / 2 283); sums within 6e-15 relative."""
+    if axis == 0:
+        p, lo, hi = np.array([0.0, 0.1, 0.5, 1.0, 0.7, 0.4]), [-0.8, -0.7, 0.0], [0.8, 0.9, 1.0]
+    else:
+        p, lo, hi = np.array([0.1, 0.0, 0.5, 1.0, 0.7, 0.4]), [-0.95, -0.6, 0.0], [1.15, 0.6, 1.0]
+    full, half = _mirror_pair(_ellipsoid_field, 3, p, lo, hi, 3, axis, 6, 6, 8, 3, 2e-4, 2e-4, 1.0, zlevels=1,
+                              faces=faces)
+    assert full[3][0] == 3
+    _assert_half_is_half(full, half, 3)
+    if axis == 0:
+        p2 = np.array([0.0, 0.3, 0.0, 1.0, 0.7, 1.0])
+        full, half = _mirror_pair(_ellipsoid_field, 3, p2, [-0.8, -0.5, 0.0], [0.8, 1.1, 0.0], 2, 0, 8, 16, 8, 4,
+                                  1e-5, 1e-5, 1.0, faces=faces)
+        assert full[3][0] == (2 if faces else 3)
+        _assert_half_is_half(full, half, 3)
+
+
+@pytest.mark.parametrize("name, axis", [("rps-upu-tool", 1), ("ups-sspr", 1), ("planar-fivebar", 0),
+                                        ("2pauu-ppap", 0), ("2pauu-ppap", 1)])
+def test_mirror_half_box_equals_the_full_box(name, axis):
+    """Mechanisms whose fields are mirror-symmetric about 0 on a cross axis (rps-upu-tool in y, ups-sspr in beta,
+    the five-bar in x, 2pauu-ppap in x and y), the config's design and options, its bounding box made symmetric
+    on that axis (it already is for all five), with the mechanism's own plan (planar-fivebar: 16 columns, 32
+    z-cells, 8 bisections, 4 levels instead of 64 / 128 / 8 / 6; an odd column count would be rounded up, none
+    is): the half box with a mirror plane equals the full box (_assert_half_is_half). Measured: rps-upu-tool
+    77 754 / 38 877 calls (level 2: z-levels, faces and both refinements), ups-sspr 4 832 / 2 416 (level 1),
+    the five-bar 3 096 / 1 548 (level 2), 2pauu-ppap 238 156 / 119 078 (level 1, faces); sums within 2e-13. On 40
+    random designs each (same plans) levels and calls (exactly half) agree everywhere, the count, LCI statistics
+    and band measures within 2e-14, the other fields' sums within 1.2e-9 (five-bar deflection, 2pauu-ppap
+    sigma_max 6e-10) except rps-upu-tool's stiffness_min and deflection: up to 8e-7 relative. Those field kernels
+    change by up to 1.9e-6 (five-bar 5e-8) relative when the point moves one ulp, next to a singular pose, and the
+    half box's column coordinates are the full box's up to rounding: a property of the field kernels, not of the
+    mirror plane (hence the config designs here, where every sum stays within 2e-13)."""
+    from scalesynth.evaluate import adaptive_plan, design_boxes
+
+    mech = get(name)
+    cfg = load_config(config_for(name))
+    design, options = cfg.resolved_design(), cfg.resolved_options()
+    ndim = len(mech.task_axes)
+    lo, hi = design_boxes(mech, [design], options)
+    assert lo[0, axis] == -hi[0, axis]
+    plan = adaptive_plan(mech) if ndim == 3 else ColumnPlan(16, 32, 8, 4)
+    n = plan.columns + plan.columns % 2
+    full, half = _mirror_pair(mech.field_kernel, mech.n_fields, mech.pack(design, options), lo[0], hi[0], ndim, axis,
+                              n, plan.cells, plan.bisections, plan.levels, 0.002, 5e-4, plan.beta,
+                              reach_kernel=mech.reach_kernel, zlevels=plan.zlevels, zconfirm=plan.zconfirm,
+                              faces=plan.faces)
+    assert full[3][0] >= 1
+    _assert_half_is_half(full, half, mech.n_fields)
 
 
 @pytest.mark.parametrize("name", ["rps-upu", "rps-upu-tool"])

@@ -10,10 +10,10 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    can miss the same shell twice, hence the confirmations (issue 15: 2pauu-ppap's lobe tips, pprs-rprs's and
    rps-upu-tool's thin slabs, 1-24 % of the volume at m = 8).
 1. Columns run along the last task axis ("z"; planar mechanisms: y) over a cell-centred grid of the other axes
-   (n x n columns; planar: n). Along a column reachability is evaluated at the m + 1 nodes ``zlo + k hz`` (the
-   mechanism's reach kernel: slot 0 alone); where reachability changes between two nodes, ``nbis`` bisection
-   steps locate the boundary (estimate: the midpoint of the last bracket, error <= hz / 2^(nbis+1)). So the
-   column's reachable length is exact to that precision, not a voxel count.
+   (nx x ny columns: column_stats's n, ny; planar: nx). Along a column reachability is evaluated at the m + 1
+   nodes ``zlo + k hz`` (the mechanism's reach kernel: slot 0 alone); where reachability changes between two
+   nodes, ``nbis`` bisection steps locate the boundary (estimate: the midpoint of the last bracket, error <=
+   hz / 2^(nbis+1)). So the column's reachable length is exact to that precision, not a voxel count.
 2. Each reachable piece of a z-cell is integrated by the 2-point Gauss-Legendre rule: every field at its two points,
    each with half the piece's length (a point that turns out unreachable gives its weight to the other; a piece
    with neither reachable is dropped). The points' fields and weights feed the shared statistics accumulator
@@ -24,9 +24,11 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    exact for linear variation; walls and silhouettes give large second differences). At the box the neighbour is
    the edge column itself (clamped), or, with ``faces``, the ghost value 2 F - L where F is the column on the box
    face (x = lo or hi; y = lo or hi) next to it: a wall between an edge column's centre and the box face (a task
-   box cutting the workspace: rps-upu-tool) is otherwise invisible. A column whose indicator x cell area / 24
-   exceeds its share ``beta * tol * V / n^(ndim-1)`` is refined: its cell splits into 3 x 3 (planar: 3) cells,
-   each with its own column (the centre one is its parent's column: the same point, reused with 1/9 of
+   box cutting the workspace: rps-upu-tool) is otherwise invisible. A lo face declared a mirror plane (``mirror``:
+   a half box of a field symmetric about that face) has no ghost: the neighbour across it is the edge column's
+   mirror image, i.e. the edge column itself (clamped). A column whose indicator x cell area / 24 exceeds its
+   share ``beta * tol * V / (nx ny)`` (planar: ``/ nx``) is refined: its cell splits into 3 x 3 (planar: 3)
+   cells, each with its own column (the centre one is its parent's column: the same point, reused with 1/9 of
    the weight, not recomputed). The next level repeats steps 1-3 on the new columns, with
    the others held at their coarser values.
 4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
@@ -39,8 +41,11 @@ Limits: a change of 0 between two levels is not proof of accuracy (a wall whose 
 on one side of it; tests/test_adaptive.py::test_box_face_columns_see_a_wall_inside_the_edge_columns); a shell
 thinner than the finest z-cell, or a slit narrower than the finest column spacing, is still missed.
 
-Counts are in units of the coarse cell (cross cell x hz with hz = box / m): measure = count x hx hy hz. Parallel
-over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
+Counts are in units of the coarse cell (cross cell x hz with hz = box / m): measure = count x hx hy hz with
+hx = box / nx, hy = box / ny. So the half box [0, hi] of a box symmetric about 0 on a cross axis, with half the
+columns on that axis and its lo face a mirror plane, evaluates the same columns as the full box's upper half and
+makes the same refinement decisions there (up to rounding): its extensive statistics are half the full box's.
+Parallel over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
 """
 
 from __future__ import annotations
@@ -117,9 +122,11 @@ def level_sums(lg, sg, area):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces, fxg, fyg, flags):
+def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces, mirror_x, mirror_y, fxg, fyg,
+                 flags):
     """flags[a] = whether active column a (cell ci[a], cj[a]) is refined: a second difference of the column
-    measure (or LCI sum) along a cross axis, x area / 24, above its budget (neighbours clamped at the box)."""
+    measure (or LCI sum) along a cross axis, x area / 24, above its budget (neighbours clamped at the box; with
+    ``faces`` the face ghosts instead, except on a lo face that is a mirror plane: ``mirror_x``, ``mirror_y``)."""
     nl = lg.shape[0]
     nyl = lg.shape[1]
     for a in range(n_active):
@@ -142,7 +149,8 @@ def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces
                     idx = i if axis == 0 else j
                     other = j if axis == 0 else i
                     fg = fxg if axis == 0 else fyg
-                    if idx == 0:
+                    # a mirror plane keeps the clamped neighbour: the edge column's mirror image is itself
+                    if idx == 0 and not (mirror_x if axis == 0 else mirror_y):
                         below = 2.0 * fg[0, t, other] - c
                     if idx == (nl - 1 if axis == 0 else nyl - 1):
                         above = 2.0 * fg[1, t, other] - c
@@ -253,20 +261,21 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
     out[3] = evals
 
 
-def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces, edges, row,
-                  info):
+def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
+                  mirror_x, mirror_y, edges, row, info):
     """Template (serial; FIELD_KERNEL is the bound ``_column``): statistics row of one design into ``row``; info:
-    error_volume, error_gci, level, evaluations."""
+    error_volume, error_gci, level, evaluations. nx, ny3: coarse columns along cross axes 0, 1 (ny3 unused when
+    planar); mirror_x, mirror_y: the lo face of cross axis 0, 1 is a mirror plane (no face ghost there)."""
     n_fields = N_FIELDS
     nb = edges.shape[0] - 1
     ncol = 1 + 4 * n_fields + nb
-    ny = n if ndim == 3 else 1
+    ny = ny3 if ndim == 3 else 1
     ca = ndim - 1
     init_row(row, n_fields)
     zlo = lo_d[ca]
     hz0 = _div(hi_d[ca] - zlo, m)
-    hx = _div(hi_d[0] - lo_d[0], n)
-    hy = _div(hi_d[1] - lo_d[1], n) if ndim == 3 else 1.0
+    hx = _div(hi_d[0] - lo_d[0], nx)
+    hy = _div(hi_d[1] - lo_d[1], ny) if ndim == 3 else 1.0
     zfix = lo_d[2]
     info[:] = 0.0
     if not (hz0 > 0.0 and hx > 0.0 and hy > 0.0):
@@ -284,7 +293,7 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     out = np.empty(4)
     evals = 0.0
     # level 0: every cell of the cross grid is active, in (i, j) order
-    n_active = n * ny
+    n_active = nx * ny
     ci = np.empty(n_active, dtype=np.int64)
     cj = np.empty(n_active, dtype=np.int64)
     for a in range(n_active):
@@ -294,12 +303,12 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     src = np.full(n_active, -1, dtype=np.int64)
     prev_rows = np.empty((0, ncol))
     nk = 9 if ndim == 3 else 3
-    lg = np.zeros((n, ny))
-    sg = np.zeros((n, ny))
+    lg = np.zeros((nx, ny))
+    sg = np.zeros((nx, ny))
     # box-face columns (step 3): measure and LCI sum of the column on the face x = lo, x = hi (per j), y = lo,
     # y = hi (per i) next to each edge column, [side, L or S, index]
     fxg = np.zeros((2, 2, ny))
-    fyg = np.zeros((2, 2, n))
+    fyg = np.zeros((2, 2, nx))
     prev_v = 0.0
     prev_g = 0.0
     err_v = 0.0
@@ -376,9 +385,11 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
                         for side in range(2):
                             if idx != (0 if side == 0 else edge):
                                 continue
+                            if side == 0 and (mirror_x if axis == 0 else mirror_y):
+                                continue  # a mirror plane: the clamped neighbour, no ghost (flag_columns)
                             x = _centre(lo_d[0], ci[a], hx, scale)
                             y = _centre(lo_d[1], cj[a], hy, scale)
-                            fpos = END_NUDGE if side == 0 else n - END_NUDGE
+                            fpos = END_NUDGE if side == 0 else (nx if axis == 0 else ny) - END_NUDGE
                             if axis == 0:
                                 x = _add_product(lo_d[0], fpos, hx)
                             else:
@@ -392,9 +403,9 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
                             else:
                                 fyg[side, 0, ci[a]] = out[0]
                                 fyg[side, 1, ci[a]] = out[1]
-            ncell0 = n * ny
+            ncell0 = nx * ny
             flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
-                         tol_g * vol * beta / ncell0, faces, fxg, fyg, flags)
+                         tol_g * vol * beta / ncell0, faces, mirror_x, mirror_y, fxg, fyg, flags)
         n_flag = 0
         for a in range(n_active):
             if flags[a]:
@@ -432,35 +443,47 @@ def _design_stats(p, lo_d, hi_d, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, z
     info[3] = evals
 
 
-def _column_stats(params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces, edges):
+def _column_stats(params, lo, hi, ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
+                  mirror_x, mirror_y, edges):
     """Template (parallel over designs): FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel."""
     n_designs = params.shape[0]
     stats = np.zeros((n_designs, 1 + 4 * N_FIELDS + edges.shape[0] - 1))
     info = np.zeros((n_designs, 4))
     for d in prange(n_designs):
-        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, n, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
-                     edges, stats[d], info[d])
+        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm,
+                     faces, mirror_x, mirror_y, edges, stats[d], info[d])
     return stats, info
 
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
-                 beta=1.0, zlevels=0, zconfirm=1, faces=False, reach_kernel=None):
+                 beta=1.0, zlevels=0, zconfirm=1, faces=False, reach_kernel=None, ny: int | None = None,
+                 mirror: tuple[bool, bool] = (False, False)):
     """Statistics rows of every design by the column algorithm (module docstring).
 
     params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
-    per cross axis; m: z-cells per column; nbis: bisection steps per boundary crossing; maxlev: most refinement
+    along cross axis 0 (and axis 1 unless ``ny``); ny: coarse columns along cross axis 1 (default n; ignored when
+    planar); m: z-cells per column; nbis: bisection steps per boundary crossing; maxlev: most refinement
     levels; tol_v, tol_g: relative measure and absolute GCI tolerance; edges: band edges; beta: share of the
     tolerance one coarse column's error indicator may take before it is refined. Returns (stats (d,
     stat_columns), error_volume (d,), error_gci (d,), levels (d,) int64, evaluations (d,)): counts in units of the
-    coarse cell (hx hy hz with hx = (hi - lo)[0] / n, ...; planar hx hz). reach_kernel: the nodes' and bisection
-    points' kernel (module header; default the field kernel). Evaluations count calls of either kernel.
+    coarse cell (hx hy hz with hx = (hi - lo)[0] / n, hy = (hi - lo)[1] / ny; planar hx hz). reach_kernel: the
+    nodes' and bisection points' kernel (module header; default the field kernel). Evaluations count calls of
+    either kernel. mirror: (axis 0, axis 1) whether the box's lo face on that cross axis is a mirror plane of the
+    fields: the edge columns' neighbour across it is themselves and no face column is evaluated there even with
+    ``faces`` (module docstring, step 3); planar: axis 1 is the column axis, a mirror there is an error.
     """
+    ny = int(n) if ny is None or int(ndim) == 2 else int(ny)
+    mirror_x, mirror_y = (bool(v) for v in mirror)
+    if ny < 1 or int(n) < 1:
+        raise ValueError(f"column counts must be >= 1 (n={n}, ny={ny})")
+    if mirror_y and int(ndim) == 2:
+        raise ValueError("mirror on axis 1 of a planar task: that is the column axis, not a cross axis")
     reach = field_kernel if reach_kernel is None else reach_kernel
     col = bind(_column, field_kernel, n_fields, extra={"REACH_KERNEL": reach}, fastmath=FASTMATH)
     one = bind(_design_stats, col, n_fields, fastmath=FASTMATH)
     run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
     stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),
-                      np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), int(m), int(nbis), int(maxlev),
-                      float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces),
-                      np.ascontiguousarray(edges, dtype=float))
+                      np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), ny, int(m), int(nbis), int(maxlev),
+                      float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces), mirror_x,
+                      mirror_y, np.ascontiguousarray(edges, dtype=float))
     return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()
