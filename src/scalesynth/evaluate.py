@@ -233,12 +233,16 @@ def adaptive_population_stats(
     boxes: Grid | None = None,
     plan: ColumnPlan | None = None,
     lci_only: bool = False,
+    mirror: bool = True,
 ) -> AdaptiveResult:
     """Statistics of every design by the adaptive column evaluator (kernels.adaptive), refined per design until
     its error estimate (change from the previous level) meets ``tolerance`` or the plan's last level is reached.
     ``boxes``: one fixed box for every design (the task box) instead of each design's bounding box. ``lci_only``:
     the Gauss points run ``Mechanism.lci_kernel`` (only the count, LCI statistics, bands and estimates are
-    meaningful; they equal the full kernel's bit for bit: the refinement reads slot 0 alone)."""
+    meaningful; they equal the full kernel's bit for bit: the refinement reads slot 0 alone). ``mirror``: on each of
+    the mechanism's mirror axes (``mirror_halves``) only the half box >= 0 is evaluated, with half the plan's
+    columns (or z-cells) there, and the extensive statistics are doubled: the same columns and nodes as the full
+    box, to rounding (tests/test_mirror.py)."""
     from scalesynth.kernels.adaptive import column_stats
 
     n = len(designs)
@@ -250,12 +254,40 @@ def adaptive_population_stats(
         lo = np.tile(boxes.lo, (n, 1))
         hi = np.tile(boxes.lo + boxes.step * boxes.shape, (n, 1))
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
+    halves = mirror_halves(mech, options, lo, hi, plan) if mirror else ()
+    counts = [plan.columns, plan.columns if ndim == 3 else 1, plan.cells]  # per task axis (planar: x, -, y)
+    axis_slot = (0, 1, 2) if ndim == 3 else (0, 2)
+    mirror_lo = [False, False]
+    lo = lo.copy()
+    for a in halves:
+        lo[:, a] = 0.0
+        counts[axis_slot[a]] //= 2
+        if axis_slot[a] < 2:
+            mirror_lo[axis_slot[a]] = True
     kernel = mech.lci_kernel if lci_only else mech.field_kernel
     stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, lo, hi, ndim,
-                                                      plan.columns, plan.cells, plan.bisections, plan.levels,
+                                                      counts[0], counts[2], plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
-                                                      plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel)
+                                                      plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel,
+                                                      ny=counts[1] if ndim == 3 else None,
+                                                      mirror=(mirror_lo[0], mirror_lo[1]))
+    if halves:
+        stats = _grid.scale_extensive(stats, mech.n_fields, float(2 ** len(halves)))
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
+
+
+def mirror_halves(mech: Mechanism, options: Mapping[str, Any], lo: np.ndarray, hi: np.ndarray,
+                  plan: ColumnPlan) -> tuple[int, ...]:
+    """The task axes the adaptive evaluator halves: the mechanism's mirror axes (``Mechanism.mirror_axes``) on
+    which every design's box (lo, hi: (n, 3)) is symmetric about 0 exactly and the plan's column count (or, on the
+    column axis, its z-cells) is even, so the half box holds exactly half of the full box's columns and nodes."""
+    ndim = len(mech.task_axes)
+    out = []
+    for a in mech.mirror_axes(options):
+        count = plan.cells if a == ndim - 1 else plan.columns
+        if count % 2 == 0 and np.all(lo[:, a] == -hi[:, a]):  # a degenerate design's empty box (0, 0) halves too
+            out.append(a)
+    return tuple(out)
 
 
 def tolerance_population_stats(

@@ -69,6 +69,19 @@ def stat_columns(n_fields: int, n_bands: int) -> int:
     return 1 + N_STATS * n_fields + n_bands
 
 
+def scale_extensive(stats: np.ndarray, n_fields: int, factor: float) -> np.ndarray:
+    """Statistics rows (d, stat_columns) with the extensive columns (count, every field's sum and sum of squares,
+    the bands) multiplied by ``factor`` and min/max kept: the rows of ``factor`` mirror-image copies of the
+    evaluated region (evaluate.adaptive_population_stats)."""
+    out = np.array(stats, dtype=float, copy=True)
+    out[:, COL_COUNT] *= factor
+    for f in range(n_fields):
+        out[:, 1 + N_STATS * f + STAT_SUM] *= factor
+        out[:, 1 + N_STATS * f + STAT_SUMSQ] *= factor
+    out[:, 1 + N_STATS * n_fields:] *= factor
+    return out
+
+
 @njit(cache=True, fastmath=FASTMATH, inline="always")
 def write_unreachable(out):
     """The pose is not reachable: LCI -1, every other field 0."""

@@ -299,6 +299,13 @@ class Mechanism(ABC):
         point); the cycle analysis differentiates it to get the payload's velocity and acceleration."""
         raise InvalidParameter(f"mechanism: {self.name} has no payload point yet (cycles on its task axes need it)")
 
+    def mirror_axes(self, options: Mapping[str, Any]) -> tuple[int, ...]:
+        """Task axes a on which, under these resolved options, every design's reachable set and every field are
+        symmetric about 0: f(.., x_a, ..) = f(.., -x_a, ..), because the pose at -x_a is the mirror image of the
+        pose at x_a (tests/test_mirror.py checks each declaration on random designs and options). The tolerance form
+        then evaluates only the half box x_a >= 0 where the box is symmetric about 0 (evaluate.py). Default: none."""
+        return ()
+
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray,
                    lci_only: bool = False):
         """Statistics rows of every field for many designs (layout in kernels.grid); ``lci_only``: only the count,

@@ -124,6 +124,12 @@ def radii(options: Mapping[str, Any], defaults: Mapping[str, float]) -> dict[str
     return {k: float(value) for k in out}
 
 
+def mirrored_radii(options: Mapping[str, Any], defaults: Mapping[str, float], pairs: Iterable[tuple[str, str]]) -> bool:
+    """Whether every pair of bodies that a mirror symmetry swaps has the same capsule radius (``radii``)."""
+    rad = radii(options, defaults)
+    return all(rad[a] == rad[b] for a, b in pairs)
+
+
 def check_flag_option(options: dict[str, Any], name: str) -> None:
     """A boolean option (true/false); raise InvalidParameter naming it otherwise."""
     if not isinstance(options.get(name), bool):

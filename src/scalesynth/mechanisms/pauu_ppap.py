@@ -712,6 +712,21 @@ class PauuPpap(Mechanism):
             X[:, j] = 0.0
         return X
 
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """y (axis 1): the two PaUU chains lie in planes y = const and the PPaP stroke is d = y, so the pose at -y is
+        the mirror image in y = 0 of the pose at y, given symmetric stroke limits and no load along y. x (axis 0):
+        the mirror image in x = 0 swaps the two PaUU chains, given one working mode for both ('++' or '--'), equal
+        theta1 and theta2 limits, equal radii of the swapped bodies and no load along x."""
+        axes = []
+        stroke = options.get("stroke_limits")
+        if options["load"][0] == 0.0 and options["mode"][0] == options["mode"][1] \
+                and options.get("theta1_limits") == options.get("theta2_limits") \
+                and links.mirrored_radii(options, LINK_RADII, [("arm1", "arm2"), ("link1", "link2")]):
+            axes.append(0)
+        if options["load"][1] == 0.0 and (stroke is None or stroke[0] == -stroke[1]):
+            axes.append(1)
+        return tuple(axes)
+
     def bounding_box(self, design, options):
         """Tight box of the reachable set: |x| <= l1 + l2 - |m - n| (both annuli), |y| < l2, |z - e| <= l1 + l2,
         clipped by the stroke limits and z_min (spec §1.9/§1.10; the spec's box uses l1 + l2 + |m - n| in x)."""

@@ -338,6 +338,23 @@ class PlanarFivebar(Mechanism):
     def kernel_branch(self, options) -> str:
         return options["mode"]
 
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """x (axis 0): the mirror image in x = 0 swaps the two chains (alpha2 = pi - alpha1), so with a working mode
+        whose two chains mirror each other ('+-' or '-+'), alpha2 limits that mirror the alpha1 limits (both null,
+        or equal packed bounds to rounding), equal radii of the swapped bodies and no load along x every field is
+        symmetric (the parallelograms carry no load: point_fields)."""
+        if options["mode"] not in ("+-", "-+") or options["load"][0] != 0.0:
+            return ()
+        if not links.mirrored_radii(options, LINK_RADII, [("arm1", "arm2"), ("forearm1", "forearm2")]):
+            return ()
+        p = self.pack(self.default_design(), options)
+        one, two = p[_LIM1 : _LIM1 + 6], p[_LIM2 : _LIM2 + 6]
+        # the mirror of [lo, hi] is [pi - hi, pi - lo]: cos changes sign, sin stays
+        mirrored = np.array([one[0], -one[3], one[4], -one[1], one[2], one[5]])
+        if not np.allclose(two, mirrored, rtol=0.0, atol=1e-12):
+            return ()
+        return (0,)
+
     def bounding_box(self, design, options):
         """Box of the reachable set: P lies in both disks of radius L = l1 + l2 around (+-r, 0), so
         |x| <= L - r and |y| <= sqrt(L^2 - r^2) (both attained at a fully stretched chain); the third entry is

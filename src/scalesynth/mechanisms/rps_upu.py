@@ -856,6 +856,14 @@ class RpsUpu(Mechanism):
     def kernel_branch(self, options) -> str:
         return BRANCH
 
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """psi (axis 2): the pose at -psi is the mirror image in y = 0 of the pose at psi (legs 1 and 2 swap; both
+        models and chain-3 variants: the yaw and y0 change sign), so with equal leg-1 and leg-2 radii and no load along
+        y every field is symmetric."""
+        if links.mirrored_radii(options, LINK_RADII, [("leg1", "leg2")]) and options["load"][1] == 0.0:
+            return (2,)
+        return ()
+
     def bounding_box(self, design, options):
         """The configured workspace box (z_range, theta_range, psi_range), in mm and rad (spec §2.8)."""
         lo = np.array([options["z_range"][0], options["theta_range"][0], options["psi_range"][0]], dtype=float)
@@ -1474,6 +1482,14 @@ class RpsUpuTool(RpsUpu):
 
     def kernel_branch(self, options) -> str:
         return "++"
+
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """y (axis 1): T at -y is reached by the mirror image (psi -> -psi, RpsUpu.mirror_axes) of the pose reaching
+        T at y, so a psi range symmetric about 0 is needed as well."""
+        lo, hi = options["psi_range"]
+        if lo == -hi and links.mirrored_radii(options, TOOL_RADII, [("leg1", "leg2")]) and options["load"][1] == 0.0:
+            return (1,)
+        return ()
 
     def bounding_box(self, design, options):
         """Interval bound of T = (-d sin(theta) cos(psi), d sin(psi), z0 - d cos(theta) cos(psi)) over the pose

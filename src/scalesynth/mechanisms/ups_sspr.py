@@ -539,6 +539,16 @@ class UpsSspr(Mechanism):
     def kernel_branch(self, options) -> str:
         return IK_LABEL
 
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """beta (axis 1): the pose at -beta is the mirror image in x = 0 of the pose at beta (Ry(-beta) Rx(alpha) =
+        M Ry(beta) Rx(alpha) M, M = diag(-1, 1, 1); the UPS legs 2 and 3 swap, the SR link and the SPR leg stay in
+        x = 0), so with equal l2 and l3 limits, equal leg-2 and leg-3 radii and no load along x every field is
+        symmetric."""
+        same_limits = options.get("l2_limits") == options.get("l3_limits")
+        if same_limits and links.mirrored_radii(options, LINK_RADII, [("leg2", "leg3")]) and options["load"][0] == 0.0:
+            return (1,)
+        return ()
+
     def bounding_box(self, design, options):
         """The workspace box (alpha_range, beta_range, Y box), with Y also clipped to the slab the l1 limits allow:
         l1 is monotone in Y, so that slab is exact (spec §3.8: l1 in [80, 110] gives Y in [-37.5, 48] for the
