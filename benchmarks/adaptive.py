@@ -28,7 +28,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 
 from scalesynth.config import load_config  # noqa: E402
-from scalesynth.evaluate import Tolerance, adaptive_plan, adaptive_population_stats, make_grid  # noqa: E402
+from scalesynth.evaluate import (  # noqa: E402
+    HalfBox,
+    Tolerance,
+    adaptive_plan,
+    adaptive_population_stats,
+    design_boxes,
+    make_grid,
+)
 
 import naive  # noqa: E402
 
@@ -214,11 +221,14 @@ def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int 
         numba.set_num_threads(threads)
     t0, c0 = time.perf_counter(), time.process_time()
     rows = []
-    for d in sub:
-        g = make_grid(mech, d, options, 1, region)
-        rows.append(naive.column_stats(lambda pts, d=d: fields(pts, d), TWIN_FIELDS, g.lo, g.lo + g.step * g.shape,
-                                       ndim, plan.columns, plan.cells, plan.bisections, plan.levels, tol.volume,
-                                       tol.gci, edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces))
+    lo, hi = design_boxes(mech, sub, options, region)
+    half = HalfBox.of(mech, options, lo, hi, plan)  # the same half box as the kernel (mirror symmetries)
+    for i, d in enumerate(sub):
+        row, *rest = naive.column_stats(lambda pts, d=d: fields(pts, d), TWIN_FIELDS, half.lo[i], hi[i], ndim,
+                                        half.columns, half.cells, plan.bisections, plan.levels, tol.volume, tol.gci,
+                                        edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces, ny=half.ny,
+                                        mirror=half.mirror)
+        rows.append((half.whole(row[None, :], TWIN_FIELDS)[0], *rest))
     twin_wall, twin_cpu = time.perf_counter() - t0, time.process_time() - c0
 
     def rel(a, b, scale=None):

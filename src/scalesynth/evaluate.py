@@ -254,25 +254,14 @@ def adaptive_population_stats(
         lo = np.tile(boxes.lo, (n, 1))
         hi = np.tile(boxes.lo + boxes.step * boxes.shape, (n, 1))
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
-    halves = mirror_halves(mech, options, lo, hi, plan) if mirror else ()
-    counts = [plan.columns, plan.columns if ndim == 3 else 1, plan.cells]  # per task axis (planar: x, -, y)
-    axis_slot = (0, 1, 2) if ndim == 3 else (0, 2)
-    mirror_lo = [False, False]
-    lo = lo.copy()
-    for a in halves:
-        lo[:, a] = 0.0
-        counts[axis_slot[a]] //= 2
-        if axis_slot[a] < 2:
-            mirror_lo[axis_slot[a]] = True
+    half = HalfBox.of(mech, options, lo, hi, plan, mirror)
     kernel = mech.lci_kernel if lci_only else mech.field_kernel
-    stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, lo, hi, ndim,
-                                                      counts[0], counts[2], plan.bisections, plan.levels,
+    stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, half.lo, hi, ndim,
+                                                      half.columns, half.cells, plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
                                                       plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel,
-                                                      ny=counts[1] if ndim == 3 else None,
-                                                      mirror=(mirror_lo[0], mirror_lo[1]))
-    if halves:
-        stats = _grid.scale_extensive(stats, mech.n_fields, float(2 ** len(halves)))
+                                                      ny=half.ny, mirror=half.mirror)
+    stats = half.whole(stats, mech.n_fields)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 
@@ -288,6 +277,41 @@ def mirror_halves(mech: Mechanism, options: Mapping[str, Any], lo: np.ndarray, h
         if count % 2 == 0 and np.all(lo[:, a] == -hi[:, a]):  # a degenerate design's empty box (0, 0) halves too
             out.append(a)
     return tuple(out)
+
+
+@dataclass(frozen=True)
+class HalfBox:
+    """What the adaptive evaluator computes on the mirror axes (``mirror_halves``): every design's box with lo = 0
+    on them (lo: (n, 3)), the coarse columns per cross axis (``columns``, ``ny``: kernels.adaptive's n and ny; None
+    for planar tasks) and z-cells, the kernel's mirror planes per cross axis, and ``factor`` = 2^(halved axes)."""
+
+    lo: np.ndarray
+    columns: int
+    ny: int | None
+    cells: int
+    mirror: tuple[bool, bool]
+    factor: float
+
+    @classmethod
+    def of(cls, mech: Mechanism, options: Mapping[str, Any], lo: np.ndarray, hi: np.ndarray, plan: ColumnPlan,
+           mirror: bool = True) -> HalfBox:
+        ndim = len(mech.task_axes)
+        counts = [plan.columns, plan.columns, plan.cells]  # x, y (3-D only), the column axis
+        slot = (0, 1, 2) if ndim == 3 else (0, 2)  # task axis -> counts' entry
+        planes = [False, False]
+        lo = lo.copy()
+        halves = mirror_halves(mech, options, lo, hi, plan) if mirror else ()
+        for a in halves:
+            lo[:, a] = 0.0
+            counts[slot[a]] //= 2
+            if slot[a] < 2:
+                planes[slot[a]] = True
+        return cls(lo, counts[0], counts[1] if ndim == 3 else None, counts[2], (planes[0], planes[1]),
+                   float(2 ** len(halves)))
+
+    def whole(self, stats: np.ndarray, n_fields: int) -> np.ndarray:
+        """Statistics rows of the half box -> those of the whole box (extensive columns times ``factor``)."""
+        return stats if self.factor == 1.0 else _grid.scale_extensive(stats, n_fields, self.factor)
 
 
 def tolerance_population_stats(
