@@ -85,3 +85,17 @@ def test_run_results_equal_a_full_evaluation_of_the_front(tmp_path):
     for k in ("area_mm2", "gci", "path_min_lci", "task_gci"):
         assert np.array_equal(pareto[k].to_numpy(), full[k]), k
     assert res.manifest["evaluations"] == 36
+
+
+def test_unknown_family_or_field_names_are_one_line_errors():
+    """A misspelt family or field would select no metric at all; evaluate_population names it instead."""
+    import pytest
+
+    from scalesynth.errors import InvalidParameter
+    from scalesynth.evaluate import evaluate_population
+
+    cfg = config_from_dict(FIVEBAR)
+    with pytest.raises(InvalidParameter, match=r"^families: unknown name 'tasks' \(known: workspace, task, "):
+        evaluate_population(cfg.mech, designs(2), families={"tasks"})
+    with pytest.raises(InvalidParameter, match=r"^fields: unknown name 'LCI' \(known: lci, sigma_min, "):
+        evaluate_population(cfg.mech, designs(2), fields={"LCI"})

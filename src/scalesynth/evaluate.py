@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from scalesynth import metrics as _metrics
+from scalesynth.errors import InvalidParameter
 from scalesynth.kernels import grid as _grid
 from scalesynth.mechanisms.base import Mechanism
 from scalesynth.paths import sample_path  # noqa: F401 - re-exported for callers of evaluate
@@ -622,6 +623,8 @@ def evaluate_population(
     ``lci_kernel`` runs, whose measure, LCI statistics, bands and error estimates equal the field kernel's bit for
     bit; the error estimates only with "estimate" (a calibrated uniform grid computes them on a second grid)."""
     options = mech.resolve_options(options)
+    _check_selection("families", families, _metrics.FAMILIES)
+    _check_selection("fields", fields, (*mech.field_names, "estimate"))
     unit = length_unit or mech.default_length_unit
     resolved = [mech.resolve_design(d) for d in designs]
     n = len(resolved)
@@ -654,6 +657,14 @@ def evaluate_population(
     stats = mech.grid_stats(packed, lo, step, grids[0].shape, edges, lci_only=lci_only)
     cell = np.array([g.cell_measure for g in grids])
     return _metrics_of(mech, resolved, options, packed, stats, cell, *args)
+
+
+def _check_selection(what: str, names: Collection[str] | None, known: Sequence[str]) -> None:
+    """Raise InvalidParameter naming the first of ``names`` not in ``known`` (a misspelt family or field would
+    otherwise just select nothing)."""
+    for name in names or ():
+        if name not in known:
+            raise InvalidParameter(f"{what}: unknown name {name!r} (known: {', '.join(known)})")
 
 
 def evaluator_description(cfg) -> str:
