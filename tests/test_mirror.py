@@ -126,21 +126,28 @@ def _random_designs(mech, n, seed):
     return [{k: v * rng.uniform(0.7, 1.3) for k, v in base.items()} for _ in range(n)]
 
 
+def _full_and_half(name, axis, n, seed):
+    """(mechanism, full-box result, half-box result) of the adaptive evaluator on n random designs whose boxes
+    are symmetric on ``axis``, each with a non-empty workspace, at the same refinement levels."""
+    mech = get(name)
+    opts = mech.resolve_options({})
+    designs = _random_designs(mech, n, seed)
+    packed = np.stack([mech.pack(d, opts) for d in designs])
+    full = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES, mirror=False)
+    half = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES)
+    lo, hi = design_boxes(mech, designs, opts)
+    assert np.all(lo[:, axis] == -hi[:, axis])
+    assert full.stats[:, 0].min() > 0.0
+    assert np.array_equal(full.levels, half.levels)
+    return mech, full, half
+
+
 def test_half_box_on_the_column_axis_equals_the_full_box():
     """rps-upu, mirror in psi (its column axis, 8 z-cells: the half box has 4 and the node at psi = 0): the same
     nodes and Gauss points to rounding, so every statistic matches the full box's to 1e-12 relative and the levels
     are equal; the kernel calls drop to about 5/9 of the nodes (measured 0.52x: 26 471 against 50 580 calls per
     design on seed 3 of the rps_upu bounds)."""
-    mech = get("rps-upu")
-    opts = mech.resolve_options({})
-    designs = _random_designs(mech, 6, 3)
-    packed = np.stack([mech.pack(d, opts) for d in designs])
-    full = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES, mirror=False)
-    half = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES)
-    lo, hi = design_boxes(mech, designs, opts)
-    assert np.all(lo[:, 2] == -hi[:, 2])
-    assert full.stats[:, 0].min() > 0.0
-    assert np.array_equal(full.levels, half.levels)
+    mech, full, half = _full_and_half("rps-upu", 2, 6, 3)
     # count, LCI statistics and bands (what the refinement and the searched metrics read): 1e-12; every other
     # statistic to 1e-8 (measured: sigma_max's extremes 8e-12 and the stiffness fields' 1.8e-9, both from
     # near-singular poses where a rounding of the pose moves the value most)
@@ -158,16 +165,7 @@ def test_half_box_on_a_cross_axis_equals_the_full_box(name, axis):
     NumPy twin): the mechanism's own plan on random designs, the half box (half the columns on that axis) against
     the full one. Count and LCI statistics to 1e-12, the same levels, about half the calls (measured exactly half
     on the helper's 200 designs: the mirror plane takes no face columns)."""
-    mech = get(name)
-    opts = mech.resolve_options({})
-    designs = _random_designs(mech, 5, 4)
-    packed = np.stack([mech.pack(d, opts) for d in designs])
-    full = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES, mirror=False)
-    half = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES)
-    lo, hi = design_boxes(mech, designs, opts)
-    assert np.all(lo[:, axis] == -hi[:, axis])
-    assert full.stats[:, 0].min() > 0.0
-    assert np.array_equal(full.levels, half.levels)
+    mech, full, half = _full_and_half(name, axis, 5, 4)
     extensive = [0, 1, 2, *range(1 + 4 * mech.n_fields, full.stats.shape[1])]
     np.testing.assert_allclose(half.stats[:, extensive], full.stats[:, extensive], rtol=1e-12)
     # the LCI's min and max (in [0, 1]) to 1e-12 absolute: a minimum of 8e-6 differs by 2e-16 (rps-upu-tool)
