@@ -67,14 +67,15 @@ def test_intervals_match_reach_kernel():
     """600 random columns (60 random designs x 10; _random_case) of random heights [zlo, zhi] (the whole bounding
     box height on even columns, a random part of it on odd ones), each at 2000 uniform random z: z lies in a
     returned interval exactly where tool_point_reach >= 0, except within 1e-9 x (box height) of an interval end
-    (rounding of the roots against the kernel's own arithmetic). The sample must hold an unreachable column
+    (rounding of the roots against the kernel's own arithmetic); every interval end inside (zlo, zhi) is a
+    crossing of the kernel to 2e-9 x (box height) on either side. The sample must hold an unreachable column
     (k = 0), a wholly reachable one ([zlo, zhi] itself) and split ones (k >= 2: a leg's lower stroke limit cuts
     the column); on those, out with k - 1 rows returns -1."""
     rng = np.random.default_rng(20261202)
     interval = TOOL.interval_kernel
     reach = TOOL.reach_kernel
     out = np.empty((K, 2))
-    counts = {"empty": 0, "whole": 0, "split": 0, "points": 0, "excused": 0}
+    counts = {"empty": 0, "whole": 0, "split": 0, "points": 0, "excused": 0, "ends": 0}
     for i in range(N_DESIGNS):
         design, options = _random_case(rng, i)
         p = TOOL.pack(design, options)
@@ -93,6 +94,16 @@ def test_intervals_match_reach_kernel():
             near = np.min(np.abs(zs[:, None] - iv.ravel()), axis=1) < tol if k else np.zeros(N_POINTS, bool)
             bad = (inside != reachable) & ~near
             assert not bad.any(), (i, j, x, y, iv, zs[bad][:5])
+            # every end inside (zlo, zhi) is a crossing to 2 tol: reachable 2 tol inside, unreachable 2 tol outside
+            # (random points alone would miss an end off by less than about the box height / 2000)
+            gaps = np.concatenate([[np.inf], iv[1:, 0] - iv[:-1, 1], [np.inf]])
+            for m, (a, b) in enumerate(iv):
+                if b - a > 4 * tol:
+                    assert (_reach_column(reach, p, x, y, np.array([a + 2 * tol, b - 2 * tol])) >= 0.0).all()
+                for end, outside, gap in ((a, a - 2 * tol, gaps[m]), (b, b + 2 * tol, gaps[m + 1])):
+                    if zlo < end < zhi and gap > 4 * tol:
+                        assert _reach_column(reach, p, x, y, np.array([outside]))[0] < 0.0, (i, j, iv, end)
+                        counts["ends"] += 1
             counts["points"] += N_POINTS
             counts["excused"] += int(((inside != reachable) & near).sum())
             counts["empty"] += k == 0
@@ -101,7 +112,7 @@ def test_intervals_match_reach_kernel():
                 counts["split"] += 1
                 assert interval(p, x, y, zlo, zhi, np.empty((k - 1, 2))) == -1
     assert counts["points"] == N_DESIGNS * N_COLUMNS * N_POINTS == 1_200_000
-    assert counts["empty"] > 0 and counts["whole"] > 0 and counts["split"] > 0, counts
+    assert counts["empty"] > 0 and counts["whole"] > 0 and counts["split"] > 0 and counts["ends"] > 0, counts
 
 
 def test_default_column_by_hand():
