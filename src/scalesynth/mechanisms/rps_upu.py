@@ -1419,6 +1419,113 @@ def _tool_fields(p, x, y, z, out, stiffness, every=True, others=True):
         out[_F_STIFFNESS_MIN], out[_F_DEFLECTION] = _tool_stiffness(p, x, y, z, z0, th, ps)
 
 
+# ----- reachable intervals of a z-column of the tool workspace (closed form) ------------------------------
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _monic_roots(b, c):
+    """(real, r1, r2): the roots r1 <= r2 of z^2 + 2 b z + c, the larger-magnitude one first and the other as
+    c / it (no cancellation); real False when there are none."""
+    disc = b * b - c
+    if not disc >= 0.0:
+        return False, 0.0, 0.0
+    t = -b - math.sqrt(disc) if b >= 0.0 else -b + math.sqrt(disc)
+    if t == 0.0:
+        return True, 0.0, 0.0  # b = c = 0: a double root at 0
+    r = c / t
+    return True, min(t, r), max(t, r)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_window(b, c, lo, hi, shift, lower, upper):
+    """One leg whose squared length is z0^2 + 2 b z0 + c (mm^2) at platform height z0 = z + shift (mm), stroke
+    [lo, hi] (mm, +-inf = no limit), as _leg_ok decides it: (lower, upper, ex_lo, ex_hi), the window
+    [lower, upper] on the tool height z narrowed to q <= hi (lower > upper when empty) and the open interval
+    (ex_lo, ex_hi) of z where q < lo ((inf, inf) when none)."""
+    if hi < math.inf:
+        if hi < 0.0:
+            return math.inf, -math.inf, math.inf, math.inf  # q >= 0 > hi everywhere
+        real, r1, r2 = _monic_roots(b, c - hi * hi)
+        if not real:
+            return math.inf, -math.inf, math.inf, math.inf  # the leg is longer than hi on the whole column
+        lower = max(lower, r1 - shift)
+        upper = min(upper, r2 - shift)
+    if lo > 0.0:  # lo <= 0 holds for every q >= 0 (the kernel clamps round-off q^2 < 0 to q = 0)
+        real, s1, s2 = _monic_roots(b, c - lo * lo)
+        if real and s1 - shift < s2 - shift:  # the roots themselves have q = lo: reachable, the interval is open
+            return lower, upper, s1 - shift, s2 - shift
+    return lower, upper, math.inf, math.inf
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _tool_column_intervals(p, x, y, zlo, zhi, out):
+    """Reachable set of the column (x, y, z in [zlo, zhi]) of the tool workspace (mm) in closed form: writes its
+    closed intervals [out[i, 0], out[i, 1]] (mm, i < k, sorted, disjoint, inside [zlo, zhi]; a degenerate
+    [a, a] is a single reachable height) into out (float64, (K, 2)) and returns k >= 0: z is in one exactly where
+    tool_point_reach(p, x, y, z) >= 0, to rounding at the ends. -1 (out undefined) when reachability is not in
+    closed form (interference_free: the clearance decides too) or out has fewer rows than the column needs (4 at
+    most: the z-range window minus one open interval per leg where it is shorter than its lower stroke limit).
+
+    Along the column the pose's angles are fixed (sin psi = y / d, sin theta = -x / (d cos psi), computed and
+    checked as in _tool_fields) and z0 = z + d cos theta cos psi, so each squared leg length is a monic quadratic
+    in z0 (_p_model_rows) and every condition is an interval or the complement of an open one."""
+    if p[_FREE_ONLY] > 0.0:
+        return -1
+    # the column's pose angles and their checks, as _tool_fields computes them
+    d = p[_D]
+    sp = y / d
+    if not (-1.0 <= sp <= 1.0) or not zlo <= zhi:  # also NaN
+        return 0
+    cp = math.sqrt(1.0 - sp * sp)
+    if cp <= 1e-12:
+        return 0
+    st = -x / (d * cp)
+    if not -1.0 <= st <= 1.0:
+        return 0
+    ct = math.sqrt(1.0 - st * st)
+    if not (p[_TLO] <= math.asin(st) <= p[_THI] and p[_PLO] <= math.asin(sp) <= p[_PHI]):
+        return 0
+    shift = d * ct * cp  # z0 - z (mm)
+    g, h, c, e = p[_G], p[_H], p[_C], p[_E]
+    lo, hi = p[_QLO], p[_QHI]
+    # q1^2, q2^2 = z0^2 -+ 2 h cos(theta) sin(psi) z0 + g^2 + h^2 - 2 g h cos(psi); q3^2 = z0^2 - 2 c sin(theta) z0
+    # + c^2 + e^2 - 2 c e cos(theta) (_p_model_rows)
+    lower = max(zlo, p[_ZLO] - shift)
+    upper = min(zhi, p[_ZHI] - shift)
+    c12 = g * g + h * h - 2.0 * g * h * cp
+    lower, upper, a1, b1 = _leg_window(-h * ct * sp, c12, lo, hi, shift, lower, upper)
+    lower, upper, a2, b2 = _leg_window(h * ct * sp, c12, lo, hi, shift, lower, upper)
+    lower, upper, a3, b3 = _leg_window(-c * st, c * c + e * e - 2.0 * c * e * ct, lo, hi, shift, lower, upper)
+    if not lower <= upper:
+        return 0
+    # sort the three excluded open intervals by their start (none: (inf, inf), last), then sweep the window
+    if a2 < a1:
+        a1, b1, a2, b2 = a2, b2, a1, b1
+    if a3 < a2:
+        a2, b2, a3, b3 = a3, b3, a2, b2
+    if a2 < a1:
+        a1, b1, a2, b2 = a2, b2, a1, b1
+    k = 0
+    cur = lower  # start of the reachable piece being built
+    for a, b in ((a1, b1), (a2, b2), (a3, b3)):
+        if a >= upper:
+            break  # this and the later exclusions start past the window (an end a = upper is itself reachable)
+        if b <= cur:
+            continue
+        if a >= cur:
+            if k == out.shape[0]:
+                return -1
+            out[k, 0] = cur
+            out[k, 1] = a
+            k += 1
+        cur = b
+    if cur <= upper:
+        if k == out.shape[0]:
+            return -1
+        out[k, 0] = cur
+        out[k, 1] = upper
+        k += 1
+    return k
+
+
 def _sin_cos_range(lo: float, hi: float) -> tuple[tuple[float, float], tuple[float, float]]:
     """([min, max] of sin, [min, max] of cos) over the angle interval [lo, hi]: the ends and every multiple of
     pi/2 inside."""
@@ -1479,6 +1586,12 @@ class RpsUpuTool(RpsUpu):
     @property
     def lci_kernel(self):
         return tool_lci_fields
+
+    @property
+    def interval_kernel(self):
+        """_tool_column_intervals(p, x, y, zlo, zhi, out) -> k: the reachable intervals of a z-column in closed
+        form (-1: not handled, evaluate points with reach_kernel instead)."""
+        return _tool_column_intervals
 
     def kernel_branch(self, options) -> str:
         return "++"
