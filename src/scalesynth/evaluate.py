@@ -235,6 +235,7 @@ def adaptive_population_stats(
     plan: ColumnPlan | None = None,
     lci_only: bool = False,
     mirror: bool = True,
+    intervals: bool = True,
 ) -> AdaptiveResult:
     """Statistics of every design by the adaptive column evaluator (kernels.adaptive), refined per design until
     its error estimate (change from the previous level) meets ``tolerance`` or the plan's last level is reached.
@@ -243,7 +244,9 @@ def adaptive_population_stats(
     meaningful; they equal the full kernel's bit for bit: the refinement reads slot 0 alone). ``mirror``: on each of
     the mechanism's mirror axes (``mirror_halves``) only the half box >= 0 is evaluated, with half the plan's
     columns (or z-cells) there, and the extensive statistics are doubled: the same columns and nodes as the full
-    box, to rounding (tests/test_mirror.py)."""
+    box, to rounding (tests/test_mirror.py). ``intervals``: columns whose reachable set the mechanism gives in
+    closed form (``Mechanism.interval_kernel``) skip the nodes and bisections (False: nodes everywhere, for A/B
+    comparisons)."""
     from scalesynth.kernels.adaptive import column_stats
 
     n = len(designs)
@@ -261,7 +264,8 @@ def adaptive_population_stats(
                                                       half.columns, half.cells, plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
                                                       plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel,
-                                                      ny=half.ny, mirror=half.mirror)
+                                                      ny=half.ny, mirror=half.mirror,
+                                                      interval_kernel=mech.interval_kernel if intervals else None)
     stats = half.whole(stats, mech.n_fields)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 

@@ -14,6 +14,10 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    nodes ``zlo + k hz`` (the mechanism's reach kernel: slot 0 alone); where reachability changes between two
    nodes, ``nbis`` bisection steps locate the boundary (estimate: the midpoint of the last bracket, error <=
    hz / 2^(nbis+1)). So the column's reachable length is exact to that precision, not a voxel count.
+   With an interval kernel (Mechanism.interval_kernel, 3-D; column_stats's ``interval_kernel``) a column's
+   reachable intervals come in closed form instead (one call), and each z-cell's intersections with them are the
+   pieces of step 2; no nudge is needed at the column ends (the Gauss points lie inside the pieces); where it
+   returns -1 the column takes the nodes and bisections (``_column_intervals``).
 2. Each reachable piece of a z-cell is integrated by the 2-point Gauss-Legendre rule: every field at its two points,
    each with half the piece's length (a point that turns out unreachable gives its weight to the other; a piece
    with neither reachable is dropped). The points' fields and weights feed the shared statistics accumulator
@@ -73,6 +77,12 @@ GAUSS_X = 1.0 / math.sqrt(3.0)  # 2-point Gauss-Legendre abscissa on [-1, 1] (we
 # themselves, and reachability exactly on a limit depends on rounding (fused multiply-adds differ between two
 # compilations of the same field kernel)
 END_NUDGE = 2.0**-20
+# rows of the interval kernel's out (Mechanism.interval_kernel): a column needing more falls back to nodes
+MAX_INTERVALS = 8
+# more placeholders, of the interval variant (_column_intervals) alone: the mechanism's interval kernel and the
+# bound node-and-bisection column (_column) it falls back to
+INTERVAL_KERNEL = None
+NODE_COLUMN = None
 
 
 @njit(cache=True)
@@ -261,6 +271,75 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
     out[3] = evals
 
 
+def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out):
+    """Template (serial), ``_column``'s variant with an interval kernel (step 1 in closed form; 3-D only): the
+    reachable intervals of the column over [zlo, zlo + mz hz] from INTERVAL_KERNEL, then each z-cell's intersection
+    with each interval (a piece; none, one or several per cell, a piece of zero length dropped) integrated as in
+    ``_column`` (step 2). Evaluations: 1 for the interval call, 2 per piece. Where the interval kernel returns -1
+    (planar tasks: always) the column is NODE_COLUMN's, plus the 1 call. ``nodes`` has >= 2 MAX_INTERVALS slots:
+    its head holds the intervals. buf, wbuf hold >= 2 (mz + MAX_INTERVALS) points (a cell split by gaps between
+    intervals has one piece more per gap)."""
+    if ndim != 3:
+        NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
+        return
+    n_fields = N_FIELDS
+    iv = nodes[: 2 * MAX_INTERVALS].reshape((MAX_INTERVALS, 2))
+    # the top is the last node of the node path (zlo + mz hz), not the box's hi: the same column to rounding
+    k = INTERVAL_KERNEL(p, x, y, zlo, _add_product(zlo, mz, hz), iv)
+    if k < 0:
+        NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
+        out[3] += 1.0
+        return
+    evals = 1.0
+    npts = 0
+    col_l = 0.0
+    col_s = 0.0
+    t = 0  # first interval not wholly below the current cell
+    for c in range(mz):
+        if t >= k:
+            break
+        ca = _add_product(zlo, c, hz)
+        cb = _add_product(zlo, c + 1, hz)
+        while t < k and iv[t, 1] <= ca:
+            t += 1
+        u = t
+        while u < k and iv[u, 0] < cb:
+            za = max(ca, iv[u, 0])
+            zb = min(cb, iv[u, 1])
+            u += 1
+            if not zb > za:
+                continue
+            # 2. 2-point Gauss rule on the piece [za, zb], weights as in _column
+            half = 0.5 * (zb - za)
+            zm = 0.5 * (za + zb)
+            FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
+            FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
+            evals += 2
+            ok0 = q0[0] >= 0.0
+            ok1 = q1[0] >= 0.0
+            if not ok0 and not ok1:
+                continue
+            w = half / hz0 if ok0 and ok1 else 2.0 * half / hz0
+            if ok0:
+                for f in range(n_fields):
+                    buf[f, npts] = q0[f]
+                wbuf[npts] = w * area
+                npts += 1
+                col_l += w
+                col_s += w * q0[0]
+            if ok1:
+                for f in range(n_fields):
+                    buf[f, npts] = q1[f]
+                wbuf[npts] = w * area
+                npts += 1
+                col_l += w
+                col_s += w * q1[0]
+    out[0] = col_l
+    out[1] = col_s
+    out[2] = npts
+    out[3] = evals
+
+
 def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
                   mirror_x, mirror_y, edges, row, info):
     """Template (serial; FIELD_KERNEL is the bound ``_column``): statistics row of one design into ``row``; info:
@@ -284,9 +363,11 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
     for _ in range(zlevels):
         mmax *= 2
     cell = np.empty(n_fields)
-    nodes = np.empty(mmax + 1)  # slot 0 (reachability) of each node
-    buf = np.empty((n_fields, 2 * mmax))
-    wbuf = np.empty(2 * mmax)
+    # slot 0 (reachability) of each node; the interval variant (_column_intervals) keeps its intervals there
+    nodes = np.empty(max(mmax + 1, 2 * MAX_INTERVALS))
+    # the Gauss points of one column: 2 per piece, a piece per z-cell plus one per gap between intervals
+    buf = np.empty((n_fields, 2 * (mmax + MAX_INTERVALS)))
+    wbuf = np.empty(2 * (mmax + MAX_INTERVALS))
     q0 = np.empty(n_fields)
     q1 = np.empty(n_fields)
     colrow = np.empty(ncol)
@@ -457,7 +538,7 @@ def _column_stats(params, lo, hi, ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, b
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
                  beta=1.0, zlevels=0, zconfirm=1, faces=False, reach_kernel=None, ny: int | None = None,
-                 mirror: tuple[bool, bool] = (False, False)):
+                 mirror: tuple[bool, bool] = (False, False), interval_kernel=None):
     """Statistics rows of every design by the column algorithm (module docstring).
 
     params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
@@ -471,6 +552,8 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     either kernel. mirror: (axis 0, axis 1) whether the box's lo face on that cross axis is a mirror plane of the
     fields: the edge columns' neighbour across it is themselves and no face column is evaluated there even with
     ``faces`` (module docstring, step 3); planar: axis 1 is the column axis, a mirror there is an error.
+    interval_kernel: Mechanism.interval_kernel (3-D only; None: nodes and bisection): each column's reachable
+    intervals in closed form where it returns k >= 0 (module docstring); each call counts as one evaluation.
     """
     ny = int(n) if ny is None or int(ndim) == 2 else int(ny)
     mirror_x, mirror_y = (bool(v) for v in mirror)
@@ -480,6 +563,10 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
         raise ValueError("mirror on axis 1 of a planar task: that is the column axis, not a cross axis")
     reach = field_kernel if reach_kernel is None else reach_kernel
     col = bind(_column, field_kernel, n_fields, extra={"REACH_KERNEL": reach}, fastmath=FASTMATH)
+    if interval_kernel is not None and int(ndim) == 3:
+        # a separate bound variant: without an interval kernel the compiled code is today's, bit for bit
+        col = bind(_column_intervals, field_kernel, n_fields,
+                   extra={"INTERVAL_KERNEL": interval_kernel, "NODE_COLUMN": col}, fastmath=FASTMATH)
     one = bind(_design_stats, col, n_fields, fastmath=FASTMATH)
     run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
     stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),

@@ -218,6 +218,16 @@ class Mechanism(ABC):
         return self.field_kernel
 
     @property
+    def interval_kernel(self):
+        """None, or a Numba kernel ``intervals(p, x, y, zlo, zhi, out) -> k`` (3-D tasks): the reachable set of the
+        column at cross position (x, y) over [zlo, zhi] of the last task axis, i.e. where the reach kernel's slot 0
+        is >= 0, in closed form: its k >= 0 sorted, disjoint, closed intervals written to out[:k] (out: float64
+        (K, 2), task units; exact to rounding at the ends), or -1 when this design and these options are not
+        handled in closed form or need more than K rows (the adaptive evaluator then evaluates nodes and bisects,
+        kernels.adaptive). Default: None (nodes and bisection everywhere)."""
+        return None
+
+    @property
     def point_kernel(self):
         """Scalar LCI kernel ``f(p, x, y, z) -> LCI or -1`` derived from the field kernel (single points, plots)."""
         kernel = _LCI_KERNELS.get(self.name)

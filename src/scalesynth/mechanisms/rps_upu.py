@@ -444,6 +444,142 @@ def _fields(p, x, y, z, out, stiffness, every=True, others=True):
             p, y0, x, st, ct, sp, cp, sf, cf, p[_MODEL_C] > 0.0, True, 0.0, 0.0, 0.0)
 
 
+# ----- reachable intervals of a psi-column (closed form, P-model) ------------------------------------------
+# kinds of a leg's reachable set on the psi axis (_leg_band)
+_BAND_NONE, _BAND_ALL, _BAND_PERIODIC = 0, 1, 2
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _half_width(r, d):
+    """w in (0, pi) with r cos(w) = d, for r > 0 and -r < d < r: 2 atan2(sqrt(r - d), sqrt(r + d)) (tan(w/2) form,
+    well conditioned where acos(d / r) is not: d / r near +-1)."""
+    return 2.0 * math.atan2(math.sqrt(r - d), math.sqrt(r + d))
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_band(a, r, lo, hi):
+    """Reachable set of one leg whose squared length is a - r cos(u) (mm^2; r >= 0, u = psi - phi) under the stroke
+    [lo, hi] (mm, +-inf = no limit), as _leg_ok decides it: (kind, n, a0, b0, a1, b1). kind _BAND_NONE or _BAND_ALL,
+    or _BAND_PERIODIC: per period 2 pi the n (1 or 2) closed intervals [a_s, b_s] of u (rad), sorted, offsets
+    within [-pi, 2 pi]: lo^2 <= q^2 (only when lo > 0: q >= 0 always) is |u| >= wl, q^2 <= hi^2 is |u| <= wh."""
+    if hi < 0.0 or lo > hi:
+        return _BAND_NONE, 0, 0.0, 0.0, 0.0, 0.0
+    # the upper limit: r cos(u) >= a - hi^2; wh = pi: no limit
+    wh = math.pi
+    if hi < math.inf:
+        dh = a - hi * hi
+        if r == 0.0 or dh > r:
+            if dh > 0.0:
+                return _BAND_NONE, 0, 0.0, 0.0, 0.0, 0.0
+        elif dh > -r:
+            wh = _half_width(r, dh)
+    # the lower limit: r cos(u) <= a - lo^2; wl = 0: no limit
+    wl = 0.0
+    if lo > 0.0:
+        dl = a - lo * lo
+        if r == 0.0 or dl < -r:
+            if dl < 0.0:
+                return _BAND_NONE, 0, 0.0, 0.0, 0.0, 0.0
+        elif dl < r:
+            wl = _half_width(r, dl)
+    if wl > wh:
+        return _BAND_NONE, 0, 0.0, 0.0, 0.0, 0.0
+    if wl == 0.0 and wh == math.pi:
+        return _BAND_ALL, 0, 0.0, 0.0, 0.0, 0.0
+    if wh == math.pi:  # the complement of the open (-wl, wl): one interval per period (no seam at u = pi)
+        return _BAND_PERIODIC, 1, wl, 2.0 * math.pi - wl, 0.0, 0.0
+    if wl == 0.0:  # one interval about u = 0 (no seam there)
+        return _BAND_PERIODIC, 1, -wh, wh, 0.0, 0.0
+    return _BAND_PERIODIC, 2, -wh, -wl, wl, wh
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _band_piece(kind, n, phi, a0, b0, a1, b1, j):
+    """Interval j (rad, sorted in j) of a leg's reachable set on the psi axis (_leg_band, shifted by phi);
+    _BAND_ALL: the whole axis."""
+    if kind == _BAND_ALL:
+        return -math.inf, math.inf
+    k = j // n
+    base = phi + 2.0 * math.pi * k
+    if j - k * n == 0:
+        return base + a0, base + b0
+    return base + a1, base + b1
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _band_first(kind, n, phi, zlo):
+    """An index j whose interval starts at or before the first one reaching zlo (every offset is >= -pi: the
+    period k with phi + 2 pi k + 2 pi <= zlo ends before it)."""
+    if kind == _BAND_ALL:
+        return 0
+    return int(math.floor((zlo - phi) / (2.0 * math.pi))) * n - n
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _psi_column_intervals(p, x, y, zlo, zhi, out):
+    """Reachable set of the column (z, theta) = (x, y), psi in [zlo, zhi] (rad) of the P-model in closed form:
+    writes its closed intervals [out[i, 0], out[i, 1]] (rad, i < k, sorted, disjoint, inside [zlo, zhi]; a
+    degenerate [a, a] is a single reachable psi) into out (float64, (K, 2)) and returns k >= 0: psi is in one
+    exactly where point_reach(p, x, y, psi) >= 0, to rounding at the ends. -1 (out undefined) when reachability is
+    not in closed form (the C-model; interference_free: the clearance decides too) or out has too few rows
+    (a column of width < 2 pi needs at most 4).
+
+    Along the column q3 is constant and q1^2, q2^2 = A - 2 g h cos(psi) -+ B sin(psi) = A - R cos(psi -+ phi)
+    (_p_model_rows; A = g^2 + h^2 + z^2, B = 2 h z cos(theta), R = |(2 g h, B)|, phi = atan2(B, 2 g h)), so each
+    stroke limit holds on closed intervals |psi -+ phi - 2 pi k| in [wl, wh] (_leg_band); the column's set is their
+    intersection, swept in order."""
+    if p[_MODEL_C] > 0.0 or p[_FREE_ONLY] > 0.0:
+        return -1
+    if not (math.isfinite(zlo) and math.isfinite(zhi)):
+        return -1
+    if not zlo <= zhi:
+        return 0
+    g, h, c, e = p[_G], p[_H], p[_C], p[_E]
+    lo, hi = p[_QLO], p[_QHI]
+    st = math.sin(y)
+    ct = math.cos(y)
+    # leg 3 does not depend on psi: decided as the reach kernel decides it
+    ok3, _ = _leg_ok(c * c + e * e + x * x - 2.0 * c * e * ct - 2.0 * c * x * st, lo, hi)
+    if not ok3:
+        return 0
+    a = g * g + h * h + x * x
+    gh2 = 2.0 * g * h
+    b = 2.0 * h * x * ct
+    r = math.sqrt(gh2 * gh2 + b * b)
+    phi = math.atan2(b, gh2)
+    kind, n, a0, b0, a1, b1 = _leg_band(a, r, lo, hi)
+    if kind == _BAND_NONE:
+        return 0
+    # leg 1 is u = psi - phi, leg 2 u = psi + phi (the same band: q1(psi) = q2(-psi))
+    ja = _band_first(kind, n, phi, zlo)
+    jb = _band_first(kind, n, -phi, zlo)
+    k = 0
+    while True:
+        s1, e1 = _band_piece(kind, n, phi, a0, b0, a1, b1, ja)
+        s2, e2 = _band_piece(kind, n, -phi, a0, b0, a1, b1, jb)
+        start = max(s1, s2, zlo)
+        if start > zhi:
+            break
+        end = min(e1, e2, zhi)
+        if start <= end:
+            if k > 0 and start <= out[k - 1, 1]:
+                out[k - 1, 1] = max(out[k - 1, 1], end)  # touching pieces of the two legs' bands: one interval
+            else:
+                if k == out.shape[0]:
+                    return -1
+                out[k, 0] = start
+                out[k, 1] = end
+                k += 1
+        if e1 >= zhi and e2 >= zhi:
+            break
+        # the one ending first has no more overlap (sorted, disjoint bands)
+        if e1 <= e2:
+            ja += 1
+        else:
+            jb += 1
+    return k
+
+
 # ----- NumPy kinematics (vectorised over poses; CLI, FK and tests) ----------------------------------------
 def _rot(axis: str, a: np.ndarray) -> np.ndarray:
     """Stack of active rotation matrices about a fixed axis, shape (n, 3, 3)."""
@@ -852,6 +988,12 @@ class RpsUpu(Mechanism):
     @property
     def lci_kernel(self):
         return lci_fields
+
+    @property
+    def interval_kernel(self):
+        """_psi_column_intervals(p, x, y, zlo, zhi, out) -> k: the reachable intervals of a psi-column in closed
+        form (P-model; -1 for the C-model or interference_free: evaluate points with reach_kernel instead)."""
+        return _psi_column_intervals
 
     def kernel_branch(self, options) -> str:
         return BRANCH
