@@ -1,6 +1,6 @@
 """Column intervals in closed form (Mechanism.interval_kernel) against nodes and bisection, A/B in one process.
 
-    NUMBA_NUM_THREADS=1 python benchmarks/interval_ab.py [MECH] [N_DESIGNS]   # default rps-upu, 20
+    NUMBA_NUM_THREADS=1 python benchmarks/interval_ab.py [MECH] [N_DESIGNS]   # default rps-upu-tool, 20
 
 Random designs of the mechanism's config (benchmarks/adaptive.py's random_designs, seed 0), the search's call
 (adaptive_population_stats with lci_only=True) with intervals on and off, alternately, best of 3: ms/design and
@@ -27,7 +27,7 @@ from scalesynth.evaluate import Tolerance, adaptive_population_stats, make_grid 
 N_REF = 96
 
 
-def main(name: str = "rps-upu", n: int = 20) -> None:
+def main(name: str = "rps-upu-tool", n: int = 20) -> None:
     cfg = load_config(ROOT / "configs" / CONFIGS[name])
     mech, options = cfg.mech, cfg.resolved_options()
     tol = Tolerance(**cfg.grid.tolerance.model_dump())
