@@ -442,11 +442,13 @@ def rps_upu_tool_fields(design, options, x, y, z):
 
 
 def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, beta=1.0, zlevels=0,
-                 zconfirm=1, faces=False, ny=None, mirror=(False, False)):
+                 zconfirm=1, faces=False, ny=None, mirror=(False, False), intervals=None):
     """NumPy twin of kernels.adaptive.column_stats for one design, vectorised over the active columns of a level:
     ``fields(points (k, 3)) -> (k, n_fields)`` (field 0 LCI, -1 unreachable); lo, hi: the design's box (3,); n, ny:
     coarse columns along cross axes 0, 1 (ny default n; planar: unused); mirror: the lo face of cross axis 0, 1 is
-    a mirror plane (clamped neighbour, no face column there even with ``faces``).
+    a mirror plane (clamped neighbour, no face column there even with ``faces``); intervals (3-D only, as the
+    kernel's interval_kernel): ``intervals(x, y, zlo, zhi)`` -> the column's reachable intervals [(a, b), ...]
+    (sorted, disjoint) or None (then that column takes the nodes and bisections), one evaluation per call.
     Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
     level, evaluations)."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
@@ -468,9 +470,50 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     def pts(xx, yy, zz):
         return np.c_[xx, yy, zz] if ndim == 3 else np.c_[xx, zz, np.full(zz.shape, lo[2])]
 
+    def gauss(X, Y, nc, pc, za, zb, area):
+        """2-point Gauss rule on the pieces [za, zb] of columns pc (of nc): column measure L, LCI sum S (in units
+        of hz0), and the Gauss points' owner column, fields and weights x area."""
+        nonlocal evals
+        half, mid = 0.5 * (zb - za), 0.5 * (za + zb)
+        zq = np.c_[mid - half * gx, mid + half * gx].ravel()
+        q = fields(pts(np.repeat(X[pc], 2), np.repeat(Y[pc], 2), zq)).reshape(-1, 2, n_fields)
+        evals += zq.size
+        ok = q[:, :, 0] >= 0
+        w = np.where(ok, np.where(ok.sum(axis=1) == 2, half, 2 * half)[:, None] / hz0, 0.0)
+        # float64 also without pieces (np.bincount of nothing is int64, which would truncate what is stored in it)
+        L = np.bincount(pc, weights=w.sum(axis=1), minlength=nc).astype(float)
+        S = np.bincount(pc, weights=(w * np.where(ok, q[:, :, 0], 0.0)).sum(axis=1), minlength=nc).astype(float)
+        return L, S, np.repeat(pc, 2), q.reshape(-1, n_fields), w.ravel() * area
+
     def columns(X, Y, area, mz):
         """Column measure L, LCI sum S (z in units of hz0) and the Gauss points (fields, weights x area) of each,
-        with mz z-cells."""
+        with mz z-cells: the closed-form intervals where ``intervals`` gives them, else nodes and bisection."""
+        nonlocal evals
+        if intervals is None or ndim != 3:
+            return node_columns(X, Y, area, mz)
+        nc = X.size
+        hz = (hi[ca] - zlo) / mz
+        ivs = [intervals(x, y, zlo, zlo + mz * hz) for x, y in zip(X, Y, strict=True)]
+        evals += nc
+        pc, za, zb = [], [], []
+        for c, iv in enumerate(ivs):
+            for k in range(mz if iv is not None else 0):  # each z-cell's intersection with each interval
+                for a, b in iv:
+                    pa, pb = max(zlo + k * hz, a), min(zlo + (k + 1) * hz, b)
+                    if pb > pa:
+                        pc.append(c)
+                        za.append(pa)
+                        zb.append(pb)
+        L, S, owner, qv, qw = gauss(X, Y, nc, np.array(pc, dtype=np.int64), np.array(za), np.array(zb), area)
+        back = np.flatnonzero([iv is None for iv in ivs])
+        if back.size:
+            Lb, Sb, ob, qb, wb = node_columns(X[back], Y[back], area, mz)
+            L[back], S[back] = Lb, Sb
+            owner, qv, qw = np.r_[owner, back[ob]], np.r_[qv, qb], np.r_[qw, wb]
+        return L, S, owner, qv, qw
+
+    def node_columns(X, Y, area, mz):
+        """columns() by nodes and bisection."""
         nonlocal evals
         nc = X.size
         hz = (hi[ca] - zlo) / mz
@@ -494,16 +537,7 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         za[ci, ck] = np.where(ra, zn[ck], cross)
         zb[ci, ck] = np.where(ra, cross, zn[ck + 1])
         pc, pk = np.nonzero(~np.isnan(za))
-        za, zb = za[pc, pk], zb[pc, pk]
-        half, mid = 0.5 * (zb - za), 0.5 * (za + zb)
-        zq = np.c_[mid - half * gx, mid + half * gx].ravel()
-        q = fields(pts(np.repeat(X[pc], 2), np.repeat(Y[pc], 2), zq)).reshape(-1, 2, n_fields)
-        evals += zq.size
-        ok = q[:, :, 0] >= 0
-        w = np.where(ok, np.where(ok.sum(axis=1) == 2, half, 2 * half)[:, None] / hz0, 0.0)
-        L = np.bincount(pc, weights=w.sum(axis=1), minlength=nc)
-        S = np.bincount(pc, weights=(w * np.where(ok, q[:, :, 0], 0.0)).sum(axis=1), minlength=nc)
-        return L, S, np.repeat(pc, 2), q.reshape(-1, n_fields), w.ravel() * area
+        return gauss(X, Y, nc, pc, za[pc, pk], zb[pc, pk], area)
 
     ci, cj = (v.ravel() for v in np.meshgrid(np.arange(n), np.arange(ny), indexing="ij"))
     lg, sg = np.zeros((n, ny)), np.zeros((n, ny))
