@@ -113,7 +113,7 @@ def bench_mechanism(name: str) -> dict:
     solid = ref_vol >= SLIVER * np.median(ref_vol)
     print(f"{name}: reference N = {n_ref}: {ref_sec * 1e3:.1f} ms/design; {int((~solid).sum())} slivers", flush=True)
     packed = np.stack([mech.pack(d, options) for d in designs])
-    plan = adaptive_plan(mech)
+    plan = adaptive_plan(mech, options)
     ndim = len(mech.task_axes)
     adaptive_population_stats(mech, designs[:1], options, packed[:1], tol, edges, region)  # compiled or loaded
     t0 = time.perf_counter()
@@ -199,7 +199,7 @@ def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int 
     alternately in this process, and the twin's agreement with the kernel on them."""
     import numba
 
-    plan = adaptive_plan(mech)
+    plan = adaptive_plan(mech, options)
     ndim = len(mech.task_axes)
     field_twin = TWINS[name]
     k = min(k, len(designs))
@@ -224,13 +224,27 @@ def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int 
         numba.set_num_threads(threads)
     t0, c0 = time.perf_counter(), time.process_time()
     rows = []
+    iv_kernel = mech.interval_kernel_for(options)
+
+    def intervals(p):
+        """The twin's column intervals: the mechanism's closed-form ones (Numba; tested against its reach kernel in
+        tests/test_tool_intervals.py), as the kernel reads them; None: nodes and bisection."""
+        if iv_kernel is None:
+            return None
+
+        def column(x, y, zlo, zhi):
+            out = np.empty((8, 2))
+            k = iv_kernel(p, x, y, zlo, zhi, out)
+            return None if k < 0 else [(float(a), float(b)) for a, b in out[:k]]
+        return column
+
     lo, hi = design_boxes(mech, sub, options, region)
     half = HalfBox.of(mech, options, lo, hi, plan)  # the same half box as the kernel (mirror symmetries)
     for i, d in enumerate(sub):
         row, *rest = naive.column_stats(lambda pts, d=d: fields(pts, d), TWIN_FIELDS, half.lo[i], hi[i], ndim,
                                         half.columns, half.cells, plan.bisections, plan.levels, tol.volume, tol.gci,
                                         edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces, ny=half.ny,
-                                        mirror=half.mirror)
+                                        mirror=half.mirror, intervals=intervals(sub_packed[i]))
         rows.append((half.whole(row[None, :], TWIN_FIELDS)[0], *rest))
     twin_wall, twin_cpu = time.perf_counter() - t0, time.process_time() - c0
 

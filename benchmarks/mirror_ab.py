@@ -30,7 +30,7 @@ def ab(name: str, n_designs: int, rounds: int, lci_only: bool) -> dict:
     designs = random_designs(cfg, n_designs)
     packed = np.stack([mech.pack(d, options) for d in designs])
     lo, hi = design_boxes(mech, designs, options, cfg.grid.region)
-    half = HalfBox.of(mech, options, lo, hi, adaptive_plan(mech))
+    half = HalfBox.of(mech, options, lo, hi, adaptive_plan(mech, options))
 
     def run(mirror: bool):
         t0 = time.perf_counter()

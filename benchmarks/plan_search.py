@@ -7,7 +7,7 @@ kernel calls.
     python benchmarks/plan_search.py rps-upu-tool --ab 24,8,5,3,1,5,2,1 16,8,5,3,2,3,1,1   # time A/B only
 
 For every plan of the grid (the product of the axis lists; any axis can be overridden, comma-separated; or
-``--plans``: columns,cells,bisections,levels,beta,zlevels,zconfirm,faces each) it runs ``column_stats`` with the
+``--plans``: columns,cells,bisections,levels,beta,zlevels,zconfirm,faces each) it runs the evaluator (``adaptive_population_stats``: mirror half boxes, column intervals) with the
 mechanism's LCI kernel (slot 0 bit for bit the field kernel's: the same volume, GCI, levels and calls) and one
 Numba thread on the designs of ``benchmarks/adaptive.py`` (``random_designs(cfg, 20, seed)``) and reports the mean
 kernel calls per design and the worst volume (relative) and GCI (absolute) errors against a uniform reference grid
@@ -40,8 +40,14 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 from adaptive import CONFIGS, OLD_RESOLUTION, SLIVER, gci_of, random_designs  # noqa: E402
 
 from scalesynth.config import load_config  # noqa: E402
-from scalesynth.evaluate import ColumnPlan, Tolerance, adaptive_plan, design_boxes, make_grid  # noqa: E402
-from scalesynth.kernels.adaptive import column_stats  # noqa: E402
+from scalesynth.evaluate import (  # noqa: E402
+    ColumnPlan,
+    Tolerance,
+    adaptive_plan,
+    adaptive_population_stats,
+    design_boxes,
+    make_grid,
+)
 
 # the default grid (issue 15's search space); --AXIS a,b,c overrides one axis
 GRID = {
@@ -122,13 +128,12 @@ class Search:
     def run(self, plan: ColumnPlan, seed: int):
         """(volume, GCI, calls per design, the evaluator's own error estimate as a multiple of the tolerance) of
         every design of a seed by the plan."""
-        _, packed, lo, hi, _, _ = self.design_set(seed)
-        stats, est_v, est_g, _, calls = column_stats(self.mech.lci_kernel, self.mech.n_fields, packed, lo, hi, self.ndim,
-                                             plan.columns, plan.cells, plan.bisections, plan.levels,
-                                             self.tol.volume, self.tol.gci, self.edges, plan.beta, plan.zlevels,
-                                             plan.zconfirm, plan.faces, self.mech.reach_kernel)
-        cell = np.prod((hi - lo)[:, :self.ndim], axis=1) / plan.coarse_cells(self.ndim)
-        return stats[:, 0] * cell, gci_of(stats), calls, np.maximum(est_v / self.tol.volume, est_g / self.tol.gci)
+        designs, packed, _, _, _, _ = self.design_set(seed)
+        # the evaluator's own path (the mirror's half box, the column intervals) with the plan
+        r = adaptive_population_stats(self.mech, designs, self.options, packed, self.tol, self.edges, self.region,
+                                      plan=plan, lci_only=True)
+        est = np.maximum(r.error_volume / self.tol.volume, r.error_gci / self.tol.gci)
+        return r.stats[:, 0] * r.cell, gci_of(r.stats), r.evaluations, est
 
     def score(self, plan: ColumnPlan, seed: int, limit: float):
         """(calls per design, volume error / tol, GCI error / tol, worst design, note, largest own estimate / tol):
@@ -227,7 +232,7 @@ def main(argv=None) -> None:
                 grid[axis] = [bool(int(v)) if kind is bool else kind(v) for v in text.split(",")]
         plans = grid_plans(grid)
     print(f"# {a.mechanism}: {len(plans)} plans, reference N = {s.n_ref}, tolerance {s.tol}, current plan "
-          f"{plan_label(adaptive_plan(s.mech))}", flush=True)
+          f"{plan_label(adaptive_plan(s.mech, s.options))}", flush=True)
     search(s, plans, seeds, a.margin, a.every_seed)
 
 

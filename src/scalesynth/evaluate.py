@@ -153,7 +153,7 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
     "ups-sspr": ColumnPlan(6, 4, 8, 3, beta=1.0),
     "rps-upu": ColumnPlan(24, 8, 5, 3, beta=3.0),
     "2pauu-ppap": ColumnPlan(24, 8, 5, 3, beta=3.0, zlevels=5, zconfirm=2, faces=True),
-    # rps-upu-tool: from benchmarks/plan_search.py's 1926 plans (LCI kernel; benchmarks/notes/adaptive_plans.md), the
+    # rps-upu-tool's node plan (with interference_free; else INTERVAL_PLAN_OF's): from benchmarks/plan_search.py's 1926 plans (LCI kernel; benchmarks/notes/adaptive_plans.md), the
     # one with the widest margin against the better reference N = 192 (N = 96 is 0.2-0.6x the volume tolerance off
     # it on most designs) among the cheap ones: 10 x 10 columns of 8 z-cells (up to 3 doublings, confirmed twice),
     # 5 bisections, 2 levels, face columns: 122 299 calls/design, 4.4x fewer than the 3-D default's 533 892. Errors x
@@ -171,7 +171,23 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 }
 
 
-def adaptive_plan(mech: Mechanism) -> ColumnPlan:
+# plans for the mechanisms whose columns come in closed form (Mechanism.interval_kernel_for the options): the
+# reachable length of a column is exact, so no z-levels are needed to find thin shells; the z-cells only serve the
+# Gauss rule of the fields. rps-upu-tool: benchmarks/plan_search.py's 14 plans against N = 192 on seeds 0, 1, 2
+# (benchmarks/notes/adaptive_plans.md): (10, 16, 5, 2, beta 1, faces) is within 0.60x (volume) and 0.52x (GCI) of the
+# tolerance on all three at 7 320 calls per design, against its node plan's 19 512 (with intervals) or 61 150 (without);
+# 8 columns or 12 z-cells miss (8.5x the volume tolerance on a seed-0 design; 1.65x in GCI), and 8 z-cells with no
+# z-levels are 12x off in GCI (the fields' Gauss rule needs the 16)
+INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
+    "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
+}
+
+
+def adaptive_plan(mech: Mechanism, options: Mapping[str, Any] | None = None) -> ColumnPlan:
+    """The mechanism's plan: its interval plan (INTERVAL_PLAN_OF) when its interval kernel handles these resolved
+    options, else its node plan (ADAPTIVE_PLAN_OF, or the default per task dimension)."""
+    if options is not None and mech.name in INTERVAL_PLAN_OF and mech.interval_kernel_for(options) is not None:
+        return INTERVAL_PLAN_OF[mech.name]
     return ADAPTIVE_PLAN_OF.get(mech.name, ADAPTIVE_PLAN[len(mech.task_axes)])
 
 
@@ -245,13 +261,13 @@ def adaptive_population_stats(
     the mechanism's mirror axes (``mirror_halves``) only the half box >= 0 is evaluated, with half the plan's
     columns (or z-cells) there, and the extensive statistics are doubled: the same columns and nodes as the full
     box, to rounding (tests/test_mirror.py). ``intervals``: columns whose reachable set the mechanism gives in
-    closed form (``Mechanism.interval_kernel``) skip the nodes and bisections (False: nodes everywhere, for A/B
-    comparisons)."""
+    closed form (``Mechanism.interval_kernel_for`` the options) skip the nodes and bisections, and the default plan
+    is the mechanism's interval plan (``adaptive_plan``); False: nodes everywhere with the node plan (A/B)."""
     from scalesynth.kernels.adaptive import column_stats
 
     n = len(designs)
     ndim = len(mech.task_axes)
-    plan = plan or adaptive_plan(mech)
+    plan = plan or adaptive_plan(mech, options if intervals else None)  # without intervals: the node plan
     if boxes is None:
         lo, hi = design_boxes(mech, designs, options, region)
     else:
@@ -260,12 +276,13 @@ def adaptive_population_stats(
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
     half = HalfBox.of(mech, options, lo, hi, plan, mirror)
     kernel = mech.lci_kernel if lci_only else mech.field_kernel
+    interval_kernel = mech.interval_kernel_for(options) if intervals else None
     stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, half.lo, hi, ndim,
                                                       half.columns, half.cells, plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
                                                       plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel,
                                                       ny=half.ny, mirror=half.mirror,
-                                                      interval_kernel=mech.interval_kernel if intervals else None)
+                                                      interval_kernel=interval_kernel)
     stats = half.whole(stats, mech.n_fields)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 

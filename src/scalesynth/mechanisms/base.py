@@ -227,6 +227,12 @@ class Mechanism(ABC):
         kernels.adaptive). Default: None (nodes and bisection everywhere)."""
         return None
 
+    def interval_kernel_for(self, options: Mapping[str, Any]):
+        """``interval_kernel`` where it handles every column under these resolved options, else None: the adaptive
+        evaluator then runs the mechanism's node plan (evaluate.adaptive_plan), whose z-levels find the thin shells
+        that nodes miss. Default: the interval kernel whatever the options."""
+        return self.interval_kernel
+
     @property
     def point_kernel(self):
         """Scalar LCI kernel ``f(p, x, y, z) -> LCI or -1`` derived from the field kernel (single points, plots)."""

@@ -1593,6 +1593,11 @@ class RpsUpuTool(RpsUpu):
         form (-1: not handled, evaluate points with reach_kernel instead)."""
         return _tool_column_intervals
 
+    def interval_kernel_for(self, options):
+        """None with interference_free (the clearance then decides reachability too: _tool_column_intervals returns
+        -1 on every column), else the interval kernel."""
+        return None if options["interference_free"] else _tool_column_intervals
+
     def kernel_branch(self, options) -> str:
         return "++"
 
