@@ -153,7 +153,8 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
     "ups-sspr": ColumnPlan(6, 4, 8, 3, beta=1.0),
     "rps-upu": ColumnPlan(24, 8, 5, 3, beta=3.0),
     "2pauu-ppap": ColumnPlan(24, 8, 5, 3, beta=3.0, zlevels=5, zconfirm=2, faces=True),
-    # rps-upu-tool's node plan (with interference_free; else INTERVAL_PLAN_OF's): from benchmarks/plan_search.py's 1926 plans (LCI kernel; benchmarks/notes/adaptive_plans.md), the
+    # rps-upu-tool's node plan (with interference_free; else INTERVAL_PLAN_OF's): from benchmarks/plan_search.py's
+    # 1926 plans (LCI kernel; benchmarks/notes/adaptive_plans.md), the
     # one with the widest margin against the better reference N = 192 (N = 96 is 0.2-0.6x the volume tolerance off
     # it on most designs) among the cheap ones: 10 x 10 columns of 8 z-cells (up to 3 doublings, confirmed twice),
     # 5 bisections, 2 levels, face columns: 122 299 calls/design, 4.4x fewer than the 3-D default's 533 892. Errors x
