@@ -208,12 +208,12 @@ class UniformPlan:
         return min(ok) if ok else None
 
 
-# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/50 of the adaptive evaluator
-# at (0.2 %, 5e-4) (N = 72: 1.5 ms against 72 ms per design, one thread). Ladders on the config's bounds
-# (paper_2pauu_ppap.yaml; quick.yaml has the same), worst volume / GCI error as multiples of the tolerance on seed 0 |
-# seed 1 (benchmarks/notes/uniform_plans.md): N = 72 at (0.2 %, 5e-4): 0.41, 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 |
-# 1.06, 1.04; N = 64: 1.04 on seed 0); N = 32 at (1 %, 2.5e-3): 0.68, 0.32 | 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57,
-# 0.46 | 0.50, 0.74 (N = 20: 0.85, 0.88 on seed 0)
+# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/10 of the adaptive evaluator
+# at (0.2 %, 5e-4) (N = 72: 1.5 ms against 15 ms per design on the quarter box of its symmetries, one thread).
+# Ladders on the config's bounds (paper_2pauu_ppap.yaml; quick.yaml has the same), worst volume / GCI error as
+# multiples of the tolerance on seed 0 | seed 1 (benchmarks/notes/uniform_plans.md): N = 72 at (0.2 %, 5e-4): 0.41,
+# 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 | 1.06, 1.04; N = 64: 1.04 on seed 0); N = 32 at (1 %, 2.5e-3): 0.68, 0.32 |
+# 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57, 0.46 | 0.50, 0.74 (N = 20: 0.85, 0.88 on seed 0)
 UNIFORM_PLAN_OF: dict[str, UniformPlan] = {
     "2pauu-ppap": UniformPlan(((0.002, 5.0e-4, 72), (0.01, 2.5e-3, 32), (0.03, 5.0e-3, 24))),
 }
