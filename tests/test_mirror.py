@@ -174,3 +174,17 @@ def test_half_box_on_a_cross_axis_equals_the_full_box(name, axis):
     # measurement on rps-upu-tool), so every statistic to 1e-5
     np.testing.assert_allclose(half.stats, full.stats, rtol=1e-5)
     assert np.all(half.evaluations <= 0.5 * full.evaluations + 1)
+
+
+def test_reports_name_the_half_box_and_the_column_intervals():
+    """evaluator_description (report.md, report.html, manifest.json) says what the config's design runs."""
+    from pathlib import Path
+
+    from scalesynth.config import load_config
+    from scalesynth.evaluate import evaluator_description
+
+    tool = Path(__file__).resolve().parents[1] / "configs" / "rps_upu_tool.yaml"
+    assert evaluator_description(load_config(tool)) == ("tolerance volume 0.002, GCI 0.0005: adaptive evaluator (half "
+                                                        "box of the mirror symmetry in y; column intervals)")
+    free = load_config(tool, ["options.interference_free=true", "options.load=[0, 20, -150]"])
+    assert evaluator_description(free) == "tolerance volume 0.002, GCI 0.0005: adaptive evaluator"

@@ -695,8 +695,17 @@ def evaluator_description(cfg) -> str:
     tol = config_tolerance(cfg)
     if tol is None:
         return f"uniform grid, {cfg.grid.resolution} cells per axis"
-    n = uniform_resolution(cfg.mech, tol)
-    how = "adaptive evaluator" if n is None else f"calibrated uniform grid, {n} cells per axis"
+    mech, options = cfg.mech, cfg.resolved_options()
+    n = uniform_resolution(mech, tol)
+    how = f"calibrated uniform grid, {n} cells per axis" if n is not None else "adaptive evaluator"
+    if n is None:
+        # what the config's own design runs: the half box of a mirror symmetry, closed-form column intervals
+        lo, hi = design_boxes(mech, [cfg.resolved_design()], options, cfg.grid.region)
+        halves = mirror_halves(mech, options, lo, hi, adaptive_plan(mech, options))
+        extras = ([f"half box of the mirror symmetry in {' and '.join(mech.task_axes[a] for a in halves)}"]
+                  if halves else []) + (["column intervals"] if mech.interval_kernel_for(options) is not None else [])
+        if extras:
+            how += f" ({'; '.join(extras)})"
     return f"tolerance volume {tol.volume:g}, GCI {tol.gci:g}: {how}"
 
 
