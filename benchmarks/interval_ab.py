@@ -3,7 +3,8 @@
     NUMBA_NUM_THREADS=1 python benchmarks/interval_ab.py [MECH] [N_DESIGNS]   # default rps-upu-tool, 20
 
 Random designs of the mechanism's config (benchmarks/adaptive.py's random_designs, seed 0), the search's call
-(adaptive_population_stats with lci_only=True) with intervals on and off, alternately, best of 3: ms/design and
+(adaptive_population_stats with lci_only=True) with intervals on (the interval plan, evaluate.INTERVAL_PLAN_OF) and
+off (nodes and bisection with the node plan), alternately, best of 3: ms/design and
 kernel calls/design; then both against the uniform grid N = 96 (volume relative, GCI absolute; worst design and
 the errors as multiples of the config's tolerance).
 """
@@ -71,4 +72,4 @@ def main(name: str = "rps-upu-tool", n: int = 20) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "rps-upu", int(sys.argv[2]) if len(sys.argv) > 2 else 20)
+    main(sys.argv[1] if len(sys.argv) > 1 else "rps-upu-tool", int(sys.argv[2]) if len(sys.argv) > 2 else 20)
