@@ -192,37 +192,11 @@ def refine_grid(g, ndim):
     return out
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
-def _keep_gauss_pair(q0, q1, half, hz0, area, buf, wbuf, npts, col_l, col_s):
-    """Step 2 for one piece of half-length ``half``: its two Gauss points' fields q0, q1 (n_fields,) into buf[:, npts]
-    and on, their weights (x area, in units of hz0) into wbuf, a point that is unreachable giving its weight to
-    the other (none kept if both are). Returns the new (npts, column measure, column LCI sum)."""
-    ok0 = q0[0] >= 0.0
-    ok1 = q1[0] >= 0.0
-    if not ok0 and not ok1:
-        return npts, col_l, col_s
-    w = half / hz0 if ok0 and ok1 else 2.0 * half / hz0
-    if ok0:
-        for f in range(q0.shape[0]):
-            buf[f, npts] = q0[f]
-        wbuf[npts] = w * area
-        npts += 1
-        col_l += w
-        col_s += w * q0[0]
-    if ok1:
-        for f in range(q1.shape[0]):
-            buf[f, npts] = q1[f]
-        wbuf[npts] = w * area
-        npts += 1
-        col_l += w
-        col_s += w * q1[0]
-    return npts, col_l, col_s
-
-
 def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out):
     """Template (serial): one column at (x, y) with ``mz`` z-cells of height ``hz`` (steps 1-2): its Gauss points'
     fields into buf[:, :npts] and weights (x ``area``, in units of ``hz0``) into wbuf; out = (column measure L, LCI
     sum S, npts, field-kernel calls)."""
+    n_fields = N_FIELDS
     evals = 0.0
     for k in range(mz + 1):
         zk = _add_product(zlo, END_NUDGE if k == 0 else (mz - END_NUDGE if k == mz else k), hz)
@@ -272,7 +246,25 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
             FIELD_KERNEL(p, x, _add_product(zm, -half, GAUSS_X), zfix, q0)
             FIELD_KERNEL(p, x, _add_product(zm, half, GAUSS_X), zfix, q1)
         evals += 2
-        npts, col_l, col_s = _keep_gauss_pair(q0, q1, half, hz0, area, buf, wbuf, npts, col_l, col_s)
+        ok0 = q0[0] >= 0.0
+        ok1 = q1[0] >= 0.0
+        if not ok0 and not ok1:
+            continue
+        w = half / hz0 if ok0 and ok1 else 2.0 * half / hz0
+        if ok0:
+            for f in range(n_fields):
+                buf[f, npts] = q0[f]
+            wbuf[npts] = w * area
+            npts += 1
+            col_l += w
+            col_s += w * q0[0]
+        if ok1:
+            for f in range(n_fields):
+                buf[f, npts] = q1[f]
+            wbuf[npts] = w * area
+            npts += 1
+            col_l += w
+            col_s += w * q1[0]
     out[0] = col_l
     out[1] = col_s
     out[2] = npts
@@ -290,6 +282,7 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
     if ndim != 3:
         NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
         return
+    n_fields = N_FIELDS
     iv = nodes[: 2 * MAX_INTERVALS].reshape((MAX_INTERVALS, 2))
     # the top is the last node of the node path (zlo + mz hz), not the box's hi: the same column to rounding
     k = INTERVAL_KERNEL(p, x, y, zlo, _add_product(zlo, mz, hz), iv)
@@ -322,7 +315,25 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
             FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
             FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
             evals += 2
-            npts, col_l, col_s = _keep_gauss_pair(q0, q1, half, hz0, area, buf, wbuf, npts, col_l, col_s)
+            ok0 = q0[0] >= 0.0
+            ok1 = q1[0] >= 0.0
+            if not ok0 and not ok1:
+                continue
+            w = half / hz0 if ok0 and ok1 else 2.0 * half / hz0
+            if ok0:
+                for f in range(n_fields):
+                    buf[f, npts] = q0[f]
+                wbuf[npts] = w * area
+                npts += 1
+                col_l += w
+                col_s += w * q0[0]
+            if ok1:
+                for f in range(n_fields):
+                    buf[f, npts] = q1[f]
+                wbuf[npts] = w * area
+                npts += 1
+                col_l += w
+                col_s += w * q1[0]
     out[0] = col_l
     out[1] = col_s
     out[2] = npts
