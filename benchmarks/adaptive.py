@@ -19,8 +19,10 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -75,6 +77,31 @@ def random_designs(cfg, n: int, seed: int = 0) -> list[dict[str, float]]:
     return out
 
 
+@dataclass(frozen=True)
+class DesignSet:
+    """One mechanism's benchmark config, its tolerance (the default where the config has a resolution), band edges
+    and ``random_designs`` with their packed parameters (d, k)."""
+
+    cfg: Any
+    mech: Any
+    options: dict
+    tol: Tolerance
+    edges: np.ndarray
+    region: Any
+    designs: list
+    packed: np.ndarray
+
+
+def design_set(name: str, n: int = N_DESIGNS, seed: int = 0) -> DesignSet:
+    """The benchmark's designs of mechanism ``name`` (its config in CONFIGS)."""
+    cfg = load_config(ROOT / "configs" / CONFIGS[name])
+    mech, options = cfg.mech, cfg.resolved_options()
+    tol = Tolerance(**cfg.grid.tolerance.model_dump()) if cfg.grid.tolerance is not None else Tolerance()
+    designs = random_designs(cfg, n, seed)
+    return DesignSet(cfg, mech, options, tol, np.asarray(cfg.dexterity.band_edges, dtype=float), cfg.grid.region,
+                     designs, np.stack([mech.pack(d, options) for d in designs]))
+
+
 def uniform(mech, designs, options, n, edges, region):
     """(volume, gci, seconds per design) on the uniform n-per-axis grid."""
     grids = [make_grid(mech, d, options, n, region) for d in designs]
@@ -102,17 +129,12 @@ def errors(vol, gci, ref_vol, ref_gci, keep=None):
 
 
 def bench_mechanism(name: str) -> dict:
-    cfg = load_config(ROOT / "configs" / CONFIGS[name])
-    mech, options = cfg.mech, cfg.resolved_options()
-    tol = Tolerance(**cfg.grid.tolerance.model_dump()) if cfg.grid.tolerance is not None else Tolerance()
-    edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
-    region = cfg.grid.region
-    designs = random_designs(cfg, N_DESIGNS)
+    s = design_set(name)
+    mech, options, tol, edges, region, designs, packed = s.mech, s.options, s.tol, s.edges, s.region, s.designs, s.packed
     n_ref = 3 * OLD_RESOLUTION[name]
     ref_vol, ref_gci, ref_sec = uniform(mech, designs, options, n_ref, edges, region)
     solid = ref_vol >= SLIVER * np.median(ref_vol)
     print(f"{name}: reference N = {n_ref}: {ref_sec * 1e3:.1f} ms/design; {int((~solid).sum())} slivers", flush=True)
-    packed = np.stack([mech.pack(d, options) for d in designs])
     plan = adaptive_plan(mech, options)
     ndim = len(mech.task_axes)
     adaptive_population_stats(mech, designs[:1], options, packed[:1], tol, edges, region)  # compiled or loaded
@@ -290,12 +312,8 @@ def bench_twin(names: list[str] | None = None) -> dict:
     its own date and load average: merged into the stored adaptive rows without re-measuring the rest."""
     out = {}
     for name in names or list(CONFIGS):
-        cfg = load_config(ROOT / "configs" / CONFIGS[name])
-        mech, options = cfg.mech, cfg.resolved_options()
-        tol = Tolerance(**cfg.grid.tolerance.model_dump()) if cfg.grid.tolerance is not None else Tolerance()
-        edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
-        designs = random_designs(cfg, N_DESIGNS)
-        packed = np.stack([mech.pack(d, options) for d in designs])
+        s = design_set(name)
+        cfg, mech, options, tol, edges, designs, packed = s.cfg, s.mech, s.options, s.tol, s.edges, s.designs, s.packed
         print(f"{name}:", flush=True)
         load = os.getloadavg()[0]
         twin = numpy_twin(name, mech, designs, options, packed, tol, edges, cfg.grid.region)

@@ -20,22 +20,16 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from adaptive import CONFIGS, gci_of, random_designs  # noqa: E402
+from adaptive import design_set, gci_of  # noqa: E402
 
-from scalesynth.config import load_config  # noqa: E402
-from scalesynth.evaluate import Tolerance, adaptive_population_stats, make_grid  # noqa: E402
+from scalesynth.evaluate import adaptive_population_stats, make_grid  # noqa: E402
 
 N_REF = 96
 
 
 def main(name: str = "rps-upu-tool", n: int = 20) -> None:
-    cfg = load_config(ROOT / "configs" / CONFIGS[name])
-    mech, options = cfg.mech, cfg.resolved_options()
-    tol = Tolerance(**cfg.grid.tolerance.model_dump())
-    edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
-    region = cfg.grid.region
-    designs = random_designs(cfg, n)
-    packed = np.stack([mech.pack(d, options) for d in designs])
+    s = design_set(name, n)
+    mech, options, tol, edges, region, designs, packed = s.mech, s.options, s.tol, s.edges, s.region, s.designs, s.packed
 
     def run(on: bool):
         t0 = time.perf_counter()

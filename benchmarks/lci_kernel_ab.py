@@ -14,20 +14,14 @@ import argparse
 import os
 import time
 
-import numpy as np
-from adaptive import CONFIGS, ROOT, random_designs
+from adaptive import design_set
 
-from scalesynth.config import load_config
-from scalesynth.evaluate import Tolerance, adaptive_population_stats
+from scalesynth.evaluate import adaptive_population_stats
 
 
 def ab(name: str, n_designs: int, rounds: int) -> dict:
-    cfg = load_config(ROOT / "configs" / CONFIGS[name])
-    mech, options = cfg.mech, cfg.resolved_options()
-    tol = Tolerance(**cfg.grid.tolerance.model_dump()) if cfg.grid.tolerance is not None else Tolerance()
-    edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
-    designs = random_designs(cfg, n_designs)
-    packed = np.stack([mech.pack(d, options) for d in designs])
+    s = design_set(name, n_designs)
+    cfg, mech, options, tol, edges, designs, packed = s.cfg, s.mech, s.options, s.tol, s.edges, s.designs, s.packed
 
     def run(lci_only: bool):
         t0 = time.perf_counter()
