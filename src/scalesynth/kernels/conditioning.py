@@ -89,6 +89,26 @@ def sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
 
 
 @njit(cache=True, fastmath=FASTMATH, inline="always")
+def cos_third_acos(r):
+    """cos(acos(r) / 3) for r in [-1, 1] (clamped), the scaled largest eigenvalue of the trigonometric cubic solution,
+    without a transcendental call, so that a loop of it vectorises (libm's acos and cos do not).
+
+    t = cos(acos(r) / 3) is the root in [1/2, 1] of 4 t^3 - 3 t = r (the triple-angle identity); with t = (1 + u) / 2
+    that is u^3 + 3 u^2 = 2 (1 + r), u in [0, 1]. The guess u0 = sqrt(2 (1 + r) / (3 + sqrt((1 + r) / 2))) is exact
+    at both ends; two Halley steps take it to rounding (2.3e-16 from the libm form over [-1, 1], tests). Near r = -1,
+    where the two largest eigenvalues meet, both forms share the same conditioning (t - 1/2 ~ sqrt(1 + r)). Every
+    divisor is bounded away from 0 by a max, which also keeps Numba's division-by-zero branch out of the loop."""
+    s2 = max(0.0, min(4.0, 2.0 * (1.0 + r)))
+    u = math.sqrt(s2 / max(3.0, 3.0 + math.sqrt(0.25 * s2)))
+    for _ in range(2):  # Halley: u -= 2 h h' / (2 h'^2 - h h'') on h(u) = u^3 + 3 u^2 - s2
+        uu = u * u
+        h = uu * (u + 3.0) - s2
+        d = 3.0 * uu + 6.0 * u
+        u = u - 2.0 * h * d / max(1e-300, 2.0 * d * d - h * (6.0 * u + 6.0))
+    return 0.5 * (1.0 + u)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
 def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
     """sigma_min/sigma_max of the 3x3 matrix with rows (a11, a12, a13), (a21, ...), (a31, ...) (see sv_3x3)."""
     return sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33)[0]
