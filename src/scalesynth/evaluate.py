@@ -208,8 +208,8 @@ class UniformPlan:
         return min(ok) if ok else None
 
 
-# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/10 of the adaptive evaluator
-# at (0.2 %, 5e-4) (N = 72: 1.5 ms against 15 ms per design on the quarter box of its symmetries, one thread).
+# 2pauu-ppap: its uniform fast path (column intervals, mirror symmetries) costs about 1/15 of the adaptive evaluator
+# at (0.2 %, 5e-4) (N = 72: 0.96 ms against 15 ms per design on the quarter box of its symmetries, one thread).
 # Ladders on the config's bounds (paper_2pauu_ppap.yaml; quick.yaml has the same), worst volume / GCI error as
 # multiples of the tolerance on seed 0 | seed 1 (benchmarks/notes/uniform_plans.md): N = 72 at (0.2 %, 5e-4): 0.41,
 # 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 | 1.06, 1.04; N = 64: 1.04 on seed 0); N = 32 at (1 %, 2.5e-3): 0.68, 0.32 |
@@ -501,6 +501,10 @@ class WorkspaceReport:
             (``Mechanism.task_axes``).
         grid: only with ``keep_grid=True``: the :class:`Grid` (``lo``, ``step``, ``shape``, ``cell_measure``).
         seconds: kernel wall time of the metrics (without JIT compilation and without the per-voxel pass).
+        resolution: cells per axis of the uniform grid behind the metrics (with a tolerance on a calibrated
+            uniform grid, its N); with the adaptive evaluator, the grid that ``keep_grid`` samples.
+        grid_cells: cells of that grid; with a tolerance, kernel calls (a calibrated grid: its cells and those
+            of the 2x finer grid behind the estimates).
     """
 
     mechanism: str
@@ -578,6 +582,8 @@ def evaluate(
                              cycle)
         values.update(error_volume=ad.error_volume, error_gci=ad.error_gci)
         n_cells = int(ad.evaluations[0])
+        # a calibrated uniform grid reports its own N (not the grid that keep_grid samples)
+        reported_resolution = uniform_resolution(mech, tolerance) or resolution
     else:
         warm_up(mech, packed, edges)
         t0 = time.perf_counter()
@@ -586,6 +592,7 @@ def evaluate(
         values = _metrics_of(mech, [design], options, packed, stats, np.array([g.cell_measure]), resolution,
                              band_edges, unit, task, cycle)
         n_cells = g.n_cells
+        reported_resolution = resolution
     metrics = {k: v[0].item() for k, v in values.items()}
     fields = None
     if keep_grid:
@@ -596,7 +603,7 @@ def evaluate(
         measure_key=mech.measure_key(unit),
         metrics=metrics,
         band_edges=[float(e) for e in band_edges],
-        resolution=resolution,
+        resolution=reported_resolution,
         grid_cells=n_cells,
         seconds=seconds,
         field_names=mech.field_names,
