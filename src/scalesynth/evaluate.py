@@ -181,6 +181,11 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # z-levels are 12x off in GCI (the fields' Gauss rule needs the 16)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
+    # ups-sspr (Y-columns in closed form, ups_sspr.column_intervals): benchmarks/plan_search.py's 864 plans against
+    # N = 192 (columns 4-8, cells 1-4, levels 3, beta 1-3, z-levels, faces), the cheapest within 0.8x of the
+    # tolerance on seeds 0, 1, 2: 0.74x (volume) and 0.64x (GCI) at worst, 0.75x on seeds 3, 4; 562 calls per design
+    # (LCI kernel) against the node plan's 2534 (with the same columns, 4 z-cells and every call a node or bisection)
+    "ups-sspr": ColumnPlan(6, 2, 8, 3, beta=2.0, faces=True),
 }
 
 
