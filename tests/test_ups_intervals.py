@@ -126,7 +126,6 @@ def test_intervals_match_reach_kernel():
                 counts["split"] += 1
                 assert interval(p, x, y, zlo, zhi, np.empty((k - 1, 2))) == -1
     assert counts["points"] == N_DESIGNS * N_COLUMNS * N_POINTS == 1_200_000
-    print(counts)
     assert all(counts[key] > 0 for key in ("empty", "whole", "split", "ends", "outside")), counts
 
 
@@ -164,3 +163,17 @@ def test_interference_free_falls_back():
     assert UPS.interval_kernel(p, 0.6, 0.0, -100.0, 100.0, np.empty((K, 2))) == -1
     assert UPS.interval_kernel_for(options) is None
     assert UPS.interval_kernel_for(UPS.resolve_options({})) is UPS.interval_kernel
+
+
+def test_the_interval_plan_only_where_every_column_is_in_closed_form():
+    """evaluate.adaptive_plan: ups-sspr's interval plan (2 z-cells: the column lengths are exact, the z-cells only
+    serve the fields' Gauss rule) with its interval kernel; with interference_free the node plan (4 z-cells and
+    bisection)."""
+    from scalesynth.evaluate import ADAPTIVE_PLAN_OF, INTERVAL_PLAN_OF, adaptive_plan
+
+    plain = UPS.resolve_options({})
+    free = UPS.resolve_options({"interference_free": True})
+    assert adaptive_plan(UPS, plain) == INTERVAL_PLAN_OF["ups-sspr"]
+    assert adaptive_plan(UPS, plain).cells < ADAPTIVE_PLAN_OF["ups-sspr"].cells
+    assert adaptive_plan(UPS, free) == ADAPTIVE_PLAN_OF["ups-sspr"]
+    assert adaptive_plan(UPS) == ADAPTIVE_PLAN_OF["ups-sspr"]
