@@ -150,7 +150,7 @@ class ColumnPlan:
 ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6),
                  3: ColumnPlan(24, 8, 5, 3, beta=1.0, zlevels=5, zconfirm=2, faces=True)}
 ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
-    "ups-sspr": ColumnPlan(6, 4, 8, 3, beta=1.0),
+    "ups-sspr": ColumnPlan(6, 4, 8, 3, beta=1.0),  # with interference_free; else INTERVAL_PLAN_OF's
     "rps-upu": ColumnPlan(24, 8, 5, 3, beta=3.0),
     "2pauu-ppap": ColumnPlan(24, 8, 5, 3, beta=3.0, zlevels=5, zconfirm=2, faces=True),
     # rps-upu-tool's node plan (with interference_free; else INTERVAL_PLAN_OF's): from benchmarks/plan_search.py's
