@@ -351,6 +351,141 @@ def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
     return _legs_k.response_upper(kk, fxx, fe, fh, length)
 
 
+# ----- reachable intervals of a Y-column (closed form) ----------------------------------------------------
+# breakpoints of a column: its window's ends (2), l1's limits (2), two roots per stroke limit of legs 2 and 3 (8)
+_MAX_BREAKS = 12
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_crossings(q, u, w, c, lower, upper, brk, n):
+    """Append to brk[n:] each Y in (lower, upper) (mm) where q + 2 u Y + 2 w rho(Y) = 0, rho = sqrt(c^2 - Y^2):
+    a UPS leg's squared length minus a stroke limit squared, q = K - limit^2 (mm^2). Isolating the root and
+    squaring gives s Y^2 + q u Y + q^2 / 4 - w^2 c^2 = 0 (s = u^2 + w^2), roots (-q u / 2 +- |w| sqrt(D)) / s with
+    D = c^2 s - q^2 / 4 (written so that w = 0 gives the double root -q / 2u exactly); a root where q + 2 u Y and w
+    have the same sign solves q + 2 u Y = +2 w rho instead (the squaring's spurious root) and is dropped. Returns the
+    new count."""
+    s = u * u + w * w
+    if not s > 0.0:
+        return n  # the length is constant along the column
+    d = c * c * s - 0.25 * q * q
+    if not d >= 0.0:
+        return n
+    mid = -0.5 * q * u
+    half = abs(w) * math.sqrt(d)
+    for r in ((mid - half) / s, (mid + half) / s):
+        if lower < r < upper and (q + 2.0 * u * r) * w <= 0.0:
+            brk[n] = r
+            n += 1
+    return n
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _column_reach(p, c, am, e2x, e2y, e2z, e3x, e3y, e3z, sb, cb, yy):
+    """_kinematics' limit checks at Y = yy (mm) inside the column's window (|Y| < c): l1 and the squared lengths of
+    legs 2, 3 from their offsets e = R B' - A (mm) (d = P + e), as _kinematics computes them up to rounding."""
+    l1 = math.sqrt(4.0 / 9.0 * c * c + am * am + 4.0 / 3.0 * am * yy)
+    if l1 < p[_L1LO] or l1 > p[_L1HI]:
+        return False
+    rho = math.sqrt(c * c - yy * yy)
+    px = sb * rho
+    pz = cb * rho
+    dx, dy, dz = px + e2x, yy + e2y, pz + e2z
+    l2 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if l2 < p[_L2LO] or l2 > p[_L2HI]:
+        return False
+    dx, dy, dz = px + e3x, yy + e3y, pz + e3z
+    l3 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    return not (l3 < p[_L3LO] or l3 > p[_L3HI])
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def column_intervals(p, alpha, beta, zlo, zhi, out):
+    """Reachable set of the column (alpha, beta fixed (rad), Y in [zlo, zhi] (mm)) in closed form: writes its closed
+    intervals [out[i, 0], out[i, 1]] (mm, i < k, sorted, disjoint, inside [zlo, zhi]; a degenerate [a, a] is a
+    single reachable Y) into out (float64, (K, 2)) and returns k >= 0: Y is in one exactly where point_reach(p,
+    alpha, beta, Y) >= 0, to rounding at the ends. -1 (out undefined) with interference_free (the clearance decides
+    too) or when out has fewer rows than the column needs (at most 4: two per UPS leg's stroke window).
+
+    Along the column the orientation is fixed and B1 = (sin(beta) rho, Y, cos(beta) rho), rho = sqrt(c^2 - Y^2), so
+    l1^2 is linear in Y and each UPS leg's squared length is K + 2 u Y + 2 w rho(Y) (K, u, w constants): its stroke
+    limits cross at the roots of a quadratic (_leg_crossings). Between consecutive crossings (and the window's ends)
+    every limit check keeps its answer, so the midpoint of each piece decides it (_column_reach) and neighbouring
+    reachable pieces are merged: an interval end is always a crossing or a window end."""
+    if p[_FREE_ONLY] > 0.0:
+        return -1
+    if alpha < p[_ALO] or alpha > p[_AHI] or beta < p[_BLO] or beta > p[_BHI]:
+        return 0
+    c = p[_C]
+    lower = max(zlo, p[_YLO], -c)
+    upper = min(zhi, p[_YHI], c)
+    if not lower <= upper:  # also NaN
+        return 0
+    am = p[_AM]
+    ax = p[_AX]
+    bx = p[_BX]
+    by = p[_BY]
+    sa = math.sin(alpha)
+    ca = math.cos(alpha)
+    sb = math.sin(beta)
+    cb = math.cos(beta)
+    # e = R B' - A of leg 2 (A2 = (-ax, -am, 0), B2' = (-bx, by, 0)) and leg 3 (A3 = (ax, -am, 0), B3' = (bx, by, 0))
+    e2x = -cb * bx + sb * sa * by + ax
+    e3x = cb * bx + sb * sa * by - ax
+    ey = ca * by + am
+    e2z = sb * bx + cb * sa * by
+    e3z = -sb * bx + cb * sa * by
+    if lower == upper:  # a single Y
+        if lower == -c or lower == c or not _column_reach(p, c, am, e2x, ey, e2z, e3x, ey, e3z, sb, cb, lower):
+            return 0
+        if out.shape[0] < 1:
+            return -1
+        out[0, 0] = lower
+        out[0, 1] = upper
+        return 1
+    brk = np.empty(_MAX_BREAKS)
+    n = 0
+    # l1^2 = 4/9 c^2 + am^2 + 4/3 am Y: one crossing per finite limit
+    g = 4.0 / 3.0 * am
+    if g != 0.0:
+        for lim in (p[_L1LO], p[_L1HI]):
+            if abs(lim) < math.inf:
+                r = (lim * lim - 4.0 / 9.0 * c * c - am * am) / g
+                if lower < r < upper:
+                    brk[n] = r
+                    n += 1
+    # leg i: |P + e|^2 = c^2 + |e|^2 + 2 e_y Y + 2 (sin(beta) e_x + cos(beta) e_z) rho
+    for ex, ez, lo, hi in ((e2x, e2z, p[_L2LO], p[_L2HI]), (e3x, e3z, p[_L3LO], p[_L3HI])):
+        kk = c * c + ex * ex + ey * ey + ez * ez
+        w = sb * ex + cb * ez
+        for lim in (lo, hi):
+            if abs(lim) < math.inf:
+                n = _leg_crossings(kk - lim * lim, ey, w, c, lower, upper, brk, n)
+    # insertion sort of the (at most 12) crossings
+    for i in range(1, n):
+        v = brk[i]
+        j = i - 1
+        while j >= 0 and brk[j] > v:
+            brk[j + 1] = brk[j]
+            j -= 1
+        brk[j + 1] = v
+    k = 0
+    a = lower
+    for i in range(n + 1):
+        b = brk[i] if i < n else upper
+        if b > a:
+            if _column_reach(p, c, am, e2x, ey, e2z, e3x, ey, e3z, sb, cb, 0.5 * (a + b)):
+                if k > 0 and out[k - 1, 1] == a:
+                    out[k - 1, 1] = b  # a spurious or touching crossing between two reachable pieces
+                else:
+                    if k == out.shape[0]:
+                        return -1
+                    out[k, 0] = a
+                    out[k, 1] = b
+                    k += 1
+            a = b
+    return k
+
+
 def _legs(a: float, b: float, c: float, alpha: float, beta: float, yy: float):
     """Leg lengths (l1, l2, l3) and rows of Jx = dl/d(alpha, beta, Y) (spec §3.3, §3.5) at a pose with |Y| < c.
 
@@ -464,6 +599,17 @@ class UpsSspr(Mechanism):
     @property
     def lci_kernel(self):
         return lci_fields
+
+    @property
+    def interval_kernel(self):
+        """column_intervals(p, alpha, beta, zlo, zhi, out) -> k: the reachable intervals of a Y-column in closed
+        form (-1: not handled, evaluate points with reach_kernel instead)."""
+        return column_intervals
+
+    def interval_kernel_for(self, options):
+        """None with interference_free (the clearance then decides reachability too: column_intervals returns -1
+        on every column), else the interval kernel."""
+        return None if options["interference_free"] else column_intervals
 
     # ----- stiffness (scalesynth.stiffness; per voxel: point_fields slots 3, 4, the same frame) ---------------
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
