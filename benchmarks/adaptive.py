@@ -35,6 +35,8 @@ from scalesynth.evaluate import (  # noqa: E402
     Tolerance,
     adaptive_plan,
     adaptive_population_stats,
+    column_axis,
+    column_order,
     design_boxes,
     make_grid,
     mirror_halves,
@@ -261,9 +263,13 @@ def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int 
         return column
 
     lo, hi = design_boxes(mech, sub, options, region)
-    half = HalfBox.of(mech, options, lo, hi, plan)  # the same half box as the kernel (mirror symmetries)
+    axis = column_axis(mech, options)  # the kernel's column axis: the twin gets points in column order too
+    order = column_order(ndim, axis)
+    back = np.argsort(order)
+    half = HalfBox.of(mech, options, lo, hi, plan, axis=axis)  # the same half box as the kernel (mirror symmetries)
     for i, d in enumerate(sub):
-        row, *rest = naive.column_stats(lambda pts, d=d: fields(pts, d), TWIN_FIELDS, half.lo[i], hi[i], ndim,
+        row, *rest = naive.column_stats(lambda pts, d=d: fields(pts[:, back], d), TWIN_FIELDS, half.lo[i, order],
+                                        hi[i, order], ndim,
                                         half.columns, half.cells, plan.bisections, plan.levels, tol.volume, tol.gci,
                                         edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces, ny=half.ny,
                                         mirror=half.mirror, intervals=intervals(sub_packed[i]))
