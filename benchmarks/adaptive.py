@@ -188,7 +188,8 @@ def bench_mechanism(name: str) -> dict:
         "plan": {"columns": plan.columns, "cells": plan.cells, "bisections": plan.bisections, "levels": plan.levels,
                  "beta": plan.beta, "zlevels": plan.zlevels, "zconfirm": plan.zconfirm, "faces": plan.faces,
                  "mirror": [mech.task_axes[a] for a in mirror_halves(mech, options, *design_boxes(
-                     mech, designs, options, region), plan)]},
+                     mech, designs, options, region), plan, column_axis(mech, options))],
+                 "column_axis": mech.task_axes[column_axis(mech, options)]},
         "finer_check": finer,
         "adaptive": {"s_per_design": ad_sec, "volume_error": ad_ev, "gci_error": ad_eg,
                      "volume_error_solid": ad_sv, "gci_error_solid": ad_sg,
