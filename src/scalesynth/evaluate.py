@@ -146,7 +146,8 @@ class ColumnPlan:
 # 0.53x; the plan before, (8, 6, 5, 3, beta 3), was 1.02x on seed 1 (against N = 384 too). Bisections are cheap
 # (reach kernel), hence 8. rps-upu: no cheaper plan passes both sets ((15, 8, 6, 3, beta 3.5): 0.61x on seed 0,
 # 1.4-1.6x on seed-1 designs against N = 192), so (24, 8, 5, 3, beta 3) stays (0.82x / 0.80x on seed 0; 0.56x /
-# 0.75x on seed 1 without the design whose N = 96 reference is 2.45x off N = 192's)
+# 0.75x on seed 1 without the design whose N = 96 reference is 2.45x off N = 192's); since its z-column intervals
+# (INTERVAL_PLAN_OF) this psi-column node plan runs only for the C-model and interference_free
 ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6),
                  3: ColumnPlan(24, 8, 5, 3, beta=1.0, zlevels=5, zconfirm=2, faces=True)}
 ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
