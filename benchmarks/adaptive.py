@@ -35,6 +35,8 @@ from scalesynth.evaluate import (  # noqa: E402
     Tolerance,
     adaptive_plan,
     adaptive_population_stats,
+    column_axis,
+    column_order,
     design_boxes,
     make_grid,
     mirror_halves,
@@ -186,7 +188,8 @@ def bench_mechanism(name: str) -> dict:
         "plan": {"columns": plan.columns, "cells": plan.cells, "bisections": plan.bisections, "levels": plan.levels,
                  "beta": plan.beta, "zlevels": plan.zlevels, "zconfirm": plan.zconfirm, "faces": plan.faces,
                  "mirror": [mech.task_axes[a] for a in mirror_halves(mech, options, *design_boxes(
-                     mech, designs, options, region), plan)]},
+                     mech, designs, options, region), plan, column_axis(mech, options))],
+                 "column_axis": mech.task_axes[column_axis(mech, options)]},
         "finer_check": finer,
         "adaptive": {"s_per_design": ad_sec, "volume_error": ad_ev, "gci_error": ad_eg,
                      "volume_error_solid": ad_sv, "gci_error_solid": ad_sg,
@@ -261,9 +264,13 @@ def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int 
         return column
 
     lo, hi = design_boxes(mech, sub, options, region)
-    half = HalfBox.of(mech, options, lo, hi, plan)  # the same half box as the kernel (mirror symmetries)
+    axis = column_axis(mech, options)  # the kernel's column axis: the twin gets points in column order too
+    order = column_order(ndim, axis)
+    back = np.argsort(order)
+    half = HalfBox.of(mech, options, lo, hi, plan, axis=axis)  # the same half box as the kernel (mirror symmetries)
     for i, d in enumerate(sub):
-        row, *rest = naive.column_stats(lambda pts, d=d: fields(pts, d), TWIN_FIELDS, half.lo[i], hi[i], ndim,
+        row, *rest = naive.column_stats(lambda pts, d=d: fields(pts[:, back], d), TWIN_FIELDS, half.lo[i, order],
+                                        hi[i, order], ndim,
                                         half.columns, half.cells, plan.bisections, plan.levels, tol.volume, tol.gci,
                                         edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces, ny=half.ny,
                                         mirror=half.mirror, intervals=intervals(sub_packed[i]))

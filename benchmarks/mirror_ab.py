@@ -18,14 +18,14 @@ import time
 import numpy as np
 from adaptive import design_set
 
-from scalesynth.evaluate import HalfBox, adaptive_plan, adaptive_population_stats, design_boxes
+from scalesynth.evaluate import HalfBox, adaptive_plan, adaptive_population_stats, column_axis, design_boxes
 
 
 def ab(name: str, n_designs: int, rounds: int, lci_only: bool) -> dict:
     s = design_set(name, n_designs)
     cfg, mech, options, tol, edges, designs, packed = s.cfg, s.mech, s.options, s.tol, s.edges, s.designs, s.packed
     lo, hi = design_boxes(mech, designs, options, cfg.grid.region)
-    half = HalfBox.of(mech, options, lo, hi, adaptive_plan(mech, options))
+    half = HalfBox.of(mech, options, lo, hi, adaptive_plan(mech, options), axis=column_axis(mech, options))
 
     def run(mirror: bool):
         t0 = time.perf_counter()

@@ -17,6 +17,7 @@ from scalesynth.evaluate import (
     ColumnPlan,
     Tolerance,
     adaptive_population_stats,
+    column_order,
     evaluate_config,
     evaluate_population,
     make_grid,
@@ -63,16 +64,24 @@ def test_column_kernel_equals_numpy_twin(name):
     mirror = dict(ny=n - 2, mirror=(True, ndim == 3))
     plans = [(0, 1.0, 0, 1, False, {}), (2, 1.0, 0, 1, False, {}), (2, 3.0, 0, 1, False, {}),
              (2, 1.0, 2, 2, True, {}), (2, 1.0, 0, 1, True, mirror)]
-    if mech.interval_kernel is not None:  # the closed-form column intervals (the twin reads the same ones)
+    if mech.interval_kernel_for(options) is not None:  # the closed-form column intervals (the twin reads the same)
         ivs = dict(interval_kernel=mech.interval_kernel), dict(intervals=_interval_twin(mech.interval_kernel, packed))
-        plans += [(2, 1.0, 0, 1, False, ivs), (2, 1.0, 2, 2, True, ivs)]
+        plans += [(2, 1.0, 0, 1, False, ivs), (2, 1.0, 2, 2, True, ivs), (2, 1.0, 1, 1, True, (
+            {**ivs[0], **mirror}, {**ivs[1], **mirror}))]
     for maxlev, beta, zlevels, zconfirm, faces, more in plans:
         kern, twin = more if isinstance(more, tuple) else (more, more)
         opt = dict(zlevels=zlevels, zconfirm=zconfirm, faces=faces)
-        s, ev, eg, lv, ne = column_stats(mech.field_kernel, mech.n_fields, packed[None, :], lo[None, :],
-                                         hi[None, :], ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt, **kern)
-        row, tv, tg, tl, tn = column_twin(fields, mech.n_fields, lo, hi, ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES,
-                                          beta, **opt, **twin)
+        # interval columns run along the mechanism's column axis: the kernel then takes (and the twin gets) the task
+        # coordinates in column order (evaluate.column_order; rps-upu: (theta, psi, z))
+        axis = mech.column_axis(options) if "interval_kernel" in kern else ndim - 1
+        order = column_order(ndim, axis)
+        kernel = mech.column_order_kernel(mech.field_kernel, options) if axis != ndim - 1 else mech.field_kernel
+        clo, chi = lo[order], hi[order]
+        cfields = fields if axis == ndim - 1 else (lambda pts, back=np.argsort(order): fields(pts[:, back]))
+        s, ev, eg, lv, ne = column_stats(kernel, mech.n_fields, packed[None, :], clo[None, :], chi[None, :], ndim,
+                                         n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt, **kern)
+        row, tv, tg, tl, tn = column_twin(cfields, mech.n_fields, clo, chi, ndim, n, 6, 5, maxlev, 0.002, 5e-4,
+                                          EDGES, beta, **opt, **twin)
         assert row[0] > 0, name
         assert lv[0] == tl and ne[0] == tn
         assert ev[0] == pytest.approx(tv, rel=1e-10, abs=1e-15)
@@ -84,9 +93,9 @@ def test_column_kernel_equals_numpy_twin(name):
         # the slack is ~1e-16)
         slack = np.zeros(row.shape)
         for direction in (np.inf, -np.inf):
-            ulp, *_ = column_twin(lambda pts, d=direction: np.c_[fields(pts)[:, :1],
-                                                                fields(np.nextafter(pts, d))[:, 1:]],
-                                  mech.n_fields, lo, hi, ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt,
+            ulp, *_ = column_twin(lambda pts, d=direction, f=cfields: np.c_[f(pts)[:, :1],
+                                                                           f(np.nextafter(pts, d))[:, 1:]],
+                                  mech.n_fields, clo, chi, ndim, n, 6, 5, maxlev, 0.002, 5e-4, EDGES, beta, **opt,
                                   **twin)
             slack = np.maximum(slack, 4.0 * np.abs(ulp - row))
         lci_cols = [0, 1, 2, 3, 4] + list(range(1 + 4 * mech.n_fields, len(row)))

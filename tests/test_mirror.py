@@ -126,15 +126,16 @@ def _random_designs(mech, n, seed):
     return [{k: v * rng.uniform(0.7, 1.3) for k, v in base.items()} for _ in range(n)]
 
 
-def _full_and_half(name, axis, n, seed):
+def _full_and_half(name, axis, n, seed, intervals=True):
     """(mechanism, full-box result, half-box result) of the adaptive evaluator on n random designs whose boxes
     are symmetric on ``axis``, each with a non-empty workspace, at the same refinement levels."""
     mech = get(name)
     opts = mech.resolve_options({})
     designs = _random_designs(mech, n, seed)
     packed = np.stack([mech.pack(d, opts) for d in designs])
-    full = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES, mirror=False)
-    half = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES)
+    full = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES, mirror=False,
+                                     intervals=intervals)
+    half = adaptive_population_stats(mech, designs, opts, packed, Tolerance(), EDGES, intervals=intervals)
     lo, hi = design_boxes(mech, designs, opts)
     assert np.all(lo[:, axis] == -hi[:, axis])
     assert full.stats[:, 0].min() > 0.0
@@ -143,11 +144,12 @@ def _full_and_half(name, axis, n, seed):
 
 
 def test_half_box_on_the_column_axis_equals_the_full_box():
-    """rps-upu, mirror in psi (its column axis, 8 z-cells: the half box has 4 and the node at psi = 0): the same
-    nodes and Gauss points to rounding, so every statistic matches the full box's to 1e-12 relative and the levels
-    are equal; the kernel calls drop to about 5/9 of the nodes (measured 0.52x: 26 471 against 50 580 calls per
-    design on seed 3 of the rps_upu bounds)."""
-    mech, full, half = _full_and_half("rps-upu", 2, 6, 3)
+    """rps-upu's node plan (its columns along psi: the C-model's, here the P-model without intervals), mirror in psi
+    (the column axis, 8 z-cells: the half box has 4 and the node at psi = 0): the same nodes and Gauss points to
+    rounding, so every statistic matches the full box's to 1e-12 relative and the levels are equal; the kernel calls
+    drop to about 5/9 of the nodes (measured 0.52x: 26 471 against 50 580 calls per design on seed 3 of the rps_upu
+    bounds)."""
+    mech, full, half = _full_and_half("rps-upu", 2, 6, 3, intervals=False)
     # count, LCI statistics and bands (what the refinement and the searched metrics read): 1e-12; every other
     # statistic to 1e-8 (measured: sigma_max's extremes 8e-12 and the stiffness fields' 1.8e-9, both from
     # near-singular poses where a rounding of the pose moves the value most)
@@ -159,12 +161,14 @@ def test_half_box_on_the_column_axis_equals_the_full_box():
     assert np.all(half.evaluations < 0.6 * full.evaluations)
 
 
-@pytest.mark.parametrize(("name", "axis"), [("rps-upu-tool", 1), ("ups-sspr", 1), ("planar-fivebar", 0)])
+@pytest.mark.parametrize(("name", "axis"), [("rps-upu-tool", 1), ("ups-sspr", 1), ("planar-fivebar", 0),
+                                           ("rps-upu", 2)])
 def test_half_box_on_a_cross_axis_equals_the_full_box(name, axis):
     """A mirror plane on a cross axis (kernels.adaptive's ``mirror``; the kernel's own tests check it against the
     NumPy twin): the mechanism's own plan on random designs, the half box (half the columns on that axis) against
-    the full one. Count and LCI statistics to 1e-12, the same levels, about half the calls (measured exactly half
-    on the helper's 200 designs: the mirror plane takes no face columns)."""
+    the full one; rps-upu (P-model): its z-columns (Mechanism.column_axis 0), psi a cross axis. Count and LCI
+    statistics to 1e-12, the same levels, about half the calls (measured exactly half on the helper's 200 designs:
+    the mirror plane takes no face columns)."""
     mech, full, half = _full_and_half(name, axis, 5, 4)
     extensive = [0, 1, 2, *range(1 + 4 * mech.n_fields, full.stats.shape[1])]
     np.testing.assert_allclose(half.stats[:, extensive], full.stats[:, extensive], rtol=1e-12)
@@ -188,3 +192,9 @@ def test_reports_name_the_half_box_and_the_column_intervals():
                                                         "box of the mirror symmetry in y; column intervals)")
     free = load_config(tool, ["options.interference_free=true", "options.load=[0, 20, -150]"])
     assert evaluator_description(free) == "tolerance volume 0.002, GCI 0.0005: adaptive evaluator"
+    rps = Path(__file__).resolve().parents[1] / "configs" / "rps_upu.yaml"
+    assert evaluator_description(load_config(rps)) == ("tolerance volume 0.002, GCI 0.0005: adaptive evaluator (half "
+                                                       "box of the mirror symmetry in psi; column intervals)")
+    c_model = load_config(rps, ["options.model=C"])
+    assert evaluator_description(c_model) == ("tolerance volume 0.002, GCI 0.0005: adaptive evaluator (half box of "
+                                              "the mirror symmetry in psi)")

@@ -146,7 +146,8 @@ class ColumnPlan:
 # 0.53x; the plan before, (8, 6, 5, 3, beta 3), was 1.02x on seed 1 (against N = 384 too). Bisections are cheap
 # (reach kernel), hence 8. rps-upu: no cheaper plan passes both sets ((15, 8, 6, 3, beta 3.5): 0.61x on seed 0,
 # 1.4-1.6x on seed-1 designs against N = 192), so (24, 8, 5, 3, beta 3) stays (0.82x / 0.80x on seed 0; 0.56x /
-# 0.75x on seed 1 without the design whose N = 96 reference is 2.45x off N = 192's)
+# 0.75x on seed 1 without the design whose N = 96 reference is 2.45x off N = 192's); since its z-column intervals
+# (INTERVAL_PLAN_OF) this psi-column node plan runs only for the C-model and interference_free
 ADAPTIVE_PLAN = {2: ColumnPlan(64, 128, 8, 6),
                  3: ColumnPlan(24, 8, 5, 3, beta=1.0, zlevels=5, zconfirm=2, faces=True)}
 ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
@@ -179,6 +180,10 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # tolerance on all three at 7 320 calls per design, against its node plan's 19 512 (with intervals) or 61 150 (without);
 # 8 columns or 12 z-cells miss (8.5x the volume tolerance on a seed-0 design; 1.65x in GCI), and 8 z-cells with no
 # z-levels are 12x off in GCI (the fields' Gauss rule needs the 16)
+# rps-upu (P-model; its columns run along z, Mechanism.column_axis): (8, 8, 5, 2, beta 1, 3 z-levels confirmed once)
+# is within 0.58x of the tolerance against N = 192 on seeds 0, 1, 2 at 7 186 calls per design (seed 0), against
+# the psi-column node plan's 23 958; without z-levels the fields' Gauss rule along z misses the GCI (16-48 fixed
+# z-cells: 1.1-4.4x; the LCI varies along z more than the 8 coarse cells resolve on some designs)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
     # ups-sspr (Y-columns in closed form, ups_sspr.column_intervals): benchmarks/plan_search.py's 864 plans against
@@ -186,6 +191,7 @@ INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     # tolerance on seeds 0, 1, 2: 0.74x (volume) and 0.64x (GCI) at worst, 0.75x on seeds 3, 4; 562 calls per design
     # (LCI kernel) against the node plan's 2534 (with the same columns, 4 z-cells and every call a node or bisection)
     "ups-sspr": ColumnPlan(6, 2, 8, 3, beta=2.0, faces=True),
+    "rps-upu": ColumnPlan(8, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=1),
 }
 
 
@@ -267,8 +273,9 @@ def adaptive_population_stats(
     the mechanism's mirror axes (``mirror_halves``) only the half box >= 0 is evaluated, with half the plan's
     columns (or z-cells) there, and the extensive statistics are doubled: the same columns and nodes as the full
     box, to rounding (tests/test_mirror.py). ``intervals``: columns whose reachable set the mechanism gives in
-    closed form (``Mechanism.interval_kernel_for`` the options) skip the nodes and bisections, and the default plan
-    is the mechanism's interval plan (``adaptive_plan``); False: nodes everywhere with the node plan (A/B)."""
+    closed form (``Mechanism.interval_kernel_for`` the options) skip the nodes and bisections, the columns run along
+    the mechanism's ``column_axis`` (``column_axis`` here), and the default plan is the mechanism's interval plan
+    (``adaptive_plan``); False: nodes everywhere, columns along the last axis, with the node plan (A/B)."""
     from scalesynth.kernels.adaptive import column_stats
 
     n = len(designs)
@@ -280,28 +287,52 @@ def adaptive_population_stats(
         lo = np.tile(boxes.lo, (n, 1))
         hi = np.tile(boxes.lo + boxes.step * boxes.shape, (n, 1))
     cell = np.prod((hi - lo)[:, :ndim], axis=1) / plan.coarse_cells(ndim)
-    half = HalfBox.of(mech, options, lo, hi, plan, mirror)
-    kernel = mech.lci_kernel if lci_only else mech.field_kernel
     interval_kernel = mech.interval_kernel_for(options) if intervals else None
-    stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, half.lo, hi, ndim,
+    axis = column_axis(mech, options, intervals)
+    half = HalfBox.of(mech, options, lo, hi, plan, mirror, axis)
+    kernel = mech.lci_kernel if lci_only else mech.field_kernel
+    reach = mech.reach_kernel
+    box_lo, box_hi = half.lo, hi
+    if axis != ndim - 1:
+        # the kernels take the task coordinates in column order (the cross axes, then the column axis); the
+        # statistics rows and estimates do not depend on the order of the axes
+        order = column_order(ndim, axis)
+        kernel, reach = mech.column_order_kernel(kernel, options), mech.column_order_kernel(reach, options)
+        box_lo, box_hi = half.lo[:, order], hi[:, order]
+    stats, err_v, err_g, levels, evals = column_stats(kernel, mech.n_fields, packed, box_lo, box_hi, ndim,
                                                       half.columns, half.cells, plan.bisections, plan.levels,
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
-                                                      plan.zlevels, plan.zconfirm, plan.faces, mech.reach_kernel,
+                                                      plan.zlevels, plan.zconfirm, plan.faces, reach,
                                                       ny=half.ny, mirror=half.mirror,
                                                       interval_kernel=interval_kernel)
     stats = half.whole(stats, mech.n_fields)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 
 
+def column_axis(mech: Mechanism, options: Mapping[str, Any], intervals: bool = True) -> int:
+    """The task axis the adaptive evaluator runs its columns along: the mechanism's ``column_axis`` where its interval
+    kernel is used (``intervals`` and ``interval_kernel_for`` the options), else the last task axis."""
+    if intervals and mech.interval_kernel_for(options) is not None:
+        return mech.column_axis(options)
+    return len(mech.task_axes) - 1
+
+
+def column_order(ndim: int, axis: int) -> list[int]:
+    """Task axes in column order: the cross axes in task order, then the column axis ``axis``."""
+    return [a for a in range(ndim) if a != axis] + [axis] + list(range(ndim, 3))
+
+
 def mirror_halves(mech: Mechanism, options: Mapping[str, Any], lo: np.ndarray, hi: np.ndarray,
-                  plan: ColumnPlan) -> tuple[int, ...]:
+                  plan: ColumnPlan, axis: int | None = None) -> tuple[int, ...]:
     """The task axes the adaptive evaluator halves: the mechanism's mirror axes (``Mechanism.mirror_axes``) on
     which every design's box (lo, hi: (n, 3)) is symmetric about 0 exactly and the plan's column count (or, on the
-    column axis, its z-cells) is even, so the half box holds exactly half of the full box's columns and nodes."""
+    column axis ``axis``, default the last, its z-cells) is even, so the half box holds exactly half of the full
+    box's columns and nodes."""
     ndim = len(mech.task_axes)
+    axis = ndim - 1 if axis is None else axis
     out = []
     for a in mech.mirror_axes(options):
-        count = plan.cells if a == ndim - 1 else plan.columns
+        count = plan.cells if a == axis else plan.columns
         if count % 2 == 0 and np.all(lo[:, a] == -hi[:, a]):  # a degenerate design's empty box (0, 0) halves too
             out.append(a)
     return tuple(out)
@@ -310,8 +341,9 @@ def mirror_halves(mech: Mechanism, options: Mapping[str, Any], lo: np.ndarray, h
 @dataclass(frozen=True)
 class HalfBox:
     """What the adaptive evaluator computes on the mirror axes (``mirror_halves``): every design's box with lo = 0
-    on them (lo: (n, 3)), the coarse columns per cross axis (``columns``, ``ny``: kernels.adaptive's n and ny; None
-    for planar tasks) and z-cells, the kernel's mirror planes per cross axis, and ``factor`` = 2^(halved axes)."""
+    on them (lo: (n, 3), task order), the coarse columns per cross axis (``columns``, ``ny``: kernels.adaptive's n
+    and ny, cross axes in column order; None for planar tasks) and z-cells, the kernel's mirror planes per cross
+    axis (column order), and ``factor`` = 2^(halved axes). ``axis``: the column axis (default the last)."""
 
     lo: np.ndarray
     columns: int
@@ -322,13 +354,15 @@ class HalfBox:
 
     @classmethod
     def of(cls, mech: Mechanism, options: Mapping[str, Any], lo: np.ndarray, hi: np.ndarray, plan: ColumnPlan,
-           mirror: bool = True) -> HalfBox:
+           mirror: bool = True, axis: int | None = None) -> HalfBox:
         ndim = len(mech.task_axes)
-        counts = [plan.columns, plan.columns, plan.cells]  # x, y (3-D only), the column axis
-        slot = (0, 1, 2) if ndim == 3 else (0, 2)  # task axis -> counts' entry
+        axis = ndim - 1 if axis is None else axis
+        counts = [plan.columns, plan.columns, plan.cells]  # cross axes 0, 1 (3-D only), the column axis
+        order = column_order(ndim, axis)
+        slot = {a: (k if ndim == 3 or k == 0 else 2) for k, a in enumerate(order[:ndim])}  # task axis -> entry
         planes = [False, False]
         lo = lo.copy()
-        halves = mirror_halves(mech, options, lo, hi, plan) if mirror else ()
+        halves = mirror_halves(mech, options, lo, hi, plan, axis) if mirror else ()
         for a in halves:
             lo[:, a] = 0.0
             counts[slot[a]] //= 2
@@ -713,7 +747,7 @@ def evaluator_description(cfg) -> str:
     if n is None:
         # what the config's own design runs: the half box of a mirror symmetry, closed-form column intervals
         lo, hi = design_boxes(mech, [cfg.resolved_design()], options, cfg.grid.region)
-        halves = mirror_halves(mech, options, lo, hi, adaptive_plan(mech, options))
+        halves = mirror_halves(mech, options, lo, hi, adaptive_plan(mech, options), column_axis(mech, options))
         extras = ([f"half box of the mirror symmetry in {' and '.join(mech.task_axes[a] for a in halves)}"]
                   if halves else []) + (["column intervals"] if mech.interval_kernel_for(options) is not None else [])
         if extras:

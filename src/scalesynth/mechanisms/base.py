@@ -220,12 +220,29 @@ class Mechanism(ABC):
     @property
     def interval_kernel(self):
         """None, or a Numba kernel ``intervals(p, x, y, zlo, zhi, out) -> k`` (3-D tasks): the reachable set of the
-        column at cross position (x, y) over [zlo, zhi] of the last task axis, i.e. where the reach kernel's slot 0
-        is >= 0, in closed form: its k >= 0 sorted, disjoint, closed intervals written to out[:k] (out: float64
+        column at cross position (x, y) over [zlo, zhi] of the column axis (``column_axis``: by default the last
+        task axis; x, y: the other two task coordinates in task order), i.e. where the reach kernel's slot 0 is
+        >= 0, in closed form: its k >= 0 sorted, disjoint, closed intervals written to out[:k] (out: float64
         (K, 2), task units; exact to rounding at the ends), or -1 when this design and these options are not
         handled in closed form or need more than K rows (the adaptive evaluator then evaluates nodes and bisects,
         kernels.adaptive). Default: None (nodes and bisection everywhere)."""
         return None
+
+    def column_axis(self, options: Mapping[str, Any]) -> int:
+        """The task axis along which ``interval_kernel`` gives a column's reachable intervals under these resolved
+        options, and so the axis the adaptive evaluator runs its columns along when it uses the interval kernel
+        (without it, the columns run along the last axis). Default: the last task axis. A mechanism returning
+        another axis gives its kernels in column order too (``column_order_kernel``)."""
+        return len(self.task_axes) - 1
+
+    def column_order_kernel(self, kernel, options: Mapping[str, Any]):
+        """``kernel`` (this mechanism's field_kernel, lci_kernel or reach_kernel) as a Numba kernel
+        ``k(p, u, v, w, out)`` whose task coordinates come in column order: the two cross axes in task order, then
+        ``column_axis(options)``; the same out, bit for bit. Default (the column axis is the last): ``kernel``."""
+        if self.column_axis(options) != len(self.task_axes) - 1:
+            raise NotImplementedError(f"{self.name}: column_axis is not the last task axis, so "
+                                      "column_order_kernel must be overridden")
+        return kernel
 
     def interval_kernel_for(self, options: Mapping[str, Any]):
         """``interval_kernel`` where it handles every column under these resolved options, else None: the adaptive
