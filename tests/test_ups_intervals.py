@@ -32,9 +32,10 @@ def _random_case(rng, i):
     """A design (a, b, c: the default scaled by U(0.6, 1.5), U(0.5, 1.5), U(0.9, 1.1)) and options: l1 limits
     [U(40, 100), + U(10, 80)] mm ([0, ...] for every seventh design, none for every fifth), l2 and l3 limits
     [q1, q2] mm each, quantiles U(0, 0.6) and U(0.6, 1.0) of the leg's length over 200 random poses of the ranges
-    (legs 2 and 3 differ; none for every fourth design: then only the l1 slab and the box cut the column), alpha and beta ranges [U(-1, 0.2), + U(0.05, 1)] rad (asymmetric, some not holding
-    0; beta within +-pi/2), Y_range default (+-0.999 c) on even designs, else [U(-1.1, 0), + U(0.1, 1.2)] c (a
-    range reaching past +-c is clipped to it)."""
+    (legs 2 and 3 differ; none for every fourth design: then only the l1 slab and the box cut the column), alpha
+    and beta ranges [U(-1, 0.2), + U(0.05, 1)] rad (asymmetric, some not holding 0; beta within +-pi/2), Y_range
+    default (+-0.999 c) on even designs, else [U(-1.1, 0), + U(0.1, 1.2)] c (a range reaching past +-c is clipped
+    to it)."""
     design = {"a": DEFAULT["a"] * rng.uniform(0.6, 1.5), "b": DEFAULT["b"] * rng.uniform(0.5, 1.5),
               "c": DEFAULT["c"] * rng.uniform(0.9, 1.1)}
     c = design["c"]
