@@ -1,12 +1,15 @@
 """pprs-rprs: the closed-form reachable intervals of a z-column (PprsRprs.interval_kernel,
-pprs_rprs.column_intervals) against the reach kernel it replaces (point_reach) point by point."""
+pprs_rprs.column_intervals) against the reach kernel it replaces (point_reach) point by point, and the bounding
+box's y pad that keeps the w2 walls off the cell centres."""
 
 import math
 
 import numpy as np
+import pytest
 from numba import njit
 
 from scalesynth.mechanisms import get
+from scalesynth.mechanisms.pprs_rprs import Y_PAD
 
 PPRS = get("pprs-rprs")
 DEFAULT = PPRS.resolve_design({})  # r = 160, R = 180, L1 = 100, L2 = L3 = 120 mm
@@ -187,3 +190,34 @@ def test_interference_free_is_not_handled():
     assert PPRS.interval_kernel(p, 0.0, 0.0, 0.0, 400.0, np.empty((K, 2))) == -1
     assert PPRS.interval_kernel_for(options) is None
     assert PPRS.interval_kernel_for(PPRS.resolve_options({})) is PPRS.interval_kernel
+
+
+def _w2(design, options, x, y):
+    """w2 = u2 . C2 at O1 = (x, y) (conv O, zero orientation), mm."""
+    r = design["r"]
+    return -0.5 * (x - 0.5 * r) + math.sqrt(3.0) / 2.0 * (y + math.sqrt(3.0) / 2.0 * r)
+
+
+def test_box_pad_only_where_both_y_faces_come_from_w2():
+    """bounding_box widens y by Y_PAD of its span on each side exactly where both y faces come from the w2 limits.
+    There the unpadded y span is sqrt3 times the x span and every cell-centred grid over the unpadded box (N = 24,
+    96, 99) has cell centres on both w2 walls (|w2 - limit| below 1e-9 mm: rounding decides them); over the padded
+    box none is within 1e-6 mm. The Table-1 design (y from |lambda1| <= L1 below, from w2 above) keeps its
+    unpadded box: y in [-100, 30 / (sqrt3 / 2)]."""
+    options = PPRS.resolve_options({})
+    design = PPRS.resolve_design({"r": 154.02, "R": 180.48, "L1": 159.61, "L2": 155.92, "L3": 116.8})
+    lo, hi = PPRS.bounding_box(design, options)
+    span = (hi[1] - lo[1]) / (1.0 + 2.0 * Y_PAD)
+    ylo, yhi = lo[1] + Y_PAD * span, hi[1] - Y_PAD * span
+    assert span == pytest.approx(math.sqrt(3.0) * (hi[0] - lo[0]), rel=1e-12)
+    assert _w2(design, options, lo[0], ylo) == pytest.approx(80.0, abs=1e-9)
+    assert _w2(design, options, hi[0], yhi) == pytest.approx(180.0, abs=1e-9)
+    for n in (24, 96, 99):
+        for box_lo, box_hi, on_wall in ((ylo, yhi, True), (lo[1], hi[1], False)):
+            x = lo[0] + (np.arange(n) + 0.5) * (hi[0] - lo[0]) / n
+            y = box_lo + (np.arange(n) + 0.5) * (box_hi - box_lo) / n
+            w2 = _w2(design, options, x[:, None], y[None, :])
+            gap = np.minimum(np.abs(w2 - 80.0), np.abs(w2 - 180.0)).min()
+            assert (gap < 1e-9) if on_wall else (gap > 1e-6), (n, on_wall, gap)
+    lo, hi = PPRS.bounding_box(DEFAULT, options)
+    np.testing.assert_allclose([lo[1], hi[1]], [-100.0, 30.0 / (math.sqrt(3.0) / 2.0)], rtol=1e-12)
