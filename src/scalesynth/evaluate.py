@@ -165,7 +165,8 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
     # above the tolerance (the reported error_volume is conservative, up to 4.6x, as ups-sspr's). Without face
     # columns or z-levels no plan passes seed 0 (the task box's wall and thin slabs).
     "rps-upu-tool": ColumnPlan(10, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=2, faces=True),
-    # pprs-rprs keeps the 3-D default: none of 332 plans searched (against N = 192, since N = 96 is off) is within
+    # pprs-rprs's node plan (interference_free only: else its interval plan, INTERVAL_PLAN_OF) is the 3-D default;
+    # searched before its box pad (bounding_box) and column intervals: none of 332 plans (against N = 192) was within
     # 0.8x on seed 0, the default included (0.96x); N = 192 is itself up to 1.35x off N = 384 on seed-0 designs, and
     # the default is 1.9x off N = 768 on a seed-1 design (0.36 % too large, its own estimate 0.88x: it stops early;
     # benchmarks/notes/adaptive_plans.md)
@@ -179,8 +180,14 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # tolerance on all three at 7 320 calls per design, against its node plan's 19 512 (with intervals) or 61 150 (without);
 # 8 columns or 12 z-cells miss (8.5x the volume tolerance on a seed-0 design; 1.65x in GCI), and 8 z-cells with no
 # z-levels are 12x off in GCI (the fields' Gauss rule needs the 16)
+# pprs-rprs: its workspaces are thin slabs (median 27-28 mm of a 215-256 mm box) whose columns hold one interval,
+# so 2 z-cells serve the fields' Gauss rule; (24, 2, 5, 3, beta 1, faces) is within 0.81x / 0.69x (volume, against
+# the exact volume of the column intervals on a 2400^2 cross grid) and 0.24x / 0.12x (GCI, against N = 192) on seeds
+# 0 / 1 at 5 341 / 6 582 calls per design, against the node plan's 668 298; 12 or 16 columns miss (up to 1.52x on a
+# small seed-1 workspace) (benchmarks/notes/pprs_rprs.md)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
+    "pprs-rprs": ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True),
 }
 
 

@@ -907,8 +907,8 @@ class PprsRprs(Mechanism):
     def bounding_box(self, design, options):
         """Box of O1 implied by the actuator limits at the fixed orientation, intersected with the spec §1.8
         box. x: u1.C1 = x + r1x is w1 (or R - w1); y: from u2.C2 (w2) given x, and |lambda1| = |y + r1y| <= L1,
-        widened by Y_PAD (3.09 %) of its span on each side where both y faces come from w2; z: z_Ci = s_i + sigma_i kappa_i with 0 <= kappa_i <= L_i,
-        for chains 1 and 2."""
+        widened by Y_PAD (3.09 %) of its span on each side where both y faces come from w2; z: z_Ci = s_i +
+        sigma_i kappa_i with 0 <= kappa_i <= L_i, for chains 1 and 2."""
         geo = Geometry.of(design, options)
         rk = geo.body @ rotation(*options["orientation"]).T
         wlo, whi = options["w_limits"]
