@@ -181,10 +181,10 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # 8 columns or 12 z-cells miss (8.5x the volume tolerance on a seed-0 design; 1.65x in GCI), and 8 z-cells with no
 # z-levels are 12x off in GCI (the fields' Gauss rule needs the 16)
 # pprs-rprs: its workspaces are thin slabs (median 27-28 mm of a 215-256 mm box) whose columns hold one interval,
-# so 2 z-cells serve the fields' Gauss rule; (24, 2, 5, 3, beta 1, faces) is within 0.81x / 0.69x (volume, against
-# the exact volume of the column intervals on a 2400^2 cross grid) and 0.24x / 0.12x (GCI, against N = 192) on seeds
-# 0 / 1 at 5 341 / 6 582 calls per design, against the node plan's 668 298; 12 or 16 columns miss (up to 1.52x on a
-# small seed-1 workspace) (benchmarks/notes/pprs_rprs.md)
+# so 2 z-cells serve the fields' Gauss rule; (24, 2, 5, 3, beta 1, faces) is within 0.81x / 0.68x / 0.72x (volume,
+# against the exact volume of the column intervals on a 2400^2 cross grid) and 0.27x / 0.11x / 0.55x (GCI, against
+# N = 192) on seeds 0 / 1 / 2 at 5 341-6 582 calls per design, against the node plan's 668 298; 12 or 16 columns miss
+# (1.52x, 1.16x on seed 1) (benchmarks/pprs_columns.py, benchmarks/notes/pprs_rprs.md)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
     "pprs-rprs": ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True),
