@@ -166,7 +166,8 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
     # above the tolerance (the reported error_volume is conservative, up to 4.6x, as ups-sspr's). Without face
     # columns or z-levels no plan passes seed 0 (the task box's wall and thin slabs).
     "rps-upu-tool": ColumnPlan(10, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=2, faces=True),
-    # pprs-rprs keeps the 3-D default: none of 332 plans searched (against N = 192, since N = 96 is off) is within
+    # pprs-rprs's node plan (interference_free only: else its interval plan, INTERVAL_PLAN_OF) is the 3-D default;
+    # searched before its box pad (bounding_box) and column intervals: none of 332 plans (against N = 192) was within
     # 0.8x on seed 0, the default included (0.96x); N = 192 is itself up to 1.35x off N = 384 on seed-0 designs, and
     # the default is 1.9x off N = 768 on a seed-1 design (0.36 % too large, its own estimate 0.88x: it stops early;
     # benchmarks/notes/adaptive_plans.md)
@@ -184,6 +185,11 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # is within 0.58x of the tolerance against N = 192 on seeds 0, 1, 2 at 7 186 calls per design (seed 0), against
 # the psi-column node plan's 23 958; without z-levels the fields' Gauss rule along z misses the GCI (16-48 fixed
 # z-cells: 1.1-4.4x; the LCI varies along z more than the 8 coarse cells resolve on some designs)
+# pprs-rprs: its workspaces are thin slabs (median 27-28 mm of a 215-256 mm box) whose columns hold one interval,
+# so 2 z-cells serve the fields' Gauss rule; (24, 2, 5, 3, beta 1, faces) is within 0.81x / 0.68x / 0.72x (volume,
+# against the exact volume of the column intervals on a 2400^2 cross grid) and 0.27x / 0.11x / 0.55x (GCI, against
+# N = 192) on seeds 0 / 1 / 2 at 5 341-6 582 calls per design, against the node plan's 668 298; 12 or 16 columns miss
+# (1.52x, 1.16x on seed 1) (benchmarks/pprs_columns.py, benchmarks/notes/pprs_rprs.md)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
     # ups-sspr (Y-columns in closed form, ups_sspr.column_intervals): benchmarks/plan_search.py's 864 plans against
@@ -192,6 +198,7 @@ INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     # (LCI kernel) against the node plan's 2534 (with the same columns, 4 z-cells and every call a node or bisection)
     "ups-sspr": ColumnPlan(6, 2, 8, 3, beta=2.0, faces=True),
     "rps-upu": ColumnPlan(8, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=1),
+    "pprs-rprs": ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True),
 }
 
 

@@ -56,6 +56,9 @@ from scalesynth.stiffness.sections import check_positive_option, check_stiffness
 SQRT3_2 = math.sqrt(3.0) / 2.0
 # spec §1.8 search box (mm); bounding_box never extends beyond it
 SPEC_BOX = (np.array([-300.0, -300.0, 0.0]), np.array([300.0, 300.0, 500.0]))
+# fraction of the y span added on each side of bounding_box's y range where both y faces come from the w2 limits
+# (irrational: see bounding_box)
+Y_PAD = (math.sqrt(5.0) - 1.0) / 40.0
 BRANCHES = tuple(a + b + c for a in "+-" for b in "+-" for c in "+-")
 CONVENTIONS = ("O", "R")
 JOINTS = ("w1", "w2", "beta", "s1", "s2", "s3")
@@ -465,6 +468,108 @@ def _fields(p, x, y, z, out, stiffness, every=True, others=True):
         out[1], out[2] = inverse_singular_values(smin, smax)
 
 
+# ----- reachable intervals of a z-column (closed form) ----------------------------------------------------
+_MAX_CUTS = 11  # candidate heights per column: 2 per stroke limit of chains 1, 2; 4 of s3; 2 of beta; h3 = 0
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _put_cut(cuts, n, z, zlo, zhi):
+    """Append the candidate height z to cuts[:n] if it lies strictly inside (zlo, zhi) (NaN never does)."""
+    if zlo < z < zhi:
+        cuts[n] = z
+        return n + 1
+    return n
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def column_intervals(p, x, y, zlo, zhi, out):
+    """Reachable set of the column (x, y, z in [zlo, zhi]) of O1 (mm) in closed form: writes its closed intervals
+    [out[i, 0], out[i, 1]] (mm, i < k, sorted, disjoint with gaps between them, inside [zlo, zhi]) into out (float64,
+    (K, 2)) and returns k >= 0: z is in one exactly where point_reach(p, x, y, z) >= 0, to rounding at the ends
+    (isolated reachable heights, of zero length, are left out). -1 (out undefined) with interference_free (the
+    clearance decides too) or when out has fewer rows than the column needs.
+
+    At the fixed orientation the column moves the triangle vertically: w1, w2, lambda_i (so kappa_i) and rho3 are
+    constant along it, s1 and s2 are z plus constants, h3 = z_C3 is z plus a constant, beta = atan2(h3, rho3) and
+    s3 = sqrt(rho3^2 + h3^2) - sigma3 kappa3. Every reachability check can change only at the heights where s1, s2
+    or s3 meets a stroke limit, beta a beta limit, or h3 = 0 (atan2's branch cut and mu3 = 0): those candidates cut
+    the column into pieces on which each check is constant, so each piece is classified by point_reach at its
+    midpoint and neighbouring reachable pieces are merged."""
+    if p[_FREE_ONLY] > 0.0:
+        return -1
+    if not zlo <= zhi:  # also NaN
+        return 0
+    slo = p[_SLO]
+    shi = p[_SHI]
+    cuts = np.empty(_MAX_CUTS + 2)
+    cuts[0] = zlo
+    n = 1
+    # kappa_i as _fields computes them (NaN where the link cannot reach: no cut, and every piece is unreachable)
+    lam1 = y + p[_R1 + 1]
+    k1 = math.sqrt(p[_L1] * p[_L1] - lam1 * lam1) if p[_L1] * p[_L1] - lam1 * lam1 >= 0.0 else math.nan
+    c2x = x + p[_R2]
+    c2y = y + p[_R2 + 1]
+    lam2 = -SQRT3_2 * c2x - 0.5 * c2y
+    k2 = math.sqrt(p[_L2] * p[_L2] - lam2 * lam2) if p[_L2] * p[_L2] - lam2 * lam2 >= 0.0 else math.nan
+    u3x = p[_U3X]
+    u3y = p[_U3Y]
+    c3x = x + p[_R3]
+    c3y = y + p[_R3 + 1]
+    lam3 = -u3y * c3x + u3x * c3y
+    k3 = math.sqrt(p[_L3] * p[_L3] - lam3 * lam3) if p[_L3] * p[_L3] - lam3 * lam3 >= 0.0 else math.nan
+    rho = p[_RAIL] - (u3x * c3x + u3y * c3y)
+    arho = abs(rho)
+    r3z = p[_R3 + 2]
+    for s in (slo, shi):
+        # s_i = z + r_iz - sigma_i kappa_i (chains 1, 2)
+        n = _put_cut(cuts, n, s + p[_SG1] * k1 - p[_R1 + 2], zlo, zhi)
+        n = _put_cut(cuts, n, s + p[_SG2] * k2 - p[_R2 + 2], zlo, zhi)
+        # s3 = s: mu3 = m = s + sigma3 kappa3, h3 = +-sqrt(m^2 - rho^2) (factored: no cancellation near m = |rho|)
+        m = s + p[_SG3] * k3
+        if m >= arho:
+            h = math.sqrt((m - arho) * (m + arho))
+            n = _put_cut(cuts, n, h - r3z, zlo, zhi)
+            n = _put_cut(cuts, n, -h - r3z, zlo, zhi)
+    for b in (p[_BLO], p[_BHI]):
+        # atan2(h3, rho) = b on the half-line of direction (cos b, sin b): h3 = rho tan b where rho cos b > 0
+        cb = math.cos(b)
+        if rho * cb > 0.0:
+            n = _put_cut(cuts, n, rho * (math.sin(b) / cb) - r3z, zlo, zhi)
+    n = _put_cut(cuts, n, -r3z, zlo, zhi)  # h3 = 0
+    cuts[n] = zhi
+    n += 1
+    # insertion sort of the few cuts
+    for i in range(2, n - 1):
+        v = cuts[i]
+        j = i - 1
+        while j >= 1 and cuts[j] > v:
+            cuts[j + 1] = cuts[j]
+            j -= 1
+        cuts[j + 1] = v
+    q = np.empty(1)
+    k = 0
+    open_ = False  # an interval is being built in out[k]
+    for i in range(n - 1):
+        a = cuts[i]
+        b = cuts[i + 1]
+        if not b > a:
+            continue  # a piece of zero length: neither extends nor ends an interval
+        _fields(p, x, y, 0.5 * (a + b), q, False, False)
+        if q[0] >= 0.0:
+            if open_:
+                out[k - 1, 1] = b
+            else:
+                if k == out.shape[0]:
+                    return -1
+                out[k, 0] = a
+                out[k, 1] = b
+                k += 1
+                open_ = True
+        else:
+            open_ = False
+    return k
+
+
 # ----- NumPy kinematics ----------------------------------------------------------------------------------
 def rotation(phi, theta, psi) -> np.ndarray:
     """R = Rz(phi) Ry(theta) Rx(psi) for scalars or arrays of angles (rad); shape (..., 3, 3)."""
@@ -785,13 +890,25 @@ class PprsRprs(Mechanism):
     def lci_kernel(self):
         return lci_fields
 
+    @property
+    def interval_kernel(self):
+        """column_intervals(p, x, y, zlo, zhi, out) -> k: the reachable intervals of a z-column in closed form (-1:
+        not handled, evaluate points with reach_kernel instead)."""
+        return column_intervals
+
+    def interval_kernel_for(self, options):
+        """None with interference_free (the clearance then decides reachability too: column_intervals returns -1
+        on every column), else the interval kernel."""
+        return None if options["interference_free"] else column_intervals
+
     def kernel_branch(self, options) -> str:
         return options["sigma"]
 
     def bounding_box(self, design, options):
         """Box of O1 implied by the actuator limits at the fixed orientation, intersected with the spec §1.8
-        box. x: u1.C1 = x + r1x is w1 (or R - w1); y: from u2.C2 (w2) given x, and |lambda1| = |y + r1y| <= L1;
-        z: z_Ci = s_i + sigma_i kappa_i with 0 <= kappa_i <= L_i, for chains 1 and 2."""
+        box. x: u1.C1 = x + r1x is w1 (or R - w1); y: from u2.C2 (w2) given x, and |lambda1| = |y + r1y| <= L1,
+        widened by Y_PAD (3.09 %) of its span on each side where both y faces come from w2; z: z_Ci = s_i +
+        sigma_i kappa_i with 0 <= kappa_i <= L_i, for chains 1 and 2."""
         geo = Geometry.of(design, options)
         rk = geo.body @ rotation(*options["orientation"]).T
         wlo, whi = options["w_limits"]
@@ -800,8 +917,18 @@ class PprsRprs(Mechanism):
         u2 = geo.u[1]
         a_lo, a_hi = plo - u2 @ rk[1], phi_ - u2 @ rk[1]  # u2 . p
         # y = (u2.p - u2x x) / u2y with u2x < 0 < u2y
-        ylo = max((a_lo - u2[0] * xlo) / u2[1], -geo.links[0] - rk[0, 1])
-        yhi = min((a_hi - u2[0] * xhi) / u2[1], geo.links[0] - rk[0, 1])
+        ylo_w2, yhi_w2 = (a_lo - u2[0] * xlo) / u2[1], (a_hi - u2[0] * xhi) / u2[1]
+        ylo = max(ylo_w2, -geo.links[0] - rk[0, 1])
+        yhi = min(yhi_w2, geo.links[0] - rk[0, 1])
+        if ylo == ylo_w2 and yhi == yhi_w2:
+            # both y faces come from the w2 limits: then the y span is sqrt3 times the x span and the w2 walls
+            # (slope 1/sqrt3, through the corners (xlo, ylo) and (xhi, yhi)) run through a line of cell centres of
+            # every cell-centred grid over the box (every third column, any N), whose reachability rounding decides:
+            # a first-order error of half a strip of columns (+2 to +3 % of the volume at 24 columns per axis,
+            # 0.5-0.8 % at N = 96). Widening y by the irrational Y_PAD of its span on each side puts the walls in
+            # general position (benchmarks/notes/pprs_rprs.md)
+            pad = Y_PAD * (yhi - ylo)
+            ylo, yhi = ylo - pad, yhi + pad
         slo, shi = options["s_limits"]
         sig = sigma_vector(options["sigma"])
         zlo, zhi = -math.inf, math.inf

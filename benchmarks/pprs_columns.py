@@ -1,0 +1,114 @@
+"""pprs-rprs: the adaptive evaluator's interval plans against exact volumes, and its time against the uniform grid.
+
+    NUMBA_NUM_THREADS=1 python benchmarks/pprs_columns.py check SEED PLAN [PLAN ...]   # e.g. 24,2,5,3,1,0,1,1
+    NUMBA_NUM_THREADS=1 python benchmarks/pprs_columns.py ab
+
+``check``: the 20 random designs of ``benchmarks/adaptive.py`` (``random_designs(cfg, 20, SEED)``); reference volume:
+the exact reachable length of every column (``PprsRprs.interval_kernel``, closed form) summed over a 2400 x 2400
+cross grid of the bounding box (its midpoint error, from the walls between columns, is below 0.02 % there);
+reference GCI: the uniform N = 192 grid (LCI kernel). Per plan (columns,cells,bisections,levels,beta,zlevels,
+zconfirm,faces, as benchmarks/plan_search.py): kernel calls per design, the worst volume and GCI errors as
+multiples of the config's tolerance (0.2 %, 5e-4; slivers, reference volume below 1 % of the median, left out), the
+largest own estimate, and the three worst designs. ``ab``: seed 0, alternating, best of 3, one process: the search's
+call (``adaptive_population_stats``, lci_only) with the column intervals and the interval plan, with nodes and
+bisection and the node plan (before), and the uniform N = 32 grid (the config's resolution).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from adaptive import SLIVER, design_set  # noqa: E402
+from plan_search import Search, parse_plan  # noqa: E402
+
+from scalesynth.evaluate import Tolerance, adaptive_plan, adaptive_population_stats  # noqa: E402
+
+N_CROSS = 2400
+N_GCI = 192
+
+
+@njit(cache=True)
+def _cross_volume(kernel, p, lo, hi, n):
+    """Sum of the exact column lengths over an n x n cell-centred cross grid of the box, times the cell area."""
+    out = np.empty((8, 2))
+    hx = (hi[0] - lo[0]) / n
+    hy = (hi[1] - lo[1]) / n
+    total = 0.0
+    for i in range(n):
+        x = lo[0] + (i + 0.5) * hx
+        for j in range(n):
+            k = kernel(p, x, lo[1] + (j + 0.5) * hy, lo[2], hi[2], out)
+            for m in range(k):
+                total += out[m, 1] - out[m, 0]
+    return total * hx * hy
+
+
+def exact_volumes(s) -> np.ndarray:
+    """Volume (mm^3) of every design of a design set from its column intervals (N_CROSS^2 columns)."""
+    kernel = s.mech.interval_kernel
+    out = []
+    for d, p in zip(s.designs, s.packed, strict=True):
+        lo, hi = s.mech.bounding_box(d, s.options)
+        out.append(_cross_volume(kernel, p, lo, hi, N_CROSS))
+    return np.array(out)
+
+
+def check(seed: int, plans: list[str]) -> None:
+    s = design_set("pprs-rprs", seed=seed)
+    t0 = time.perf_counter()
+    ex = exact_volumes(s)
+    _, rg = Search("pprs-rprs", N_GCI, None).uniform(s.designs, N_GCI)
+    keep = ex >= SLIVER * np.median(ex)
+    print(f"# seed {seed}: references in {time.perf_counter() - t0:.0f} s; slivers (left out): "
+          f"{np.flatnonzero(~keep).tolist()}; exact volumes {np.round(ex).tolist()}", flush=True)
+    tol: Tolerance = s.tol
+    for text in plans:
+        plan = parse_plan(text)
+        r = adaptive_population_stats(s.mech, s.designs, s.options, s.packed, tol, s.edges, s.region, plan=plan,
+                                      lci_only=True)
+        vol = r.stats[:, 0] * r.cell
+        gci = np.where(r.stats[:, 0] > 0, r.stats[:, 1] / np.where(r.stats[:, 0] > 0, r.stats[:, 0], 1.0), 0.0)
+        ev = np.where(keep, np.abs(vol - ex) / np.where(keep, ex, 1.0), 0.0) / tol.volume
+        eg = np.where(keep, np.abs(gci - rg), 0.0) / tol.gci
+        est = np.maximum(r.error_volume / tol.volume, r.error_gci / tol.gci)
+        worst = np.argsort(-np.maximum(ev, eg))[:3]
+        print(f"{text}: calls {r.evaluations.mean():.0f}, volume {ev.max():.2f}, GCI {eg.max():.2f}, own estimate "
+              f"{est.max():.2f}; worst " + ", ".join(f"d{j} {ev[j]:.2f}, {eg[j]:.2f}" for j in worst), flush=True)
+
+
+def ab() -> None:
+    s = design_set("pprs-rprs")
+    uni = Search("pprs-rprs", 32, None)
+
+    def adaptive(intervals: bool):
+        plan = adaptive_plan(s.mech, s.options if intervals else None)
+        return lambda: adaptive_population_stats(s.mech, s.designs, s.options, s.packed, s.tol, s.edges, s.region,
+                                                 plan=plan, lci_only=True, intervals=intervals)
+
+    runs = {"column intervals, interval plan": adaptive(True), "nodes and bisection, node plan": adaptive(False),
+            "uniform N = 32": lambda: uni.uniform(s.designs, 32)}
+    for f in runs.values():
+        f()  # compiled or loaded
+    best = dict.fromkeys(runs, np.inf)
+    for _ in range(3):
+        for k, f in runs.items():
+            t0 = time.perf_counter()
+            f()
+            best[k] = min(best[k], (time.perf_counter() - t0) / len(s.designs) * 1e3)
+    for k, v in best.items():
+        print(f"{k}: {v:.2f} ms/design ({v / best['uniform N = 32']:.2f}x uniform N = 32)")
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "check":
+        check(int(sys.argv[2]), sys.argv[3:])
+    else:
+        ab()
