@@ -3,31 +3,21 @@ pprs_rprs.column_intervals) against the reach kernel it replaces (point_reach) p
 box's y pad that keeps the w2 walls off the cell centres."""
 
 import math
+from collections import Counter
 
 import numpy as np
 import pytest
-from numba import njit
 
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.pprs_rprs import Y_PAD
+
+from interval_checks import K, check_column, reach_column
 
 PPRS = get("pprs-rprs")
 DEFAULT = PPRS.resolve_design({})  # r = 160, R = 180, L1 = 100, L2 = L3 = 120 mm
 N_DESIGNS = 60
 N_COLUMNS = 10  # per design: 600 columns
 N_POINTS = 2000  # per column: 1.2 million reach-kernel points
-K = 8  # rows of out
-
-
-@njit
-def _reach_column(kernel, p, x, y, zs):
-    """kernel(p, x, y, z) slot 0 at each z of zs."""
-    out = np.empty(1)
-    r = np.empty(zs.shape[0])
-    for i in range(zs.shape[0]):
-        kernel(p, x, y, zs[i], out)
-        r[i] = out[0]
-    return r
 
 
 def _random_case(rng, i):
@@ -70,45 +60,10 @@ def _column_box(design, options):
     return lo - 0.3 * span, hi + 0.3 * span
 
 
-def _check_intervals(out, k, zlo, zhi):
-    """Sorted, disjoint (strictly: a gap between neighbours), each a <= b, inside [zlo, zhi]."""
-    iv = out[:k]
-    assert np.all(iv[:, 0] <= iv[:, 1])
-    assert np.all(iv[1:, 0] > iv[:-1, 1])
-    if k:
-        assert zlo <= iv[0, 0] and iv[-1, 1] <= zhi
-
-
 def _check_column(p, x, y, zlo, zhi, tol, zs, counts):
-    """One column against point_reach (test_intervals_match_reach_kernel); returns k."""
-    out = np.empty((K, 2))
-    k = PPRS.interval_kernel(p, x, y, zlo, zhi, out)
-    assert 0 <= k <= 4, (x, y, k)
-    _check_intervals(out, k, zlo, zhi)
-    iv = out[:k].copy()
-    reach = PPRS.reach_kernel
-    inside = np.any((iv[:, :1] <= zs) & (zs <= iv[:, 1:]), axis=0)
-    reachable = _reach_column(reach, p, x, y, zs) >= 0.0
-    near = np.min(np.abs(zs[:, None] - iv.ravel()), axis=1) < tol if k else np.zeros(len(zs), bool)
-    bad = (inside != reachable) & ~near
-    assert not bad.any(), (x, y, iv, zs[bad][:5])
-    # every end inside (zlo, zhi) is a crossing to 2 tol: reachable 2 tol inside, unreachable 2 tol outside
-    # (random points alone would miss an end off by less than about the box height / 2000)
-    gaps = np.concatenate([[np.inf], iv[1:, 0] - iv[:-1, 1], [np.inf]])
-    for m, (a, b) in enumerate(iv):
-        if b - a > 4 * tol:
-            assert (_reach_column(reach, p, x, y, np.array([a + 2 * tol, b - 2 * tol])) >= 0.0).all()
-        for end, outside, gap in ((a, a - 2 * tol, gaps[m]), (b, b + 2 * tol, gaps[m + 1])):
-            if zlo < end < zhi and gap > 4 * tol:
-                assert _reach_column(reach, p, x, y, np.array([outside]))[0] < 0.0, (x, y, iv, end)
-                counts["ends"] += 1
-    counts["points"] += len(zs)
-    counts["reachable"] += int(reachable.sum())
-    counts["empty"] += k == 0
-    if k >= 2:
-        counts["split"] += 1
-        assert PPRS.interval_kernel(p, x, y, zlo, zhi, np.empty((k - 1, 2))) == -1
-    return k
+    """One column against point_reach (interval_checks.check_column)."""
+    check_column(PPRS.interval_kernel, lambda z: reach_column(PPRS.reach_kernel, p, x, y, z), p, x, y, zlo, zhi, zs,
+                 tol, counts)
 
 
 def test_intervals_match_reach_kernel():
@@ -120,7 +75,7 @@ def test_intervals_match_reach_kernel():
     the reach kernel finds the workspace (else most would miss the thin workspaces). The sample must hold
     unreachable columns (k = 0), more than 200 interval ends and reachable points."""
     rng = np.random.default_rng(20261202)
-    counts = {"empty": 0, "split": 0, "points": 0, "ends": 0, "reachable": 0}
+    counts = Counter()
     for i in range(N_DESIGNS):
         design, options = _random_case(rng, i)
         p = PPRS.pack(design, options)
@@ -129,7 +84,7 @@ def test_intervals_match_reach_kernel():
         # reachable points of a coarse grid, to draw half the columns through the workspace
         g = [np.linspace(lo[a], hi[a], 24) for a in range(3)]
         pts = np.stack(np.meshgrid(*g, indexing="ij"), -1).reshape(-1, 3)
-        hit = pts[[_reach_column(PPRS.reach_kernel, p, q[0], q[1], q[2:3])[0] >= 0.0 for q in pts]]
+        hit = pts[[reach_column(PPRS.reach_kernel, p, q[0], q[1], q[2:3])[0] >= 0.0 for q in pts]]
         for j in range(N_COLUMNS):
             if j % 2 and len(hit):
                 x, y = hit[rng.integers(len(hit)), :2] + rng.uniform(-2.0, 2.0, 2)
@@ -153,7 +108,7 @@ def test_split_columns_match_reach_kernel():
     p = PPRS.pack(DEFAULT, options)
     lo, hi = _column_box(DEFAULT, options)
     tol = 1e-9 * (hi[2] - lo[2])
-    counts = {"empty": 0, "split": 0, "points": 0, "ends": 0, "reachable": 0}
+    counts = Counter()
     for x in np.linspace(lo[0], hi[0], 60):
         for y in np.linspace(lo[1], hi[1], 60):
             _check_column(p, x, y, lo[2], hi[2], tol, rng.uniform(lo[2], hi[2], 500), counts)

@@ -2,30 +2,20 @@
 ups_sspr.column_intervals) against the reach kernel it replaces (point_reach) point by point."""
 
 import math
+from collections import Counter
 
 import numpy as np
-from numba import njit
 
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.ups_sspr import _legs
+
+from interval_checks import K, check_column, reach_column
 
 UPS = get("ups-sspr")
 DEFAULT = UPS.resolve_design({})  # a = 100, b = 80, c = 120 mm
 N_DESIGNS = 60
 N_COLUMNS = 10  # per design: 600 columns
 N_POINTS = 2000  # per column: 1.2 million reach-kernel points
-K = 8  # rows of out; a column needs at most 4 (two per UPS leg's stroke window)
-
-
-@njit
-def _reach_column(kernel, p, x, y, zs):
-    """kernel(p, x, y, z) slot 0 at each z of zs."""
-    out = np.empty(1)
-    r = np.empty(zs.shape[0])
-    for i in range(zs.shape[0]):
-        kernel(p, x, y, zs[i], out)
-        r[i] = out[0]
-    return r
 
 
 def _random_case(rng, i):
@@ -66,15 +56,6 @@ def _random_case(rng, i):
     return UPS.resolve_design(design), options
 
 
-def _check_intervals(out, k, zlo, zhi):
-    """Sorted, disjoint (strictly: a gap between neighbours), each a <= b, inside [zlo, zhi]."""
-    iv = out[:k]
-    assert np.all(iv[:, 0] <= iv[:, 1])
-    assert np.all(iv[1:, 0] > iv[:-1, 1])
-    if k:
-        assert zlo <= iv[0, 0] and iv[-1, 1] <= zhi
-
-
 def test_intervals_match_reach_kernel():
     """600 random columns (60 random designs x 10; _random_case) at random (alpha, beta) in a box 10 % wider than
     the ranges (columns outside them are empty), over random Y windows (the whole box height on even columns, a
@@ -85,10 +66,7 @@ def test_intervals_match_reach_kernel():
     itself) and split ones (k >= 2: a leg's lower stroke limit cuts the column); on those, out with k - 1 rows
     returns -1."""
     rng = np.random.default_rng(20261202)
-    interval = UPS.interval_kernel
-    reach = UPS.reach_kernel
-    out = np.empty((K, 2))
-    counts = {"empty": 0, "whole": 0, "split": 0, "points": 0, "excused": 0, "ends": 0, "outside": 0}
+    counts = Counter()
     for i in range(N_DESIGNS):
         design, options = _random_case(rng, i)
         p = UPS.pack(design, options)
@@ -98,34 +76,9 @@ def test_intervals_match_reach_kernel():
         for j in range(N_COLUMNS):
             x, y = rng.uniform(lo[:2] - 0.05 * (hi[:2] - lo[:2]), hi[:2] + 0.05 * (hi[:2] - lo[:2]))
             zlo, zhi = (lo[2], hi[2]) if j % 2 == 0 else np.sort(rng.uniform(lo[2], hi[2], 2))
-            k = interval(p, x, y, zlo, zhi, out)
-            assert 0 <= k <= 4, (i, j, k)
-            _check_intervals(out, k, zlo, zhi)
-            iv = out[:k].copy()
-            zs = rng.uniform(zlo, zhi, N_POINTS)
-            inside = np.any((iv[:, :1] <= zs) & (zs <= iv[:, 1:]), axis=0)
-            reachable = _reach_column(reach, p, x, y, zs) >= 0.0
-            near = np.min(np.abs(zs[:, None] - iv.ravel()), axis=1) < tol if k else np.zeros(N_POINTS, bool)
-            bad = (inside != reachable) & ~near
-            assert not bad.any(), (i, j, x, y, iv, zs[bad][:5])
-            # every end inside (zlo, zhi) is a crossing to 2 tol: reachable 2 tol inside, unreachable 2 tol outside
-            # (random points alone would miss an end off by less than about the box height / 2000)
-            gaps = np.concatenate([[np.inf], iv[1:, 0] - iv[:-1, 1], [np.inf]])
-            for m, (a, b) in enumerate(iv):
-                if b - a > 4 * tol:
-                    assert (_reach_column(reach, p, x, y, np.array([a + 2 * tol, b - 2 * tol])) >= 0.0).all()
-                for end, outside, gap in ((a, a - 2 * tol, gaps[m]), (b, b + 2 * tol, gaps[m + 1])):
-                    if zlo < end < zhi and gap > 4 * tol:
-                        assert _reach_column(reach, p, x, y, np.array([outside]))[0] < 0.0, (i, j, iv, end)
-                        counts["ends"] += 1
-            counts["points"] += N_POINTS
-            counts["excused"] += int(((inside != reachable) & near).sum())
-            counts["empty"] += k == 0
+            check_column(UPS.interval_kernel, lambda zs, p=p, x=x, y=y: reach_column(UPS.reach_kernel, p, x, y, zs),
+                         p, x, y, zlo, zhi, rng.uniform(zlo, zhi, N_POINTS), tol, counts)
             counts["outside"] += not (lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1])
-            counts["whole"] += k == 1 and iv[0, 0] == zlo and iv[0, 1] == zhi
-            if k >= 2:
-                counts["split"] += 1
-                assert interval(p, x, y, zlo, zhi, np.empty((k - 1, 2))) == -1
     assert counts["points"] == N_DESIGNS * N_COLUMNS * N_POINTS == 1_200_000
     assert all(counts[key] > 0 for key in ("empty", "whole", "split", "ends", "outside")), counts
 
