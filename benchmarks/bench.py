@@ -692,6 +692,12 @@ def _issue15_summary(data: dict) -> list[str]:
                                      f"adaptive {100 * f['adaptive_volume_error']:.3f} %, "
                                      f"{f['adaptive_gci_error']:.1e}, the reference itself "
                                      f"{100 * f['reference_volume_error']:.3f} %, {f['reference_gci_error']:.1e}")
+                    e = f.get("exact")
+                    if e:
+                        adaptive_acc += (f"; their volume against the exact column volumes ({e['N_cross']}^2 "
+                                         f"columns): adaptive {100 * e['adaptive_volume_error']:.3f} %, the reference "
+                                         f"{100 * e['reference_volume_error']:.3f} %: "
+                                         f"{yes[e['within']]} against it")
                 if adaptive_now:
                     acc = adaptive_acc
                 else:

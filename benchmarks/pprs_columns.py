@@ -21,44 +21,22 @@ import time
 from pathlib import Path
 
 import numpy as np
-from numba import njit
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from adaptive import SLIVER, design_set  # noqa: E402
+from adaptive import N_CROSS, SLIVER, design_set  # noqa: E402
+from adaptive import exact_volumes as adaptive_exact_volumes  # noqa: E402
 from plan_search import Search, parse_plan  # noqa: E402
 
 from scalesynth.evaluate import Tolerance, adaptive_plan, adaptive_population_stats  # noqa: E402
 
-N_CROSS = 2400
 N_GCI = 192
-
-
-@njit(cache=True)
-def _cross_volume(kernel, p, lo, hi, n):
-    """Sum of the exact column lengths over an n x n cell-centred cross grid of the box, times the cell area."""
-    out = np.empty((8, 2))
-    hx = (hi[0] - lo[0]) / n
-    hy = (hi[1] - lo[1]) / n
-    total = 0.0
-    for i in range(n):
-        x = lo[0] + (i + 0.5) * hx
-        for j in range(n):
-            k = kernel(p, x, lo[1] + (j + 0.5) * hy, lo[2], hi[2], out)
-            for m in range(k):
-                total += out[m, 1] - out[m, 0]
-    return total * hx * hy
 
 
 def exact_volumes(s) -> np.ndarray:
     """Volume (mm^3) of every design of a design set from its column intervals (N_CROSS^2 columns)."""
-    kernel = s.mech.interval_kernel
-    out = []
-    for d, p in zip(s.designs, s.packed, strict=True):
-        lo, hi = s.mech.bounding_box(d, s.options)
-        out.append(_cross_volume(kernel, p, lo, hi, N_CROSS))
-    return np.array(out)
+    return adaptive_exact_volumes(s.mech, s.designs, s.options, s.packed, s.region, N_CROSS)
 
 
 def check(seed: int, plans: list[str]) -> None:
