@@ -37,6 +37,7 @@ from scalesynth.kernels.clearance import put_segment as _put_seg
 from scalesynth.kernels.clearance import segment_distance
 from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.kernels.intervals import add_piece, sort_span
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
@@ -538,17 +539,9 @@ def column_intervals(p, x, y, zlo, zhi, out):
     n = _put_cut(cuts, n, -r3z, zlo, zhi)  # h3 = 0
     cuts[n] = zhi
     n += 1
-    # insertion sort of the few cuts
-    for i in range(2, n - 1):
-        v = cuts[i]
-        j = i - 1
-        while j >= 1 and cuts[j] > v:
-            cuts[j + 1] = cuts[j]
-            j -= 1
-        cuts[j + 1] = v
+    sort_span(cuts, 1, n - 1)  # the candidates between zlo and zhi
     q = np.empty(1)
     k = 0
-    open_ = False  # an interval is being built in out[k]
     for i in range(n - 1):
         a = cuts[i]
         b = cuts[i + 1]
@@ -556,17 +549,9 @@ def column_intervals(p, x, y, zlo, zhi, out):
             continue  # a piece of zero length: neither extends nor ends an interval
         _fields(p, x, y, 0.5 * (a + b), q, False, False)
         if q[0] >= 0.0:
-            if open_:
-                out[k - 1, 1] = b
-            else:
-                if k == out.shape[0]:
-                    return -1
-                out[k, 0] = a
-                out[k, 1] = b
-                k += 1
-                open_ = True
-        else:
-            open_ = False
+            k = add_piece(out, k, a, b)
+            if k < 0:
+                return -1
     return k
 
 

@@ -32,6 +32,7 @@ from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.kernels.intervals import add_piece, sort_span
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
@@ -460,28 +461,17 @@ def column_intervals(p, alpha, beta, zlo, zhi, out):
         for lim in (lo, hi):
             if abs(lim) < math.inf:
                 n = _leg_crossings(kk - lim * lim, ey, w, c, lower, upper, brk, n)
-    # insertion sort of the (at most 12) crossings
-    for i in range(1, n):
-        v = brk[i]
-        j = i - 1
-        while j >= 0 and brk[j] > v:
-            brk[j + 1] = brk[j]
-            j -= 1
-        brk[j + 1] = v
+    sort_span(brk, 0, n)  # the (at most 12) crossings
     k = 0
     a = lower
     for i in range(n + 1):
         b = brk[i] if i < n else upper
         if b > a:
             if _column_reach(p, c, am, e2x, ey, e2z, e3x, ey, e3z, sb, cb, 0.5 * (a + b)):
-                if k > 0 and out[k - 1, 1] == a:
-                    out[k - 1, 1] = b  # a spurious or touching crossing between two reachable pieces
-                else:
-                    if k == out.shape[0]:
-                        return -1
-                    out[k, 0] = a
-                    out[k, 1] = b
-                    k += 1
+                # a spurious or touching crossing between two reachable pieces extends the last interval
+                k = add_piece(out, k, a, b)
+                if k < 0:
+                    return -1
             a = b
     return k
 
