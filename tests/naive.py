@@ -442,14 +442,17 @@ def rps_upu_tool_fields(design, options, x, y, z):
 
 
 def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges, beta=1.0, zlevels=0,
-                 zconfirm=1, faces=False, ny=None, mirror=(False, False), intervals=None):
+                 zconfirm=1, faces=False, ny=None, mirror=(False, False), intervals=None, field_levels=-1,
+                 gauss_points=2):
     """NumPy twin of kernels.adaptive.column_stats for one design, vectorised over the active columns of a level:
     ``fields(points (k, 3)) -> (k, n_fields)`` (field 0 LCI, -1 unreachable); lo, hi: the design's box (3,); n, ny:
     coarse columns along cross axes 0, 1 (ny default n; planar: unused); mirror: the lo face of cross axis 0, 1 is
     a mirror plane (clamped neighbour, no face column there even with ``faces``); intervals (3-D only, as the
     kernel's interval_kernel): ``intervals(x, y, zlo, zhi)`` -> the column's reachable intervals [(a, b), ...]
-    (sorted, disjoint) or None (then that column takes the nodes and bisections), one evaluation per call.
-    Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
+    (sorted, disjoint) or None (then that column takes the nodes and bisections), one evaluation per call;
+    field_levels >= 0: a new column below that level takes its measure alone and its parent's Gauss points with
+    their weights times (its measure / the parent's / nk), unless the parent has no measure or its mean-LCI
+    indicator fired (kernels.adaptive step 3b); gauss_points 1: the midpoint rule per piece. Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
     level, evaluations)."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     ca = ndim - 1
@@ -472,9 +475,18 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
 
     def gauss(X, Y, nc, pc, za, zb, area):
         """2-point Gauss rule on the pieces [za, zb] of columns pc (of nc): column measure L, LCI sum S (in units
-        of hz0), and the Gauss points' owner column, fields and weights x area."""
+        of hz0), and the Gauss points' owner column, fields and weights x area; ``gauss_points`` 1: the midpoint
+        rule (the fields at each piece's midpoint with its whole length)."""
         nonlocal evals
         half, mid = 0.5 * (zb - za), 0.5 * (za + zb)
+        if gauss_points == 1:
+            q = fields(pts(X[pc], Y[pc], mid))
+            evals += mid.size
+            ok = q[:, 0] >= 0
+            w = np.where(ok, 2 * half / hz0, 0.0)
+            L = np.bincount(pc, weights=w, minlength=nc).astype(float)
+            S = np.bincount(pc, weights=w * np.where(ok, q[:, 0], 0.0), minlength=nc).astype(float)
+            return L, S, pc, q, w * area
         zq = np.c_[mid - half * gx, mid + half * gx].ravel()
         q = fields(pts(np.repeat(X[pc], 2), np.repeat(Y[pc], 2), zq)).reshape(-1, 2, n_fields)
         evals += zq.size
@@ -485,12 +497,21 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         S = np.bincount(pc, weights=(w * np.where(ok, q[:, :, 0], 0.0)).sum(axis=1), minlength=nc).astype(float)
         return L, S, np.repeat(pc, 2), q.reshape(-1, n_fields), w.ravel() * area
 
-    def columns(X, Y, area, mz):
+    def measure(X, Y, nc, pc, za, zb, area, fields_on):
+        """gauss(), or without ``fields_on`` the pieces' lengths alone (L; S zero, no Gauss points)."""
+        if fields_on:
+            return gauss(X, Y, nc, pc, za, zb, area)
+        L = np.bincount(pc, weights=(zb - za) / hz0, minlength=nc).astype(float)
+        return L, np.zeros(nc), pc[:0], np.zeros((0, n_fields)), np.zeros(0)
+
+    def columns(X, Y, area, mz, fields_on=True):
         """Column measure L, LCI sum S (z in units of hz0) and the Gauss points (fields, weights x area) of each,
         with mz z-cells: the closed-form intervals where ``intervals`` gives them, else nodes and bisection."""
         nonlocal evals
+        if X.size == 0:
+            return np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros((0, n_fields)), np.zeros(0)
         if intervals is None or ndim != 3:
-            return node_columns(X, Y, area, mz)
+            return node_columns(X, Y, area, mz, fields_on)
         nc = X.size
         hz = (hi[ca] - zlo) / mz
         ivs = [intervals(x, y, zlo, zlo + mz * hz) for x, y in zip(X, Y, strict=True)]
@@ -504,15 +525,16 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
                         pc.append(c)
                         za.append(pa)
                         zb.append(pb)
-        L, S, owner, qv, qw = gauss(X, Y, nc, np.array(pc, dtype=np.int64), np.array(za), np.array(zb), area)
+        L, S, owner, qv, qw = measure(X, Y, nc, np.array(pc, dtype=np.int64), np.array(za), np.array(zb), area,
+                                      fields_on)
         back = np.flatnonzero([iv is None for iv in ivs])
         if back.size:
-            Lb, Sb, ob, qb, wb = node_columns(X[back], Y[back], area, mz)
+            Lb, Sb, ob, qb, wb = node_columns(X[back], Y[back], area, mz, fields_on)
             L[back], S[back] = Lb, Sb
             owner, qv, qw = np.r_[owner, back[ob]], np.r_[qv, qb], np.r_[qw, wb]
         return L, S, owner, qv, qw
 
-    def node_columns(X, Y, area, mz):
+    def node_columns(X, Y, area, mz, fields_on=True):
         """columns() by nodes and bisection."""
         nonlocal evals
         nc = X.size
@@ -537,7 +559,7 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         za[ci, ck] = np.where(ra, zn[ck], cross)
         zb[ci, ck] = np.where(ra, cross, zn[ck + 1])
         pc, pk = np.nonzero(~np.isnan(za))
-        return gauss(X, Y, nc, pc, za[pc, pk], zb[pc, pk], area)
+        return measure(X, Y, nc, pc, za[pc, pk], zb[pc, pk], area, fields_on)
 
     ci, cj = (v.ravel() for v in np.meshgrid(np.arange(n), np.arange(ny), indexing="ij"))
     lg, sg = np.zeros((n, ny)), np.zeros((n, ny))
@@ -545,6 +567,7 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     fxg, fyg = np.zeros((2, 2, ny)), np.zeros((2, 2, n))
     kept_v, kept_w = [], []
     src = None  # per active column: the previous level's column it repeats (centre children), else -1
+    par = own = None  # per active column: its parent (previous level's index); whether it evaluates its fields
     p_owner = p_qv = p_qw = None  # the previous level's Gauss points: owner column, fields, weights
     nk = 9 if ndim == 3 else 3
     prev = None
@@ -560,19 +583,30 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         area = 1.0 / scale ** (ndim - 1)
         X = lo[0] + (ci + 0.5) * hx / scale
         Y = lo[1] + (cj + 0.5) * hy / scale
+        inherit = 0 <= field_levels < level
         if src is None:
             L, S, owner, qv, qw = columns(X, Y, area, mz)
             lg[ci, cj], sg[ci, cj] = L, S
         else:  # the centre children repeat their parents' columns (values, 1/nk of the weights), the others are new
-            new = src < 0
+            lpar, spar = lg[ci, cj], sg[ci, cj]  # the parent's L, S (repeated over its children)
+            inh = (src < 0) & inherit & (lpar > 0) & ~own
+            new = (src < 0) & ~inh
             L, S, o_new, v_new, w_new = columns(X[new], Y[new], area, mz)
             lg[ci[new], cj[new]], sg[ci[new], cj[new]] = L, S  # the centre ones' L, S: the parent's (repeated)
+            # inheriting children: their measure alone, their parent's Gauss points with the weights scaled
+            Li, *_ = columns(X[inh], Y[inh], area, mz, fields_on=False)
+            ia = np.flatnonzero(inh)
+            lg[ci[ia], cj[ia]], sg[ci[ia], cj[ia]] = Li, Li * (spar[ia] / lpar[ia])
+            ratio = np.zeros(ci.size)
+            ratio[~new] = 1.0 / nk
+            ratio[ia] = Li / (lpar[ia] * nk)
+            parent = np.where(src >= 0, src, par)
             pos = np.flatnonzero(new)
             rep = np.flatnonzero(~new)
-            take = [np.flatnonzero(p_owner == src[a]) for a in rep]
+            take = [np.flatnonzero(p_owner == parent[a]) for a in rep]
             owner = np.concatenate([pos[o_new]] + [np.full(len(t), a) for a, t in zip(rep, take, strict=True)])
             qv = np.concatenate([v_new] + [p_qv[t] for t in take])
-            qw = np.concatenate([w_new] + [p_qw[t] / nk for t in take])
+            qw = np.concatenate([w_new] + [p_qw[t] * ratio[a] for a, t in zip(rep, take, strict=True)])
         vol, ssum = lg.sum() * area, sg.sum() * area
         gci = ssum / vol if vol > 0 else 0.0
         if level == 0 and zl > 0:
@@ -601,7 +635,13 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
                         face = lo[axis] + (nudge if side == 0 else (n, ny)[axis] - nudge) * (hx if axis == 0 else hy)
                         FX = np.full(e.sum(), face) if axis == 0 else X[e]
                         FY = np.full(e.sum(), face) if axis == 1 else Y[e]
-                        fl, fs, *_ = columns(FX, FY, area, mz)
+                        # with inherited fields: the face column's measure times the edge column's mean LCI
+                        le, se = lg[ci[e], cj[e]], sg[ci[e], cj[e]]
+                        fon = ~(inherit & (le > 0))
+                        fl, fs = np.zeros(e.sum()), np.zeros(e.sum())
+                        fl[fon], fs[fon], *_ = columns(FX[fon], FY[fon], area, mz)
+                        lm, *_ = columns(FX[~fon], FY[~fon], area, mz, fields_on=False)
+                        fl[~fon], fs[~fon] = lm, lm * (se[~fon] / np.where(fon, 1.0, le)[~fon])
                         fg[side, 0, other[e]], fg[side, 1, other[e]] = fl, fs
             for axis in range(ndim - 1):
                 sh = lg.shape[axis]
@@ -617,6 +657,19 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
                         above = np.where(idx == sh - 1, 2.0 * fg[1, t, other] - c, above)
                     d2 = np.abs(above + below - 2.0 * c)
                     flag |= d2 * area / 24.0 > tol * vol * beta / (n * ny)
+            if 0 <= field_levels <= level:  # step 3b: the mean LCI's second differences (no measure: itself)
+                ff = ~(lg[ci, cj] > 0)
+                mean = np.where(lg > 0, sg / np.where(lg > 0, lg, 1.0), np.nan)
+                mc = mean[ci, cj]
+                for axis in range(ndim - 1):
+                    sh = lg.shape[axis]
+                    lo_i = (np.maximum(ci - 1, 0), cj) if axis == 0 else (ci, np.maximum(cj - 1, 0))
+                    hi_i = (np.minimum(ci + 1, sh - 1), cj) if axis == 0 else (ci, np.minimum(cj + 1, sh - 1))
+                    below = np.where(lg[lo_i] > 0, mean[lo_i], mc)
+                    above = np.where(lg[hi_i] > 0, mean[hi_i], mc)
+                    ff |= np.abs(above + below - 2.0 * mc) * lg[ci, cj] * area / 24.0 > tol_g * vol * beta / (n * ny)
+            else:
+                ff = np.ones(ci.size, dtype=bool)
         keep = ~flag[owner]
         kept_v.append(qv[keep])
         kept_w.append(qw[keep])
@@ -626,6 +679,8 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
         p_owner, p_qv, p_qw = owner, qv, qw
         centre = (da == 1) & ((db == 1) | (ndim == 2))
         src = np.where(centre[None, :], np.flatnonzero(flag)[:, None], -1).ravel()
+        par = np.repeat(np.flatnonzero(flag), centre.size)
+        own = np.repeat(ff[flag], centre.size)
         ci = (3 * ci[flag][:, None] + da[None, :]).ravel()
         cj = (3 * cj[flag][:, None] + db[None, :]).ravel() if ndim == 3 else np.zeros(ci.size, dtype=np.int64)
         lg = np.repeat(np.repeat(lg, 3, axis=0), 3 if ndim == 3 else 1, axis=1)

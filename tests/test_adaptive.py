@@ -46,8 +46,9 @@ def test_column_kernel_equals_numpy_twin(name):
     compilations of it (fused multiply-adds): 1e-12 relative for the count, the LCI statistics and the band
     measures; the other fields' statistics within 1e-12 plus 4x their change when the twin evaluates those fields
     one ulp away from the same points (~1e-16 relative except next to a singular surface). Plans with and without
-    z-levels and box-face columns, and one with ny = n - 2 (3-D) and mirror planes on every cross axis (with box-face
-    columns, where the mirror matters). The twin evaluates the fields through the
+    z-levels and box-face columns, one with ny = n - 2 (3-D) and mirror planes on every cross axis (with box-face
+    columns, where the mirror matters), one with inherited fields (step 3b: fewer field evaluations than without)
+    and one with the 1-point (midpoint) rule, and with the column intervals both together. The twin evaluates the fields through the
     mechanism's kernel (population_points_fields) so that only the algorithm is compared; the field kernels
     themselves are checked against NumPy SVD twins in test_fields.py."""
     mech = get(name)
@@ -62,12 +63,15 @@ def test_column_kernel_equals_numpy_twin(name):
 
     n = 6 if ndim == 3 else 12
     mirror = dict(ny=n - 2, mirror=(True, ndim == 3))
+    inherit = dict(field_levels=0)  # step 3b: refined columns inherit their parent's fields
     plans = [(0, 1.0, 0, 1, False, {}), (2, 1.0, 0, 1, False, {}), (2, 3.0, 0, 1, False, {}),
-             (2, 1.0, 2, 2, True, {}), (2, 1.0, 0, 1, True, mirror)]
+             (2, 1.0, 2, 2, True, {}), (2, 1.0, 0, 1, True, mirror), (2, 1.0, 0, 1, True, inherit),
+             (2, 1.0, 0, 1, False, dict(gauss_points=1))]
     if mech.interval_kernel_for(options) is not None:  # the closed-form column intervals (the twin reads the same)
         ivs = dict(interval_kernel=mech.interval_kernel), dict(intervals=_interval_twin(mech.interval_kernel, packed))
         plans += [(2, 1.0, 0, 1, False, ivs), (2, 1.0, 2, 2, True, ivs), (2, 1.0, 1, 1, True, (
-            {**ivs[0], **mirror}, {**ivs[1], **mirror}))]
+            {**ivs[0], **mirror}, {**ivs[1], **mirror})), (2, 1.0, 0, 1, True, (
+            {**ivs[0], **inherit, "gauss_points": 1}, {**ivs[1], **inherit, "gauss_points": 1}))]
     for maxlev, beta, zlevels, zconfirm, faces, more in plans:
         kern, twin = more if isinstance(more, tuple) else (more, more)
         opt = dict(zlevels=zlevels, zconfirm=zconfirm, faces=faces)
@@ -103,6 +107,10 @@ def test_column_kernel_equals_numpy_twin(name):
         assert np.all(np.abs(s[0] - row) <= 1e-12 * np.abs(row) + 1e-12 * np.abs(row).max() + slack), name
         if beta == 1.0 and maxlev == 2 and not zlevels:
             assert tl >= 1  # the refinement itself was compared
+        if kern.get("field_levels", -1) >= 0:  # refined columns inherited their fields: fewer field evaluations
+            full = column_stats(kernel, mech.n_fields, packed[None, :], clo[None, :], chi[None, :], ndim, n, 6, 5,
+                                maxlev, 0.002, 5e-4, EDGES, beta, **opt, **{**kern, "field_levels": -1})
+            assert tl >= 1 and ne[0] < full[4][0], name
 
 
 def _interval_twin(interval_kernel, p, rows=8):
@@ -353,6 +361,42 @@ def test_interval_columns_equal_the_numpy_twin():
         assert eg[0] == pytest.approx(tg, rel=1e-10, abs=1e-13)
         np.testing.assert_allclose(s[0], row, rtol=1e-12, atol=1e-12 * np.abs(row).max())
         assert ne[0] < nodes[4][0]
+
+
+@njit(cache=True)
+def _ellipsoid_constant_field(p, x, y, z, out):
+    """_ellipsoid_field's reachable set with a constant LCI 0.25 (other slots as there)."""
+    _ellipsoid_field(p, x, y, z, out)
+    if out[0] >= 0.0:
+        out[0] = 0.25
+
+
+def test_inherited_fields_on_an_ellipsoid():
+    """Step 3b (``field_levels=0``) on an ellipsoid wholly inside its box, with closed-form column intervals:
+    - a constant LCI: refined columns that inherit their parent's fields give the same statistics as columns that
+      evaluate them (to 1e-12: the same pieces, the weights scaled), with fewer evaluations;
+    - LCI = 1 - r^2 (r the ellipsoid radius): the volume is the same as with evaluated fields (the measure is
+      exact either way) and the GCI is within 1e-3 of the exact mean of 1 - r^2 over the ball, 1 - 3/5 = 0.4
+      (the inherited per-column means are first-order accurate where a wall leaves the children asymmetric);
+      the kernel equals the NumPy twin."""
+    lo, hi = np.array([-0.5, -0.5, 0.0]), np.array([0.5, 0.5, 1.0])
+    p = np.array([0.03, -0.02, 0.5, 0.41, 0.33, 0.37, np.inf])
+    run = dict(interval_kernel=_ellipsoid_intervals, faces=True)
+    plan = (lo[None], hi[None], 3, 8, 2, 5, 3, 2e-4, 1e-4, EDGES, 1.0)  # 8 x 8 columns, 2 z-cells, 3 levels
+    const = [column_stats(_ellipsoid_constant_field, 3, p[None], *plan, **run, field_levels=f) for f in (-1, 0)]
+    np.testing.assert_allclose(const[1][0][0, :5], const[0][0][0, :5], rtol=1e-12)
+    assert const[1][3][0] == const[0][3][0] >= 2 and const[1][4][0] < const[0][4][0]
+    full, inh = (column_stats(_ellipsoid_field, 3, p[None], *plan, **run, field_levels=f) for f in (-1, 0))
+    cell = 1.0 / 8**2 / 2  # coarse cell: box / (8 x 8 columns x 2 z-cells)
+    exact_volume = 4.0 / 3.0 * np.pi * 0.41 * 0.33 * 0.37
+    assert inh[0][0, 0] == pytest.approx(full[0][0, 0], rel=1e-12)
+    assert inh[0][0, 0] * cell == pytest.approx(exact_volume, rel=2e-3)
+    assert inh[0][0, 1] / inh[0][0, 0] == pytest.approx(0.4, abs=1e-3)
+    assert inh[4][0] < full[4][0]
+    row, tv, tg, tl, tn = column_twin(_ellipsoid_fields(p), 3, lo, hi, *plan[2:], faces=True,
+                                      intervals=_interval_twin(_ellipsoid_intervals, p), field_levels=0)
+    assert (inh[3][0], inh[4][0]) == (tl, tn)
+    np.testing.assert_allclose(inh[0][0], row, rtol=1e-12, atol=1e-12 * np.abs(row).max())
 
 
 def test_interval_column_lengths_are_exact():

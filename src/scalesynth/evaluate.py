@@ -127,6 +127,10 @@ class ColumnPlan:
     zlevels: int = 0  # most doublings of the z-cells on the coarse grid (z-levels, kernels.adaptive step 0)
     zconfirm: int = 1  # consecutive z-level changes within the tolerance before the z-cells are trusted
     faces: bool = False  # box-face columns as ghost neighbours of the edge columns (kernels.adaptive step 3)
+    # the last level whose new columns evaluate the fields at their Gauss points; deeper ones refine the measure
+    # alone and inherit their parent's fields per unit measure (kernels.adaptive step 3b); -1: every level
+    field_levels: int = -1
+    gauss_points: int = 2  # fields per piece: 2 (Gauss-Legendre) or 1 (midpoint rule; kernels.adaptive step 2)
 
     def coarse_cells(self, ndim: int) -> int:
         """Cells of the coarse grid (the unit of the statistics rows' counts)."""
@@ -311,7 +315,9 @@ def adaptive_population_stats(
                                                       tolerance.volume, tolerance.gci, edges, plan.beta,
                                                       plan.zlevels, plan.zconfirm, plan.faces, reach,
                                                       ny=half.ny, mirror=half.mirror,
-                                                      interval_kernel=interval_kernel)
+                                                      interval_kernel=interval_kernel,
+                                                      field_levels=plan.field_levels,
+                                                      gauss_points=plan.gauss_points)
     stats = half.whole(stats, mech.n_fields)
     return AdaptiveResult(stats, cell, err_v, err_g, levels, evals, plan.coarse_cells(ndim))
 

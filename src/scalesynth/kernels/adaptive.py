@@ -22,7 +22,8 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    each with half the piece's length (a point that turns out unreachable gives its weight to the other; a piece
    with neither reachable is dropped). The points' fields and weights feed the shared statistics accumulator
    (kernels.grid), so every statistic of the row layout (count, sum, sum of squares, min, max per field, band
-   measures) exists as for uniform grids.
+   measures) exists as for uniform grids. With ``gauss_points`` 1 the midpoint rule instead: the fields at the
+   piece's midpoint with its whole length (dropped if unreachable).
 3. Level 0 integrates the column measures L and LCI sums S over the cross grid by the midpoint rule. Its local
    error indicator is the second difference of L (and of S) over the neighbouring columns (the midpoint rule is
    exact for linear variation; walls and silhouettes give large second differences). At the box the neighbour is
@@ -35,6 +36,16 @@ Algorithm, per design (``tests/naive.py::column_stats`` is its NumPy twin):
    cells, each with its own column (the centre one is its parent's column: the same point, reused with 1/9 of
    the weight, not recomputed). The next level repeats steps 1-3 on the new columns, with
    the others held at their coarser values.
+3b. Inherited fields (``field_levels`` = f >= 0): a new column at a level above f takes its measure alone (its
+   intervals, or nodes and bisections: no Gauss points) and its parent's statistics row scaled by its measure over
+   the parent's (L / (L_parent nk)): the fields' distribution per unit measure of the parent (its LCI sum S =
+   L S_parent / L_parent). Refinement is mostly driven by walls, where the measure jumps but the fields do not;
+   the fields then cost only the coarse levels. A column's children still evaluate their own fields where it has
+   no measure (nothing to inherit) or where the second difference of its mean LCI S / L along a cross axis (a
+   neighbour without measure replaced by the column itself), x L x cell area / 24, exceeds the GCI share of step 3
+   (``field_flags``). The level-to-level estimate of step 4 does not see what inheriting costs (a child's mean
+   differs from its parent's by the gradient over a third of a cell, which cancels between children except where
+   a wall keeps only some of them): the plans that use it are checked against references (evaluate.py).
 4. After each level l >= 1 the error estimate is the change of the workspace measure (relative) and of the GCI
    (absolute) from level l-1; the design stops at the first level whose estimate meets the tolerance, or at
    ``maxlev``, or when no column is flagged for refinement (the estimate is then the last change, reported as
@@ -171,6 +182,34 @@ def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def field_flags(lg, sg, ci, cj, n_active, ndim, area, budget_g, fflags):
+    """fflags[a] = whether active column a's children evaluate their own fields (step 3b): its column has no
+    measure, or the second difference of the mean LCI S / L along a cross axis (a neighbour without measure
+    replaced by the column itself), x L x area / 24, exceeds the GCI budget (flag_columns' for S)."""
+    nl = lg.shape[0]
+    nyl = lg.shape[1]
+    for a in range(n_active):
+        i = ci[a]
+        j = cj[a]
+        lc = lg[i, j]
+        if not lc > 0.0:
+            fflags[a] = True
+            continue
+        mc = sg[i, j] / lc
+        f = False
+        for axis in range(ndim - 1):
+            if axis == 0:
+                i0, j0, i1, j1 = max(i - 1, 0), j, min(i + 1, nl - 1), j
+            else:
+                i0, j0, i1, j1 = i, max(j - 1, 0), i, min(j + 1, nyl - 1)
+            below = sg[i0, j0] / lg[i0, j0] if lg[i0, j0] > 0.0 else mc
+            above = sg[i1, j1] / lg[i1, j1] if lg[i1, j1] > 0.0 else mc
+            if abs(above + below - 2.0 * mc) * lc * area / 24.0 > budget_g:
+                f = True
+        fflags[a] = f
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def refine_faces(fg, r):
     """Face-column values [side, L or S, index] at the next level: every value repeated over its r children."""
     out = np.empty((2, 2, fg.shape[2] * r))
@@ -192,7 +231,7 @@ def refine_grid(g, ndim):
     return out
 
 
-def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out):
+def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out, gauss):
     """Template (serial): one column at (x, y) with ``mz`` z-cells of height ``hz`` (steps 1-2): its Gauss points'
     fields into buf[:, :npts] and weights (x ``area``, in units of ``hz0``) into wbuf; out = (column measure L, LCI
     sum S, npts, field-kernel calls)."""
@@ -236,9 +275,28 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
                 zb = cross
             else:
                 za = cross
+        if gauss == 0:
+            col_l += (zb - za) / hz0  # the measure alone (a column whose fields are inherited)
+            continue
         # 2. 2-point Gauss rule on the piece [za, zb]
         half = 0.5 * (zb - za)
         zm = 0.5 * (za + zb)
+        if gauss == 1:
+            # the 1-point rule: the fields at the piece's midpoint, with its whole length
+            if ndim == 3:
+                FIELD_KERNEL(p, x, y, zm, q0)
+            else:
+                FIELD_KERNEL(p, x, zm, zfix, q0)
+            evals += 1
+            if q0[0] >= 0.0:
+                w = 2.0 * half / hz0
+                for f in range(n_fields):
+                    buf[f, npts] = q0[f]
+                wbuf[npts] = w * area
+                npts += 1
+                col_l += w
+                col_s += w * q0[0]
+            continue
         if ndim == 3:
             FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
             FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
@@ -271,7 +329,8 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
     out[3] = evals
 
 
-def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out):
+def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
+                      gauss):
     """Template (serial), ``_column``'s variant with an interval kernel (step 1 in closed form; 3-D only): the
     reachable intervals of the column over [zlo, zlo + mz hz] from INTERVAL_KERNEL, then each z-cell's intersection
     with each interval (a piece; none, one or several per cell, a piece of zero length dropped) integrated as in
@@ -280,14 +339,14 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
     its head holds the intervals. buf, wbuf hold >= 2 (mz + MAX_INTERVALS) points (a cell split by gaps between
     intervals has one piece more per gap)."""
     if ndim != 3:
-        NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
+        NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out, gauss)
         return
     n_fields = N_FIELDS
     iv = nodes[: 2 * MAX_INTERVALS].reshape((MAX_INTERVALS, 2))
     # the top is the last node of the node path (zlo + mz hz), not the box's hi: the same column to rounding
     k = INTERVAL_KERNEL(p, x, y, zlo, _add_product(zlo, mz, hz), iv)
     if k < 0:
-        NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
+        NODE_COLUMN(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out, gauss)
         out[3] += 1.0
         return
     evals = 1.0
@@ -309,10 +368,25 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
             u += 1
             if not zb > za:
                 continue
+            if gauss == 0:
+                col_l += (zb - za) / hz0  # the measure alone (a column whose fields are inherited)
+                continue
             # 2. 2-point Gauss rule on the piece [za, zb], weights as in _column (a copy of its lines: one shared
             # inline helper was byte-identical but made rps_upu_tool's search loop about 10 % slower)
             half = 0.5 * (zb - za)
             zm = 0.5 * (za + zb)
+            if gauss == 1:
+                FIELD_KERNEL(p, x, y, zm, q0)  # the 1-point rule, as in _column
+                evals += 1
+                if q0[0] >= 0.0:
+                    w = 2.0 * half / hz0
+                    for f in range(n_fields):
+                        buf[f, npts] = q0[f]
+                    wbuf[npts] = w * area
+                    npts += 1
+                    col_l += w
+                    col_s += w * q0[0]
+                continue
             FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
             FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
             evals += 2
@@ -342,7 +416,7 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
 
 
 def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
-                  mirror_x, mirror_y, edges, row, info):
+                  mirror_x, mirror_y, field_levels, gauss_points, edges, row, info):
     """Template (serial; FIELD_KERNEL is the bound ``_column``): statistics row of one design into ``row``; info:
     error_volume, error_gci, level, evaluations. nx, ny3: coarse columns along cross axes 0, 1 (ny3 unused when
     planar); mirror_x, mirror_y: the lo face of cross axis 0, 1 is a mirror plane (no face ghost there)."""
@@ -381,8 +455,12 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
     for a in range(n_active):
         ci[a] = a // ny
         cj[a] = a - (a // ny) * ny
-    # src[a]: the parent (index into the previous level's rows) whose column active column a repeats, else -1
+    # src[a]: the parent (index into the previous level's rows) whose column active column a repeats, else -1;
+    # par[a]: active column a's parent (every child; level 0: -1)
     src = np.full(n_active, -1, dtype=np.int64)
+    par = np.full(n_active, -1, dtype=np.int64)
+    # own[a]: active column a evaluates its fields (step 3b: its parent's field flag); else it inherits them
+    own = np.ones(n_active, dtype=np.bool_)
     prev_rows = np.empty((0, ncol))
     nk = 9 if ndim == 3 else 3
     lg = np.zeros((nx, ny))
@@ -403,6 +481,7 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
     zok = 0
     while True:
         hz = _div(hi_d[ca] - zlo, mz)
+        inherit = field_levels >= 0 and level > field_levels
         scale = 1.0
         for _ in range(level):
             scale *= 3.0
@@ -423,7 +502,33 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                 continue
             x = _centre(lo_d[0], ci[a], hx, scale)
             y = _centre(lo_d[1], cj[a], hy, scale)
-            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out)
+            # lg, sg hold the parent's L and S at a child's cell (refine_grid) until it is computed
+            lpar = lg[ci[a], cj[a]]
+            if inherit and lpar > 0.0 and not own[a]:
+                # step 3b: the measure alone; the fields' statistics are the parent's per unit measure
+                FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
+                             0)
+                evals += out[3]
+                lc = out[0]
+                if lc > 0.0:
+                    r = lc / (lpar * nk)
+                    for c in range(ncol):
+                        rows[a, c] = prev_rows[par[a], c]
+                    rows[a, 0] *= r
+                    for f in range(n_fields):
+                        rows[a, 1 + 4 * f] *= r
+                        rows[a, 2 + 4 * f] *= r
+                    for c in range(1 + 4 * n_fields, ncol):
+                        rows[a, c] *= r
+                else:
+                    init_row(colrow, n_fields)
+                    for c in range(ncol):
+                        rows[a, c] = colrow[c]
+                sg[ci[a], cj[a]] = lc * (sg[ci[a], cj[a]] / lpar)
+                lg[ci[a], cj[a]] = lc
+                continue
+            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
+                         gauss_points)
             evals += out[3]
             init_row(colrow, n_fields)
             accumulate_cells(colrow, buf, wbuf, int(out[2]), edges)
@@ -456,6 +561,7 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
         prev_g = gci
         stop = level >= maxlev or (level >= 1 and err_v <= tol_v and err_g <= tol_g)
         flags = np.zeros(n_active, dtype=np.bool_)
+        fflags = np.ones(n_active, dtype=np.bool_)
         if not stop:
             if faces:
                 nl = lg.shape[0]
@@ -476,18 +582,25 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                                 x = _add_product(lo_d[0], fpos, hx)
                             else:
                                 y = _add_product(lo_d[1], fpos, hy)
+                            # with inherited fields the face column's LCI sum is its measure times the edge
+                            # column's mean LCI (unless the edge column has none)
+                            ledge = lg[ci[a], cj[a]]
+                            fon = not (inherit and ledge > 0.0)
                             FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1,
-                                         buf, wbuf, out)
+                                         buf, wbuf, out, gauss_points if fon else 0)
                             evals += out[3]
+                            fs = out[1] if fon else out[0] * (sg[ci[a], cj[a]] / ledge)
                             if axis == 0:
                                 fxg[side, 0, cj[a]] = out[0]
-                                fxg[side, 1, cj[a]] = out[1]
+                                fxg[side, 1, cj[a]] = fs
                             else:
                                 fyg[side, 0, ci[a]] = out[0]
-                                fyg[side, 1, ci[a]] = out[1]
+                                fyg[side, 1, ci[a]] = fs
             ncell0 = nx * ny
             flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
                          tol_g * vol * beta / ncell0, faces, mirror_x, mirror_y, fxg, fyg, flags)
+            if field_levels >= 0 and level >= field_levels:
+                field_flags(lg, sg, ci, cj, n_active, ndim, area, tol_g * vol * beta / ncell0, fflags)
         n_flag = 0
         for a in range(n_active):
             if flags[a]:
@@ -500,6 +613,8 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
         ni = np.empty(n_flag * nk, dtype=np.int64)
         nj = np.empty(n_flag * nk, dtype=np.int64)
         ns = np.empty(n_flag * nk, dtype=np.int64)
+        npar = np.empty(n_flag * nk, dtype=np.int64)
+        nown = np.empty(n_flag * nk, dtype=np.bool_)
         t = 0
         for a in range(n_active):
             if flags[a]:
@@ -508,10 +623,14 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                         ni[t] = 3 * ci[a] + da
                         nj[t] = 3 * cj[a] + db if ndim == 3 else 0
                         ns[t] = a if da == 1 and (db == 1 or ndim == 2) else -1
+                        npar[t] = a
+                        nown[t] = fflags[a]
                         t += 1
         ci = ni
         cj = nj
         src = ns
+        par = npar
+        own = nown
         prev_rows = rows
         n_active = t
         lg = refine_grid(lg, ndim)
@@ -526,20 +645,21 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
 
 
 def _column_stats(params, lo, hi, ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
-                  mirror_x, mirror_y, edges):
+                  mirror_x, mirror_y, field_levels, gauss_points, edges):
     """Template (parallel over designs): FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel."""
     n_designs = params.shape[0]
     stats = np.zeros((n_designs, 1 + 4 * N_FIELDS + edges.shape[0] - 1))
     info = np.zeros((n_designs, 4))
     for d in prange(n_designs):
         FIELD_KERNEL(params[d], lo[d], hi[d], ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm,
-                     faces, mirror_x, mirror_y, edges, stats[d], info[d])
+                     faces, mirror_x, mirror_y, field_levels, gauss_points, edges, stats[d], info[d])
     return stats, info
 
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
                  beta=1.0, zlevels=0, zconfirm=1, faces=False, reach_kernel=None, ny: int | None = None,
-                 mirror: tuple[bool, bool] = (False, False), interval_kernel=None):
+                 mirror: tuple[bool, bool] = (False, False), interval_kernel=None, field_levels: int = -1,
+                 gauss_points: int = 2):
     """Statistics rows of every design by the column algorithm (module docstring).
 
     params (d, k) packed designs; lo, hi (d, 3): each design's box (planar: lo[2] is the fixed z); n: coarse columns
@@ -555,9 +675,14 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     ``faces`` (module docstring, step 3); planar: axis 1 is the column axis, a mirror there is an error.
     interval_kernel: Mechanism.interval_kernel (3-D only; None: nodes and bisection): each column's reachable
     intervals in closed form where it returns k >= 0 (module docstring); each call counts as one evaluation.
+    field_levels: the last level whose new columns all evaluate their fields; deeper ones inherit their parent's
+    (module docstring, step 3b); -1: every level evaluates them. gauss_points: 2 (the 2-point Gauss-Legendre rule
+    per piece) or 1 (the midpoint rule: half the field evaluations, for fields that vary little along a piece).
     """
     ny = int(n) if ny is None or int(ndim) == 2 else int(ny)
     mirror_x, mirror_y = (bool(v) for v in mirror)
+    if int(gauss_points) not in (1, 2):
+        raise ValueError(f"gauss_points must be 1 or 2, got {gauss_points}")
     if ny < 1 or int(n) < 1:
         raise ValueError(f"column counts must be >= 1 (n={n}, ny={ny})")
     if mirror_y and int(ndim) == 2:
@@ -573,5 +698,5 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),
                       np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), ny, int(m), int(nbis), int(maxlev),
                       float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces), mirror_x,
-                      mirror_y, np.ascontiguousarray(edges, dtype=float))
+                      mirror_y, int(field_levels), int(gauss_points), np.ascontiguousarray(edges, dtype=float))
     return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()
