@@ -450,10 +450,11 @@ def column_stats(fields, n_fields, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_
     a mirror plane (clamped neighbour, no face column there even with ``faces``); intervals (3-D only, as the
     kernel's interval_kernel): ``intervals(x, y, zlo, zhi)`` -> the column's reachable intervals [(a, b), ...]
     (sorted, disjoint) or None (then that column takes the nodes and bisections), one evaluation per call;
-    field_levels >= 0: a new column below that level takes its measure alone and its parent's Gauss points with
-    their weights times (its measure / the parent's / nk), unless the parent has no measure or its mean-LCI
-    indicator fired (kernels.adaptive step 3b); gauss_points 1: the midpoint rule per piece. Returns (stats row in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci,
-    level, evaluations)."""
+    field_levels >= 0: a new column at a deeper level takes its measure alone and its parent's Gauss points
+    with their weights times (its measure / the parent's / nk), unless the parent has no measure or its mean-LCI
+    indicator fired (kernels.adaptive step 3b); gauss_points 1: the midpoint rule per piece. Returns (stats row
+    in the layout of kernels.grid with counts in coarse-cell units, error_volume, error_gci, level,
+    evaluations)."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     ca = ndim - 1
     zlo = lo[ca]

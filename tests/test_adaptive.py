@@ -48,9 +48,9 @@ def test_column_kernel_equals_numpy_twin(name):
     one ulp away from the same points (~1e-16 relative except next to a singular surface). Plans with and without
     z-levels and box-face columns, one with ny = n - 2 (3-D) and mirror planes on every cross axis (with box-face
     columns, where the mirror matters), one with inherited fields (step 3b: fewer field evaluations than without)
-    and one with the 1-point (midpoint) rule, and with the column intervals both together. The twin evaluates the fields through the
-    mechanism's kernel (population_points_fields) so that only the algorithm is compared; the field kernels
-    themselves are checked against NumPy SVD twins in test_fields.py."""
+    and one with the 1-point (midpoint) rule, and with the column intervals both together. The twin evaluates the
+    fields through the mechanism's kernel (population_points_fields) so that only the algorithm is compared; the
+    field kernels themselves are checked against NumPy SVD twins in test_fields.py."""
     mech = get(name)
     cfg = load_config(config_for(name))
     design, options = cfg.resolved_design(), cfg.resolved_options()
