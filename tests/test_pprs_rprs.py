@@ -18,8 +18,11 @@ from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.pprs_rprs import (
     BRANCHES,
+    GRAM_MIN_RATIO,
     Geometry,
+    _jacobi_6x6,
     _lci_6x6,
+    _sv_6x6,
     chain_state,
     newton_fk,
     normalise_euler,
@@ -27,7 +30,7 @@ from scalesynth.mechanisms.pprs_rprs import (
 )
 
 from conftest import ROOT
-from naive import pprs_lci
+from naive import pprs_fields, pprs_lci
 from refdata import load_case
 
 M = get("pprs-rprs")
@@ -295,6 +298,78 @@ def test_lci_6x6_matches_svd():
         assert _lci_6x6(a.copy()) == pytest.approx(ref, rel=1e-7)
     assert _lci_6x6(np.eye(6)) == 1.0
     assert _lci_6x6(np.zeros((6, 6))) == 0.0
+
+
+def _with_singular_values(rng, s):
+    """A random 6x6 matrix U diag(s) V^T."""
+    u, _, vt = np.linalg.svd(rng.normal(size=(2, 6, 6)))
+    return (u[0] * s) @ vt[1]
+
+
+@pytest.mark.parametrize(("lci", "gram"), [(0.7, True), (1e-2, True), (2e-3, True), (5e-4, False), (1e-5, False),
+                                           (1e-7, False)])
+def test_sv_6x6_gram_path_and_jacobi_fallback(lci, gram):
+    # GRAM_MIN_RATIO (lambda_min / lambda_max of A^T A) sits at LCI 1e-3: above it the Gram/Laguerre result (which
+    # differs from Jacobi's in the last bits), below it one-sided Jacobi, both against NumPy's SVD
+    assert GRAM_MIN_RATIO == pytest.approx(1e-6)
+    rng = np.random.default_rng(7)
+    differ = 0
+    for _ in range(300):
+        s = np.exp(rng.uniform(math.log(lci), 0.0, 6))
+        s[:2] = 1.0, lci
+        a = _with_singular_values(rng, s) * rng.choice([1e-3, 1.0, 1e3])
+        sv = np.linalg.svd(a, compute_uv=False)
+        got = _sv_6x6(a)
+        jac = _jacobi_6x6(a.copy())
+        differ += got != jac
+        rel = 2e-9 if gram else 1e-7  # the Gram path's bound (bracket + eps kappa^2); Jacobi's contract
+        assert got[0] == pytest.approx(sv[-1] / sv[0], rel=rel)
+        assert got[1] == pytest.approx(sv[-1], rel=rel)
+        assert got[2] == pytest.approx(sv[0], rel=1e-12)
+    if gram:
+        assert differ >= 270  # the fast path ran (bit-equal to Jacobi at most by chance)
+    else:
+        assert differ == 0  # the fallback ran
+
+
+@pytest.mark.parametrize("spread", [1e-3, 1e-6, 1e-8, 1e-12, 0.0])
+@pytest.mark.parametrize("size", [2, 3, 6])
+def test_sv_6x6_clustered_singular_values(spread, size):
+    # Laguerre converges only linearly onto a cluster and may overshoot into it: the Sturm brackets must catch that
+    # (fallback) or bound the error by GRAM_BRACKET
+    rng = np.random.default_rng(8)
+    for top in (True, False):
+        for _ in range(100):
+            s = rng.uniform(0.1, 0.9, 6) * (1.0 if top else 10.0)
+            s[:size] = 1.0 + rng.uniform(-spread, spread, size)
+            a = _with_singular_values(rng, s)
+            sv = np.linalg.svd(a, compute_uv=False)
+            got = _sv_6x6(a)
+            assert got[0] == pytest.approx(sv[-1] / sv[0], rel=2e-9)
+            assert got[1] == pytest.approx(sv[-1], rel=2e-9)
+            assert got[2] == pytest.approx(sv[0], rel=2e-9)
+
+
+def test_sv_6x6_degenerate():
+    assert _sv_6x6(np.zeros((6, 6))) == (0.0, 0.0, 0.0)
+    assert _sv_6x6(np.full((6, 6), np.nan)) == (0.0, 0.0, 0.0)
+    assert _sv_6x6(np.diag([2.0, 2.0, 2.0, 2.0, 2.0, 0.0])) == (0.0, 0.0, 2.0)
+    assert _sv_6x6(np.diag([3.0] * 6)) == (1.0, 3.0, 3.0)
+    assert _sv_6x6(np.diag([1e200] * 6))[2] == math.inf  # A^T A overflows: Jacobi, as before the Gram path
+
+
+def test_kernel_lci_of_real_jacobians():
+    # the LCIs that matter: the Table-1 design's reachable nodes (LCI 1e-3 .. 0.2, so the Gram path) against the
+    # NumPy twin (SVD of the homogenised J_t), within the Gram path's bound rather than the 1e-7 contract
+    g = make_grid(M, D, OPT, 24)
+    lci = kgrid.sample_grid(M.point_kernel, M.pack(D, OPT), g.lo, g.step, g.shape)
+    X, Y, Z = (g.lo[a] + (np.arange(g.shape[a]) + 0.5) * g.step[a] for a in range(3))
+    twin = pprs_fields(D, OPT, *np.meshgrid(X, Y, Z, indexing="ij"))
+    reach = twin[..., 0] >= 0
+    assert np.count_nonzero(reach) > 1000
+    assert np.array_equal(lci >= 0, reach)
+    assert np.mean(twin[reach, 0] >= 1e-3) > 0.95
+    np.testing.assert_allclose(lci[reach], twin[reach, 0], rtol=2e-9, atol=0.0)
 
 
 TWIN_CASES = [
