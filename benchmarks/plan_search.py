@@ -64,12 +64,16 @@ N_DESIGNS = 20
 
 
 def parse_plan(text: str) -> ColumnPlan:
-    c, m, b, lv, beta, zl, zc, f = text.split(",")
-    return ColumnPlan(int(c), int(m), int(b), int(lv), float(beta), int(zl), int(zc), bool(int(f)))
+    """columns,cells,bisections,levels,beta,zlevels,zconfirm,faces[,field_levels[,gauss_points]]"""
+    c, m, b, lv, beta, zl, zc, f, *more = text.split(",")
+    extra = dict(zip(("field_levels", "gauss_points"), (int(v) for v in more), strict=False))
+    return ColumnPlan(int(c), int(m), int(b), int(lv), float(beta), int(zl), int(zc), bool(int(f)), **extra)
 
 
 def plan_label(p: ColumnPlan) -> str:
-    return f"({p.columns}, {p.cells}, {p.bisections}, {p.levels}, {p.beta:g}, {p.zlevels}, {p.zconfirm}, {int(p.faces)})"
+    more = f", {p.field_levels}, {p.gauss_points}" if (p.field_levels, p.gauss_points) != (-1, 2) else ""
+    return (f"({p.columns}, {p.cells}, {p.bisections}, {p.levels}, {p.beta:g}, {p.zlevels}, {p.zconfirm}, "
+            f"{int(p.faces)}{more})")
 
 
 def grid_plans(grid: dict) -> list[ColumnPlan]:

@@ -1,17 +1,23 @@
-"""pprs-rprs: the adaptive evaluator's interval plans against exact volumes, and its time against the uniform grid.
+"""pprs-rprs: the adaptive evaluator's interval plans against converged references, and its time against the uniform
+grid.
 
-    NUMBA_NUM_THREADS=1 python benchmarks/pprs_columns.py check SEED PLAN [PLAN ...]   # e.g. 24,2,5,3,1,0,1,1
+    NUMBA_NUM_THREADS=1 python benchmarks/pprs_columns.py check SEED PLAN [PLAN ...]   # e.g. 24,1,5,3,4,0,1,0,0,1
     NUMBA_NUM_THREADS=1 python benchmarks/pprs_columns.py ab
 
-``check``: the 20 random designs of ``benchmarks/adaptive.py`` (``random_designs(cfg, 20, SEED)``); reference volume:
+``check``: the 20 random designs of ``benchmarks/adaptive.py`` (``random_designs(cfg, 20, SEED)``). Reference volume:
 the exact reachable length of every column (``PprsRprs.interval_kernel``, closed form) summed over a 2400 x 2400
-cross grid of the bounding box (its midpoint error, from the walls between columns, is below 0.02 % there);
-reference GCI: the uniform N = 192 grid (LCI kernel). Per plan (columns,cells,bisections,levels,beta,zlevels,
-zconfirm,faces, as benchmarks/plan_search.py): kernel calls per design, the worst volume and GCI errors as
-multiples of the config's tolerance (0.2 %, 5e-4; slivers, reference volume below 1 % of the median, left out), the
-largest own estimate, and the three worst designs. ``ab``: seed 0, alternating, best of 3, one process: the search's
-call (``adaptive_population_stats``, lci_only) with the column intervals and the interval plan, with nodes and
-bisection and the node plan (before), and the uniform N = 32 grid (the config's resolution).
+cross grid of the bounding box (its midpoint error, from the walls between columns, is below 0.02 % there).
+Reference GCI: the adaptive evaluator itself with 324 x 324 columns of 4 z-cells, every column's fields evaluated
+(2-point rule, no refinement): its column lengths are exact, so only the cross midpoint rule and the Gauss rule
+along z remain; against 216 x 216 columns it moves by at most 0.07x the GCI tolerance without slivers on seeds 0-4,
+where the uniform N = 192 is up to 0.35x off it (benchmarks/notes/pprs_rprs.md). Per plan (columns,cells,
+bisections,levels,beta,zlevels,zconfirm,faces[,field_levels[,gauss_points]], as benchmarks/plan_search.py):
+kernel calls per design, the worst volume and GCI errors as multiples of the config's tolerance (0.2 %, 5e-4;
+slivers, reference volume below 1 % of the median, left out), the largest own estimate, and the three worst
+designs. ``ab``: seed 0, alternating, best of 3, one process: the search's call (``adaptive_population_stats``,
+lci_only) with the column intervals and the interval plan, with the interval plan before inherited fields
+(PLAN_BEFORE), with nodes and bisection and the node plan, and the uniform N = 32 grid (the config's resolution
+before the tolerance form).
 """
 
 from __future__ import annotations
@@ -29,9 +35,12 @@ from adaptive import N_CROSS, SLIVER, design_set  # noqa: E402
 from adaptive import exact_volumes as adaptive_exact_volumes  # noqa: E402
 from plan_search import Search, parse_plan  # noqa: E402
 
-from scalesynth.evaluate import Tolerance, adaptive_plan, adaptive_population_stats  # noqa: E402
+from scalesynth.evaluate import ColumnPlan, Tolerance, adaptive_plan, adaptive_population_stats  # noqa: E402
 
-N_GCI = 192
+# the GCI reference's plan: 324 x 324 columns of 4 z-cells, fields at every column, no refinement
+GCI_REFERENCE = ColumnPlan(324, 4, 5, 0, faces=True)
+# the interval plan before inherited fields and the midpoint rule (2026-12-02 morning), for ``ab``
+PLAN_BEFORE = ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True)
 
 
 def exact_volumes(s) -> np.ndarray:
@@ -39,11 +48,16 @@ def exact_volumes(s) -> np.ndarray:
     return adaptive_exact_volumes(s.mech, s.designs, s.options, s.packed, s.region, N_CROSS)
 
 
+def gci_of(stats: np.ndarray) -> np.ndarray:
+    return np.where(stats[:, 0] > 0, stats[:, 1] / np.where(stats[:, 0] > 0, stats[:, 0], 1.0), 0.0)
+
+
 def check(seed: int, plans: list[str]) -> None:
     s = design_set("pprs-rprs", seed=seed)
     t0 = time.perf_counter()
     ex = exact_volumes(s)
-    _, rg = Search("pprs-rprs", N_GCI, None).uniform(s.designs, N_GCI)
+    rg = gci_of(adaptive_population_stats(s.mech, s.designs, s.options, s.packed, s.tol, s.edges, s.region,
+                                          plan=GCI_REFERENCE, lci_only=True).stats)
     keep = ex >= SLIVER * np.median(ex)
     print(f"# seed {seed}: references in {time.perf_counter() - t0:.0f} s; slivers (left out): "
           f"{np.flatnonzero(~keep).tolist()}; exact volumes {np.round(ex).tolist()}", flush=True)
@@ -53,7 +67,7 @@ def check(seed: int, plans: list[str]) -> None:
         r = adaptive_population_stats(s.mech, s.designs, s.options, s.packed, tol, s.edges, s.region, plan=plan,
                                       lci_only=True)
         vol = r.stats[:, 0] * r.cell
-        gci = np.where(r.stats[:, 0] > 0, r.stats[:, 1] / np.where(r.stats[:, 0] > 0, r.stats[:, 0], 1.0), 0.0)
+        gci = gci_of(r.stats)
         ev = np.where(keep, np.abs(vol - ex) / np.where(keep, ex, 1.0), 0.0) / tol.volume
         eg = np.where(keep, np.abs(gci - rg), 0.0) / tol.gci
         est = np.maximum(r.error_volume / tol.volume, r.error_gci / tol.gci)
@@ -66,13 +80,14 @@ def ab() -> None:
     s = design_set("pprs-rprs")
     uni = Search("pprs-rprs", 32, None)
 
-    def adaptive(intervals: bool):
-        plan = adaptive_plan(s.mech, s.options if intervals else None)
+    def adaptive(intervals: bool, plan: ColumnPlan | None = None):
+        plan = plan or adaptive_plan(s.mech, s.options if intervals else None)
         return lambda: adaptive_population_stats(s.mech, s.designs, s.options, s.packed, s.tol, s.edges, s.region,
                                                  plan=plan, lci_only=True, intervals=intervals)
 
-    runs = {"column intervals, interval plan": adaptive(True), "nodes and bisection, node plan": adaptive(False),
-            "uniform N = 32": lambda: uni.uniform(s.designs, 32)}
+    runs = {"column intervals, interval plan": adaptive(True),
+            "column intervals, the interval plan before inherited fields": adaptive(True, PLAN_BEFORE),
+            "nodes and bisection, node plan": adaptive(False), "uniform N = 32": lambda: uni.uniform(s.designs, 32)}
     for f in runs.values():
         f()  # compiled or loaded
     best = dict.fromkeys(runs, np.inf)

@@ -190,10 +190,15 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # the psi-column node plan's 23 958; without z-levels the fields' Gauss rule along z misses the GCI (16-48 fixed
 # z-cells: 1.1-4.4x; the LCI varies along z more than the 8 coarse cells resolve on some designs)
 # pprs-rprs: its workspaces are thin slabs (median 27-28 mm of a 215-256 mm box) whose columns hold one interval,
-# so 2 z-cells serve the fields' Gauss rule; (24, 2, 5, 3, beta 1, faces) is within 0.81x / 0.68x / 0.72x (volume,
-# against the exact volume of the column intervals on a 2400^2 cross grid) and 0.27x / 0.11x / 0.55x (GCI, against
-# N = 192) on seeds 0 / 1 / 2 at 5 341-6 582 calls per design, against the node plan's 668 298; 12 or 16 columns miss
-# (1.52x, 1.16x on seed 1) (benchmarks/pprs_columns.py, benchmarks/notes/pprs_rprs.md)
+# so 1 z-cell and the midpoint rule serve the fields; its refinement is driven by walls (vertical planes of the
+# rail and link limits), where the measure jumps but the LCI does not, so the refined columns inherit their fields
+# (field_levels 0, kernels.adaptive step 3b) and refine 4 times less eagerly (beta 4): (24, 1, 5, 3, beta 4, no
+# faces, fields on level 0, 1 Gauss point) is within 0.68x / 0.54x / 0.76x / 0.78x / 0.63x (volume, against the
+# exact volume of the column intervals on a 2400^2 cross grid) and 0.47x / 0.51x / 0.50x / 0.56x / 0.76x (GCI,
+# against 324^2 columns of exact intervals with fields everywhere) on seeds 0-4 at 2 056-2 609 calls per design,
+# where the plan before, (24, 2, 5, 3, beta 1, faces), took 5 341-6 793 and was 1.14x off on a seed-3 design; 12
+# or 16 columns miss small workspaces (1.52x, 1.16x on seed 1) (benchmarks/pprs_columns.py,
+# benchmarks/notes/pprs_rprs.md)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
     # ups-sspr (Y-columns in closed form, ups_sspr.column_intervals): benchmarks/plan_search.py's 864 plans against
@@ -202,7 +207,7 @@ INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     # (LCI kernel) against the node plan's 2534 (with the same columns, 4 z-cells and every call a node or bisection)
     "ups-sspr": ColumnPlan(6, 2, 8, 3, beta=2.0, faces=True),
     "rps-upu": ColumnPlan(8, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=1),
-    "pprs-rprs": ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True),
+    "pprs-rprs": ColumnPlan(24, 1, 5, 3, beta=4.0, field_levels=0, gauss_points=1),
 }
 
 
