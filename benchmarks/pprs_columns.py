@@ -31,14 +31,12 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from adaptive import N_CROSS, SLIVER, design_set  # noqa: E402
+from adaptive import COLUMN_GCI_PLAN, N_CROSS, SLIVER, design_set  # noqa: E402
 from adaptive import exact_volumes as adaptive_exact_volumes  # noqa: E402
 from plan_search import Search, parse_plan  # noqa: E402
 
 from scalesynth.evaluate import ColumnPlan, Tolerance, adaptive_plan, adaptive_population_stats  # noqa: E402
 
-# the GCI reference's plan: 324 x 324 columns of 4 z-cells, fields at every column, no refinement
-GCI_REFERENCE = ColumnPlan(324, 4, 5, 0, faces=True)
 # the interval plan before inherited fields and the midpoint rule (2026-12-02 morning), for ``ab``
 PLAN_BEFORE = ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True)
 
@@ -57,7 +55,7 @@ def check(seed: int, plans: list[str]) -> None:
     t0 = time.perf_counter()
     ex = exact_volumes(s)
     rg = gci_of(adaptive_population_stats(s.mech, s.designs, s.options, s.packed, s.tol, s.edges, s.region,
-                                          plan=GCI_REFERENCE, lci_only=True).stats)
+                                          plan=COLUMN_GCI_PLAN, lci_only=True).stats)
     keep = ex >= SLIVER * np.median(ex)
     print(f"# seed {seed}: references in {time.perf_counter() - t0:.0f} s; slivers (left out): "
           f"{np.flatnonzero(~keep).tolist()}; exact volumes {np.round(ex).tolist()}", flush=True)
