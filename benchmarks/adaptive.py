@@ -240,6 +240,7 @@ def bench_mechanism(name: str) -> dict:
         "reference_s_per_design": ref_sec,
         "plan": {"columns": plan.columns, "cells": plan.cells, "bisections": plan.bisections, "levels": plan.levels,
                  "beta": plan.beta, "zlevels": plan.zlevels, "zconfirm": plan.zconfirm, "faces": plan.faces,
+                 "field_levels": plan.field_levels, "gauss_points": plan.gauss_points,
                  "mirror": [mech.task_axes[a] for a in mirror_halves(mech, options, *design_boxes(
                      mech, designs, options, region), plan, column_axis(mech, options))],
                  "column_axis": mech.task_axes[column_axis(mech, options)]},
@@ -326,7 +327,8 @@ def numpy_twin(name, mech, designs, options, packed, tol, edges, region, k: int 
                                         hi[i, order], ndim,
                                         half.columns, half.cells, plan.bisections, plan.levels, tol.volume, tol.gci,
                                         edges, plan.beta, plan.zlevels, plan.zconfirm, plan.faces, ny=half.ny,
-                                        mirror=half.mirror, intervals=intervals(sub_packed[i]))
+                                        mirror=half.mirror, intervals=intervals(sub_packed[i]),
+                                        field_levels=plan.field_levels, gauss_points=plan.gauss_points)
         rows.append((half.whole(row[None, :], TWIN_FIELDS)[0], *rest))
     twin_wall, twin_cpu = time.perf_counter() - t0, time.process_time() - c0
 
@@ -554,6 +556,9 @@ def markdown(data: dict) -> list[str]:
                     f"axis, {pl['cells']} z-cells, {pl['bisections']} bisections, up to {pl['levels']} levels, beta "
                     f"{pl.get('beta', 1.0):g}, up to {pl.get('zlevels', 0)} z-levels (confirmed "
                     f"{pl.get('zconfirm', 1)}x), box-face columns {'on' if pl.get('faces') else 'off'}"
+                    + (f", fields evaluated on levels <= {pl['field_levels']} (deeper columns inherit them)"
+                       if pl.get("field_levels", -1) >= 0 else "")
+                    + (f", {pl['gauss_points']}-point rule" if pl.get("gauss_points", 2) != 2 else "")
                     + (f", the half box of the mirror symmetry in {' and '.join(pl['mirror'])} (half the columns "
                        "there; evaluate.HalfBox)" if pl.get("mirror") else "") + ". "
                     + (f"Measured {m['date']}. " if "date" in m else "")

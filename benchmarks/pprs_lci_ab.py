@@ -1,4 +1,4 @@
-"""pprs-rprs: the 6 x 6 LCI kernel, one-sided Jacobi (A, the code before) against the certified Gram/Laguerre path
+"""pprs-rprs: the 6 x 6 LCI kernel, one-sided Jacobi (A, the code before, kept as the fallback ``_jacobi_6x6``) against the certified Gram/Laguerre path
 with its Jacobi fallback (B, ``pprs_rprs._sv_6x6``), in one process.
 
     NUMBA_NUM_THREADS=1 python benchmarks/pprs_lci_ab.py
@@ -12,7 +12,6 @@ of 7, each pass over the set 10 times) and the ratio A / B.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from pathlib import Path
@@ -27,53 +26,8 @@ from adaptive import design_set  # noqa: E402
 
 from scalesynth.evaluate import make_grid  # noqa: E402
 from scalesynth.kernels import grid as kgrid  # noqa: E402
-from scalesynth.kernels.flags import FASTMATH  # noqa: E402
+from scalesynth.mechanisms.pprs_rprs import _jacobi_6x6 as jacobi_6x6  # noqa: E402
 from scalesynth.mechanisms.pprs_rprs import _sv_6x6  # noqa: E402
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def jacobi_6x6(a):
-    """A: the one-sided Jacobi _sv_6x6 before the Gram path (a copy of the old code)."""
-    n = 6
-    for _sweep in range(40):
-        rotated = False
-        for i in range(n - 1):
-            for j in range(i + 1, n):
-                alpha = 0.0
-                beta = 0.0
-                gamma = 0.0
-                for k in range(n):
-                    alpha += a[k, i] * a[k, i]
-                    beta += a[k, j] * a[k, j]
-                    gamma += a[k, i] * a[k, j]
-                if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
-                    continue
-                rotated = True
-                zeta = (beta - alpha) / (2.0 * gamma)
-                t = 1.0 / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
-                if zeta < 0.0:
-                    t = -t
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = c * t
-                for k in range(n):
-                    ai = a[k, i]
-                    aj = a[k, j]
-                    a[k, i] = c * ai - s * aj
-                    a[k, j] = s * ai + c * aj
-        if not rotated:
-            break
-    smax = 0.0
-    smin = math.inf
-    for j in range(n):
-        norm = 0.0
-        for k in range(n):
-            norm += a[k, j] * a[k, j]
-        norm = math.sqrt(norm)
-        smax = max(smax, norm)
-        smin = min(smin, norm)
-    if not smax > 0.0:
-        return 0.0, 0.0, 0.0
-    return min(smin / smax, 1.0), smin, smax
 
 
 @njit(cache=True)

@@ -200,7 +200,10 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # or 16 columns miss small workspaces (1.52x, 1.16x on seed 1) (benchmarks/pprs_columns.py,
 # benchmarks/notes/pprs_rprs.md)
 INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
-    "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True),
+    # rps-upu-tool: inherited fields (step 3b) on the same plan: 3 132 calls per design against 7 320, 0.43x the time
+    # (plan_search.py --ab), with the same worst errors against N = 192 on seeds 0-4 (volume 0.60 / 0.91x, GCI
+    # 0.50 / 0.46x; before 0.60 / 0.91x, 0.52 / 0.62x); rps-upu's GCI does not allow it (1.19x on seed 1)
+    "rps-upu-tool": ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True, field_levels=0),
     # ups-sspr (Y-columns in closed form, ups_sspr.column_intervals): benchmarks/plan_search.py's 864 plans against
     # N = 192 (columns 4-8, cells 1-4, levels 3, beta 1-3, z-levels, faces), the cheapest within 0.8x of the
     # tolerance on seeds 0, 1, 2: 0.74x (volume) and 0.64x (GCI) at worst, 0.75x on seeds 3, 4; 562 calls per design

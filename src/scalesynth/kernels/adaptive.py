@@ -376,7 +376,8 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
             half = 0.5 * (zb - za)
             zm = 0.5 * (za + zb)
             if gauss == 1:
-                FIELD_KERNEL(p, x, y, zm, q0)  # the 1-point rule, as in _column
+                # the 1-point rule: _column's lines copied, as the 2-point ones below (same reason)
+                FIELD_KERNEL(p, x, y, zm, q0)
                 evals += 1
                 if q0[0] >= 0.0:
                     w = 2.0 * half / hz0
