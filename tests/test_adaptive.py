@@ -47,8 +47,8 @@ def test_column_kernel_equals_numpy_twin(name):
     measures; the other fields' statistics within 1e-12 plus 4x their change when the twin evaluates those fields
     one ulp away from the same points (~1e-16 relative except next to a singular surface). Plans with and without
     z-levels and box-face columns, one with ny = n - 2 (3-D) and mirror planes on every cross axis (with box-face
-    columns, where the mirror matters), one with inherited fields (step 3b: fewer field evaluations than without)
-    and one with the 1-point (midpoint) rule, and with the column intervals both together. The twin evaluates the
+    columns, where the mirror matters), and one with inherited fields (step 3b: fewer field evaluations than
+    without) and the 1-point (midpoint) rule, with and without the column intervals. The twin evaluates the
     fields through the mechanism's kernel (population_points_fields) so that only the algorithm is compared; the
     field kernels themselves are checked against NumPy SVD twins in test_fields.py."""
     mech = get(name)
@@ -63,15 +63,16 @@ def test_column_kernel_equals_numpy_twin(name):
 
     n = 6 if ndim == 3 else 12
     mirror = dict(ny=n - 2, mirror=(True, ndim == 3))
-    inherit = dict(field_levels=0)  # step 3b: refined columns inherit their parent's fields
+    # step 3b: refined columns inherit their parent's fields; the 1-point (midpoint) rule (the ellipsoid test
+    # below compares inheriting with the 2-point rule)
+    inherit = dict(field_levels=0, gauss_points=1)
     plans = [(0, 1.0, 0, 1, False, {}), (2, 1.0, 0, 1, False, {}), (2, 3.0, 0, 1, False, {}),
-             (2, 1.0, 2, 2, True, {}), (2, 1.0, 0, 1, True, mirror), (2, 1.0, 0, 1, True, inherit),
-             (2, 1.0, 0, 1, False, dict(gauss_points=1))]
+             (2, 1.0, 2, 2, True, {}), (2, 1.0, 0, 1, True, mirror), (2, 1.0, 0, 1, True, inherit)]
     if mech.interval_kernel_for(options) is not None:  # the closed-form column intervals (the twin reads the same)
         ivs = dict(interval_kernel=mech.interval_kernel), dict(intervals=_interval_twin(mech.interval_kernel, packed))
         plans += [(2, 1.0, 0, 1, False, ivs), (2, 1.0, 2, 2, True, ivs), (2, 1.0, 1, 1, True, (
             {**ivs[0], **mirror}, {**ivs[1], **mirror})), (2, 1.0, 0, 1, True, (
-            {**ivs[0], **inherit, "gauss_points": 1}, {**ivs[1], **inherit, "gauss_points": 1}))]
+            {**ivs[0], **inherit}, {**ivs[1], **inherit}))]
     for maxlev, beta, zlevels, zconfirm, faces, more in plans:
         kern, twin = more if isinstance(more, tuple) else (more, more)
         opt = dict(zlevels=zlevels, zconfirm=zconfirm, faces=faces)
