@@ -281,12 +281,14 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
         # 2. 2-point Gauss rule on the piece [za, zb]
         half = 0.5 * (zb - za)
         zm = 0.5 * (za + zb)
+        # the first point (the 1-point rule: the piece's midpoint, with its whole length); one call site per point,
+        # since the field kernel is compiled into each
+        z0 = zm if gauss == 1 else _add_product(zm, -half, GAUSS_X)
+        if ndim == 3:
+            FIELD_KERNEL(p, x, y, z0, q0)
+        else:
+            FIELD_KERNEL(p, x, z0, zfix, q0)
         if gauss == 1:
-            # the 1-point rule: the fields at the piece's midpoint, with its whole length
-            if ndim == 3:
-                FIELD_KERNEL(p, x, y, zm, q0)
-            else:
-                FIELD_KERNEL(p, x, zm, zfix, q0)
             evals += 1
             if q0[0] >= 0.0:
                 w = 2.0 * half / hz0
@@ -298,10 +300,8 @@ def _column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, 
                 col_s += w * q0[0]
             continue
         if ndim == 3:
-            FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
             FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
         else:
-            FIELD_KERNEL(p, x, _add_product(zm, -half, GAUSS_X), zfix, q0)
             FIELD_KERNEL(p, x, _add_product(zm, half, GAUSS_X), zfix, q1)
         evals += 2
         ok0 = q0[0] >= 0.0
@@ -375,9 +375,10 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
             # inline helper was byte-identical but made rps_upu_tool's search loop about 10 % slower)
             half = 0.5 * (zb - za)
             zm = 0.5 * (za + zb)
+            # the first point as in _column (one call site per point); the 1-point rule's lines are _column's,
+            # copied as the 2-point ones below (same reason)
+            FIELD_KERNEL(p, x, y, zm if gauss == 1 else _add_product(zm, -half, GAUSS_X), q0)
             if gauss == 1:
-                # the 1-point rule: _column's lines copied, as the 2-point ones below (same reason)
-                FIELD_KERNEL(p, x, y, zm, q0)
                 evals += 1
                 if q0[0] >= 0.0:
                     w = 2.0 * half / hz0
@@ -388,7 +389,6 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
                     col_l += w
                     col_s += w * q0[0]
                 continue
-            FIELD_KERNEL(p, x, y, _add_product(zm, -half, GAUSS_X), q0)
             FIELD_KERNEL(p, x, y, _add_product(zm, half, GAUSS_X), q1)
             evals += 2
             ok0 = q0[0] >= 0.0
@@ -505,11 +505,14 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
             y = _centre(lo_d[1], cj[a], hy, scale)
             # lg, sg hold the parent's L and S at a child's cell (refine_grid) until it is computed
             lpar = lg[ci[a], cj[a]]
-            if inherit and lpar > 0.0 and not own[a]:
-                # step 3b: the measure alone; the fields' statistics are the parent's per unit measure
-                FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
-                             0)
-                evals += out[3]
+            # step 3b: the measure alone where the column inherits its parent's fields (one call site: the column
+            # and the field kernel in it are compiled into each)
+            inh = inherit and lpar > 0.0 and not own[a]
+            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
+                         0 if inh else gauss_points)
+            evals += out[3]
+            if inh:
+                # the fields' statistics are the parent's per unit measure
                 lc = out[0]
                 if lc > 0.0:
                     r = lc / (lpar * nk)
@@ -528,9 +531,6 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                 sg[ci[a], cj[a]] = lc * (sg[ci[a], cj[a]] / lpar)
                 lg[ci[a], cj[a]] = lc
                 continue
-            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
-                         gauss_points)
-            evals += out[3]
             init_row(colrow, n_fields)
             accumulate_cells(colrow, buf, wbuf, int(out[2]), edges)
             for c in range(ncol):
