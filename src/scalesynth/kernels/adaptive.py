@@ -334,8 +334,9 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
     """Template (serial), ``_column``'s variant with an interval kernel (step 1 in closed form; 3-D only): the
     reachable intervals of the column over [zlo, zlo + mz hz] from INTERVAL_KERNEL, then each z-cell's intersection
     with each interval (a piece; none, one or several per cell, a piece of zero length dropped) integrated as in
-    ``_column`` (step 2). Evaluations: 1 for the interval call, 2 per piece. Where the interval kernel returns -1
-    (planar tasks: always) the column is NODE_COLUMN's, plus the 1 call. ``nodes`` has >= 2 MAX_INTERVALS slots:
+    ``_column`` (step 2). Evaluations: 1 for the interval call, ``gauss`` per piece (0: the measure alone). Where
+    the interval kernel returns -1 (planar tasks: always) the column is NODE_COLUMN's, plus the 1 call. ``nodes`` has
+    >= 2 MAX_INTERVALS slots:
     its head holds the intervals. buf, wbuf hold >= 2 (mz + MAX_INTERVALS) points (a cell split by gaps between
     intervals has one piece more per gap)."""
     if ndim != 3:
