@@ -16,11 +16,5 @@ if [ ! -f "$STAMP" ] || [ "$ROOT/pyproject.toml" -nt "$STAMP" ]; then
   touch "$STAMP"
 fi
 export PATH="$VENV/bin:$PATH"
-# Numba's cache keys an entry by its own file only: a change to a helper inlined from another file would leave a
-# stale compiled kernel (false passes, or results of old code). scripts/test and scripts/run use a cache directory
-# per state of src/ (older ones are pruned).
-SRC_HASH="$(cd "$ROOT" && find src -name '*.py' -type f -print0 | LC_ALL=C sort -z | xargs -0 sha256sum | sha256sum | cut -c1-16)"
-CACHE_ROOT="$ROOT/.numba-cache"
-mkdir -p "$CACHE_ROOT/$SRC_HASH"
-find "$CACHE_ROOT" -mindepth 1 -maxdepth 1 -type d ! -name "$SRC_HASH" -exec rm -rf {} +
-export NUMBA_CACHE_DIR="$CACHE_ROOT/$SRC_HASH"
+# scripts/test and scripts/run use a Numba cache directory per state of src/ (scripts/_numba_cache.sh)
+source "$ROOT/scripts/_numba_cache.sh" "$ROOT/.numba-cache"
