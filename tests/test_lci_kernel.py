@@ -67,6 +67,12 @@ def test_lci_only_statistics_equal_the_full_ones(name):
     a = adaptive_population_stats(mech, designs, options, packed, Tolerance(), EDGES)
     b = adaptive_population_stats(mech, designs, options, packed, Tolerance(), EDGES, lci_only=True)
     assert a.stats[:, lci_cols].tobytes() == b.stats[:, lci_cols].tobytes(), name
+    # every other field's sums are the full evaluation's (a field the LCI kernel computes too: ups-sspr's sigmas) or
+    # exactly 0 (one it does not write: the buffers start at 0; they once summed whatever the allocation held, which
+    # overflowed to inf in a search of rps-upu)
+    others = [kgrid.field_column(f, s) for f in range(1, mech.n_fields) for s in (kgrid.STAT_SUM, kgrid.STAT_SUMSQ)]
+    for lci, every in ((part, full), (b.stats, a.stats)):
+        assert np.all((lci[:, others] == every[:, others]) | (lci[:, others] == 0.0)), name
     for attr in ("error_volume", "error_gci", "levels", "evaluations"):
         assert getattr(a, attr).tobytes() == getattr(b, attr).tobytes(), (name, attr)
 

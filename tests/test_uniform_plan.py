@@ -33,6 +33,11 @@ def test_a_tolerance_picks_the_coarsest_step_at_least_as_tight():
     assert plan.resolution_for(Tolerance(0.001, 5e-4)) is None  # tighter than every step: adaptive
     mech = get("2pauu-ppap")
     assert uniform_resolution(mech, Tolerance()) == 72  # the default tolerance (0.2 %, 5e-4)
+    # the calibrated steps (evaluate.UNIFORM_PLAN_OF's comment: benchmarks/uniform_ladder.py on two design sets)
+    assert uniform_resolution(mech, Tolerance(0.001, 2.5e-4)) == 112
+    assert uniform_resolution(mech, Tolerance(0.001, 5e-4)) == 112  # the 0.2 % step is too loose in volume
+    assert uniform_resolution(mech, Tolerance(0.0005, 1e-4)) == 144
+    assert uniform_resolution(mech, Tolerance(0.0002, 5e-4)) is None  # tighter than every step: adaptive
     assert uniform_resolution(get("rps-upu"), Tolerance(0.03, 5e-3)) is None  # no calibrated plan
 
 
@@ -68,7 +73,7 @@ def test_values_are_the_calibrated_grids_and_estimates_the_change_to_twice_as_fi
 def test_a_tighter_tolerance_than_every_step_runs_the_adaptive_evaluator():
     cfg, designs = _designs(3)
     mech, options = cfg.mech, cfg.resolved_options()
-    tol = Tolerance(0.001, 5e-4)
+    tol = Tolerance(0.0002, 5e-4)  # tighter in volume than the tightest calibrated step (0.05 %)
     out = evaluate_population(mech, designs, options, band_edges=EDGES, tolerance=tol)
     packed = np.stack([mech.pack(mech.resolve_design(d), options) for d in designs])
     ad = adaptive_population_stats(mech, [mech.resolve_design(d) for d in designs], options, packed, tol,

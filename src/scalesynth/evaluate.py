@@ -185,10 +185,13 @@ ADAPTIVE_PLAN_OF: dict[str, ColumnPlan] = {
 # tolerance on all three at 7 320 calls per design, against its node plan's 19 512 (with intervals) or 61 150 (without);
 # 8 columns or 12 z-cells miss (8.5x the volume tolerance on a seed-0 design; 1.65x in GCI), and 8 z-cells with no
 # z-levels are 12x off in GCI (the fields' Gauss rule needs the 16)
-# rps-upu (P-model; its columns run along z, Mechanism.column_axis): (8, 8, 5, 2, beta 1, 3 z-levels confirmed once)
-# is within 0.58x of the tolerance against N = 192 on seeds 0, 1, 2 at 7 186 calls per design (seed 0), against
-# the psi-column node plan's 23 958; without z-levels the fields' Gauss rule along z misses the GCI (16-48 fixed
-# z-cells: 1.1-4.4x; the LCI varies along z more than the 8 coarse cells resolve on some designs)
+# rps-upu (P-model; its columns run along z, Mechanism.column_axis): (8, 6, 5, 2, beta 3, 2 z-levels confirmed once)
+# is within 0.77x of the tolerance against N = 192 on seeds 0-3 and N = 384 on seed 4 (N = 192 is off there) at
+# 2 988 calls per design (seed 0), 0.44x the time of (8, 8, 5, 2, beta 1, 3 z-levels), which was within 0.58x at
+# 7 186 calls: its 200 x 200 loop had reached 30 s, the goal. The psi-column node plan took 23 958. Without z-levels
+# the fields' Gauss rule along z misses the GCI (16-48 fixed z-cells: 1.1-4.4x; the LCI varies along z more than
+# the coarse cells resolve on some designs); more z-levels are not safer here (3 instead of 2: 2.02x in GCI on seed
+# 0 against N = 384), so only the searched plan is trusted (benchmarks/notes/adaptive_plans.md)
 # pprs-rprs: its workspaces are thin slabs (median 27-28 mm of a 215-256 mm box) whose columns hold one interval,
 # so 1 z-cell and the midpoint rule serve the fields; its refinement is driven by walls (vertical planes of the
 # rail and link limits), where the measure jumps but the LCI does not, so the refined columns inherit their fields
@@ -209,7 +212,7 @@ INTERVAL_PLAN_OF: dict[str, ColumnPlan] = {
     # tolerance on seeds 0, 1, 2: 0.74x (volume) and 0.64x (GCI) at worst, 0.75x on seeds 3, 4; 562 calls per design
     # (LCI kernel) against the node plan's 2534 (with the same columns, 4 z-cells and every call a node or bisection)
     "ups-sspr": ColumnPlan(6, 2, 8, 3, beta=2.0, faces=True),
-    "rps-upu": ColumnPlan(8, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=1),
+    "rps-upu": ColumnPlan(8, 6, 5, 2, beta=3.0, zlevels=2, zconfirm=1),
     "pprs-rprs": ColumnPlan(24, 1, 5, 3, beta=4.0, field_levels=0, gauss_points=1),
 }
 
@@ -243,9 +246,14 @@ class UniformPlan:
 # Ladders on the config's bounds (paper_2pauu_ppap.yaml; quick.yaml has the same), worst volume / GCI error as
 # multiples of the tolerance on seed 0 | seed 1 (benchmarks/notes/uniform_plans.md): N = 72 at (0.2 %, 5e-4): 0.41,
 # 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 | 1.06, 1.04; N = 64: 1.04 on seed 0); N = 32 at (1 %, 2.5e-3): 0.68, 0.32 |
-# 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57, 0.46 | 0.50, 0.74 (N = 20: 0.85, 0.88 on seed 0)
+# 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57, 0.46 | 0.50, 0.74 (N = 20: 0.85, 0.88 on seed 0). Tighter steps, against
+# N = 448 (`uniform_ladder.py 2pauu-ppap SEED ... --ref 448`): N = 112 at (0.1 %, 2.5e-4): 0.53, 0.60 | 0.58, 0.76
+# (N = 96: 0.88x in GCI on seed 1); N = 144 at (0.05 %, 1e-4): 0.28, 0.59 | 0.60, 0.72 (N = 128: 0.93x on seed 1).
+# Without them such a tolerance ran the adaptive evaluator: 0.12 s per design at (0.05 %, 1e-4), where N = 144
+# takes about 4 ms
 UNIFORM_PLAN_OF: dict[str, UniformPlan] = {
-    "2pauu-ppap": UniformPlan(((0.002, 5.0e-4, 72), (0.01, 2.5e-3, 32), (0.03, 5.0e-3, 24))),
+    "2pauu-ppap": UniformPlan(((0.0005, 1.0e-4, 144), (0.001, 2.5e-4, 112), (0.002, 5.0e-4, 72), (0.01, 2.5e-3, 32),
+                               (0.03, 5.0e-3, 24))),
 }
 
 

@@ -61,6 +61,9 @@ hx = box / nx, hy = box / ny. So the half box [0, hi] of a box symmetric about 0
 columns on that axis and its lo face a mirror plane, evaluates the same columns as the full box's upper half and
 makes the same refinement decisions there (up to rounding): its extensive statistics are half the full box's.
 Parallel over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
+The columns' L and S live in a sparse cell store (initial_cells, refine_cells: each column with its neighbours'
+cells), not in a dense grid of the finest level, whose copies and sums cost more than the refined columns at level
+3 (tests/test_adaptive_store.py compares the two; benchmarks/adaptive_store_ab.py the evaluator before and after).
 """
 
 from __future__ import annotations
@@ -131,49 +134,37 @@ def add_row(acc, row, n_fields):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def level_sums(lg, sg, area):
-    """(measure, LCI sum) of a level's piecewise-constant column grids, in coarse-cell units."""
-    v = 0.0
-    s = 0.0
-    for i in range(lg.shape[0]):
-        for j in range(lg.shape[1]):
-            v += lg[i, j]
-            s += sg[i, j]
-    return v * area, s * area
+def _neighbour_values(gv, nb, a, axis, c):
+    """(below, above) of active column a's value ``c`` along a cross axis: its neighbours' values in ``gv``, the
+    column itself (clamped) at the box (``nb`` -1)."""
+    lo_ref = nb[a, 2 * axis]
+    hi_ref = nb[a, 2 * axis + 1]
+    return (c if lo_ref < 0 else gv[lo_ref]), (c if hi_ref < 0 else gv[hi_ref])
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces, mirror_x, mirror_y, fxg, fyg,
-                 flags):
-    """flags[a] = whether active column a (cell ci[a], cj[a]) is refined: a second difference of the column
-    measure (or LCI sum) along a cross axis, x area / 24, above its budget (neighbours clamped at the box; with
-    ``faces`` the face ghosts instead, except on a lo face that is a mirror plane: ``mirror_x``, ``mirror_y``)."""
-    nl = lg.shape[0]
-    nyl = lg.shape[1]
+def flag_columns(gl, gs, gi, nb, ci, cj, n_active, ndim, area, budget_v, budget_g, faces, mirror_x, mirror_y, fxg,
+                 fyg, flags):
+    """flags[a] = whether active column a (cell ci[a], cj[a]; its values gl[gi[a]], gs[gi[a]]; its neighbours
+    nb[a]) is refined: a second difference of the column measure (or LCI sum) along a cross axis, x area / 24,
+    above its budget (neighbours clamped at the box; with ``faces`` the face ghosts instead, except on a lo face
+    that is a mirror plane: ``mirror_x``, ``mirror_y``)."""
     for a in range(n_active):
-        i = ci[a]
-        j = cj[a]
         f = False
         for axis in range(ndim - 1):
-            if axis == 0:
-                i0, j0, i1, j1 = max(i - 1, 0), j, min(i + 1, nl - 1), j
-            else:
-                i0, j0, i1, j1 = i, max(j - 1, 0), i, min(j + 1, nyl - 1)
             for t in range(2):
-                g = lg if t == 0 else sg
-                c = g[i, j]
-                below = g[i0, j0]
-                above = g[i1, j1]
+                g = gl if t == 0 else gs
+                c = g[gi[a]]
+                below, above = _neighbour_values(g, nb, a, axis, c)
                 if faces:
                     # at the box, the neighbour is the ghost 2 F - c, F the face column's value (linear
                     # extrapolation through the face): a wall between the edge column and the face shows
-                    idx = i if axis == 0 else j
-                    other = j if axis == 0 else i
+                    other = cj[a] if axis == 0 else ci[a]
                     fg = fxg if axis == 0 else fyg
                     # a mirror plane keeps the clamped neighbour: the edge column's mirror image is itself
-                    if idx == 0 and not (mirror_x if axis == 0 else mirror_y):
+                    if nb[a, 2 * axis] < 0 and not (mirror_x if axis == 0 else mirror_y):
                         below = 2.0 * fg[0, t, other] - c
-                    if idx == (nl - 1 if axis == 0 else nyl - 1):
+                    if nb[a, 2 * axis + 1] < 0:
                         above = 2.0 * fg[1, t, other] - c
                 d2 = abs(above + below - 2.0 * c)
                 if d2 * area / 24.0 > (budget_v if t == 0 else budget_g):
@@ -182,31 +173,137 @@ def flag_columns(lg, sg, ci, cj, n_active, ndim, area, budget_v, budget_g, faces
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def field_flags(lg, sg, ci, cj, n_active, ndim, area, budget_g, fflags):
+def field_flags(gl, gs, gi, nb, n_active, ndim, area, budget_g, fflags):
     """fflags[a] = whether active column a's children evaluate their own fields (step 3b): its column has no
     measure, or the second difference of the mean LCI S / L along a cross axis (a neighbour without measure
     replaced by the column itself), x L x area / 24, exceeds the GCI budget (flag_columns' for S)."""
-    nl = lg.shape[0]
-    nyl = lg.shape[1]
     for a in range(n_active):
-        i = ci[a]
-        j = cj[a]
-        lc = lg[i, j]
+        lc = gl[gi[a]]
         if not lc > 0.0:
             fflags[a] = True
             continue
-        mc = sg[i, j] / lc
+        mc = gs[gi[a]] / lc
         f = False
         for axis in range(ndim - 1):
-            if axis == 0:
-                i0, j0, i1, j1 = max(i - 1, 0), j, min(i + 1, nl - 1), j
-            else:
-                i0, j0, i1, j1 = i, max(j - 1, 0), i, min(j + 1, nyl - 1)
-            below = sg[i0, j0] / lg[i0, j0] if lg[i0, j0] > 0.0 else mc
-            above = sg[i1, j1] / lg[i1, j1] if lg[i1, j1] > 0.0 else mc
+            r0 = nb[a, 2 * axis]
+            r1 = nb[a, 2 * axis + 1]
+            below = gs[r0] / gl[r0] if r0 >= 0 and gl[r0] > 0.0 else mc
+            above = gs[r1] / gl[r1] if r1 >= 0 and gl[r1] > 0.0 else mc
             if abs(above + below - 2.0 * mc) * lc * area / 24.0 > budget_g:
                 f = True
         fflags[a] = f
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def leaf_sums(gl, gs, gchild, seg, level, ndim):
+    """(measure, LCI sum) in coarse-cell units of the cell store's leaves (gchild -1) up to ``level``: a leaf of
+    level l, cells seg[l]:seg[l + 1], weighs its cell's area, 1 / 9^l (planar 1 / 3^l). A sum of non-negative
+    terms: exactly 0 where nothing is reachable."""
+    vol = 0.0
+    ssum = 0.0
+    scale = 1.0
+    for lev in range(level + 1):
+        area = 1.0 / (scale * scale) if ndim == 3 else 1.0 / scale
+        v = 0.0
+        s = 0.0
+        for c in range(seg[lev], seg[lev + 1]):
+            if gchild[c] < 0:
+                v += gl[c]
+                s += gs[c]
+        vol += v * area
+        ssum += s * area
+        scale *= 3.0
+    return vol, ssum
+
+
+@njit(cache=True)
+def _grow(g, n):
+    """``g`` (1-D) with ``n`` more slots at its end (uninitialised)."""
+    out = np.empty(g.shape[0] + n, dtype=g.dtype)
+    out[: g.shape[0]] = g
+    return out
+
+
+@njit(cache=True)
+def initial_cells(nx, ny, ndim):
+    """The cell store of level 0's nx x ny columns (planar: ny 1), cell a = i ny + j: (gl, gs, gchild, gi, nb) as
+    refine_cells returns them, values 0."""
+    n = nx * ny
+    gl = np.zeros(n)
+    gs = np.zeros(n)
+    gchild = np.full(n, -1, dtype=np.int64)
+    gi = np.arange(n)
+    nb = np.full((n, 4), -1, dtype=np.int64)
+    for a in range(n):
+        i = a // ny
+        j = a - i * ny
+        if i > 0:
+            nb[a, 0] = a - ny
+        if i < nx - 1:
+            nb[a, 1] = a + ny
+        if ndim == 3 and j > 0:
+            nb[a, 2] = a - 1
+        if ndim == 3 and j < ny - 1:
+            nb[a, 3] = a + 1
+    return gl, gs, gchild, gi, nb
+
+
+@njit(cache=True)
+def refine_cells(gl, gs, gchild, gi, nb, flags, n_active, ndim):
+    """The children of the flagged active columns, in (parent, a, b) order (3 x 3; planar: 3 along axis 0): the
+    cell store (gl, gs, gchild) grown by their slots, each child's L and S its parent's until computed, each
+    flagged parent's gchild its first child; the children's global indices and neighbours (-x, +x, -y, +y: a
+    sibling, the child of a refined neighbour across the border, or an unrefined neighbour itself, which keeps
+    its value over the finer cells it covers; -1 at the box). Returns (gl, gs, gchild, gi, nb)."""
+    ry = 3 if ndim == 3 else 1
+    nk = 3 * ry
+    n_flag = 0
+    for a in range(n_active):
+        if flags[a]:
+            n_flag += 1
+    base = gl.shape[0]
+    gl = _grow(gl, n_flag * nk)
+    gs = _grow(gs, n_flag * nk)
+    gchild = _grow(gchild, n_flag * nk)
+    k = 0
+    for a in range(n_active):
+        if flags[a]:
+            gchild[gi[a]] = base + k * nk
+            k += 1
+    cgi = np.empty(n_flag * nk, dtype=np.int64)
+    cnb = np.empty((n_flag * nk, 4), dtype=np.int64)
+    t = 0
+    for a in range(n_active):
+        if not flags[a]:
+            continue
+        p = gi[a]
+        first = gchild[p]
+        for da in range(3):
+            for db in range(ry):
+                g = first + da * ry + db
+                gl[g] = gl[p]
+                gs[g] = gs[p]
+                gchild[g] = -1
+                cgi[t] = g
+                for side in range(4):
+                    axis = side // 2
+                    step = -1 if side % 2 == 0 else 1
+                    d = da if axis == 0 else db
+                    if axis == 1 and ndim == 2:
+                        cnb[t, side] = -1  # planar: no second cross axis
+                    elif 0 <= d + step <= 2:  # a sibling
+                        cnb[t, side] = g + (step * ry if axis == 0 else step)
+                    else:
+                        nbr = nb[a, side]
+                        if nbr < 0:
+                            cnb[t, side] = -1
+                        elif gchild[nbr] >= 0:  # the neighbour was refined too: its child across the border
+                            e = 2 if step < 0 else 0
+                            cnb[t, side] = gchild[nbr] + (e * ry + db if axis == 0 else da * ry + e)
+                        else:
+                            cnb[t, side] = nbr
+                t += 1
+    return gl, gs, gchild, cgi, cnb
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -217,17 +314,6 @@ def refine_faces(fg, r):
         for t in range(2):
             for i in range(out.shape[2]):
                 out[s, t, i] = fg[s, t, i // r]
-    return out
-
-
-@njit(cache=True, fastmath=FASTMATH)
-def refine_grid(g, ndim):
-    """A level's column grid at the next level: every value repeated over its 3 x 3 (planar: 3) children."""
-    ry = 3 if ndim == 3 else 1
-    out = np.empty((g.shape[0] * 3, g.shape[1] * ry))
-    for i in range(out.shape[0]):
-        for j in range(out.shape[1]):
-            out[i, j] = g[i // 3, j // ry]
     return out
 
 
@@ -439,14 +525,16 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
     mmax = m
     for _ in range(zlevels):
         mmax *= 2
-    cell = np.empty(n_fields)
+    # zeros, not empty: an LCI kernel (lci_only) writes slot 0 alone, so the other fields' statistics sum these
+    # zeros instead of whatever the allocation held (garbage could overflow, and differ between runs)
+    cell = np.zeros(n_fields)
     # slot 0 (reachability) of each node; the interval variant (_column_intervals) keeps its intervals there
     nodes = np.empty(max(mmax + 1, 2 * MAX_INTERVALS))
     # the Gauss points of one column: 2 per piece, a piece per z-cell plus one per gap between intervals
     buf = np.empty((n_fields, 2 * (mmax + MAX_INTERVALS)))
     wbuf = np.empty(2 * (mmax + MAX_INTERVALS))
-    q0 = np.empty(n_fields)
-    q1 = np.empty(n_fields)
+    q0 = np.zeros(n_fields)
+    q1 = np.zeros(n_fields)
     colrow = np.empty(ncol)
     out = np.empty(4)
     evals = 0.0
@@ -465,8 +553,13 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
     own = np.ones(n_active, dtype=np.bool_)
     prev_rows = np.empty((0, ncol))
     nk = 9 if ndim == 3 else 3
-    lg = np.zeros((nx, ny))
-    sg = np.zeros((nx, ny))
+    # the cell store: every column ever active, level 0's first (a = i ny + j), then each level's children: its
+    # measure gl and LCI sum gs (a child holds its parent's until computed), gchild its first child (-1: a leaf);
+    # gi[a]: active column a's cell; nb[a]: its neighbours' cells (-x, +x, -y, +y; -1 at the box), a coarser leaf
+    # where the neighbouring region was not refined (it keeps its value over the finer cells it covers). Sparse:
+    # a dense grid at the finest level (648^2 cells at level 3 of 24^2) costs more than the columns refined.
+    gl, gs, gchild, gi, nb = initial_cells(nx, ny, ndim)
+    seg = np.zeros(maxlev + 2, dtype=np.int64)  # seg[l]: the store's first cell of level l (levels in order)
     # box-face columns (step 3): measure and LCI sum of the column on the face x = lo, x = hi (per j), y = lo,
     # y = hi (per i) next to each edge column, [side, L or S, index]
     fxg = np.zeros((2, 2, ny))
@@ -491,8 +584,8 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
         rows = np.empty((n_active, ncol))
         for a in range(n_active):
             if src[a] >= 0:
-                # the centre child is its parent's column (same x, y and z-cells): its L and S are already in lg,
-                # sg (refine_grid), its row is the parent's with 1/nk of the weight (min and max unchanged)
+                # the centre child is its parent's column (same x, y and z-cells): its L and S are already in its
+                # cell (refine_cells), its row is the parent's with 1/nk of the weight (min and max unchanged)
                 for c in range(ncol):
                     rows[a, c] = prev_rows[src[a], c]
                 rows[a, 0] /= nk
@@ -504,8 +597,9 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                 continue
             x = _centre(lo_d[0], ci[a], hx, scale)
             y = _centre(lo_d[1], cj[a], hy, scale)
-            # lg, sg hold the parent's L and S at a child's cell (refine_grid) until it is computed
-            lpar = lg[ci[a], cj[a]]
+            # a child's cell holds its parent's L and S (refine_cells) until it is computed
+            g = gi[a]
+            lpar = gl[g]
             # step 3b: the measure alone where the column inherits its parent's fields (one call site: the column
             # and the field kernel in it are compiled into each)
             inh = inherit and lpar > 0.0 and not own[a]
@@ -529,16 +623,17 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                     init_row(colrow, n_fields)
                     for c in range(ncol):
                         rows[a, c] = colrow[c]
-                sg[ci[a], cj[a]] = lc * (sg[ci[a], cj[a]] / lpar)
-                lg[ci[a], cj[a]] = lc
+                gs[g] = lc * (gs[g] / lpar)
+                gl[g] = lc
                 continue
             init_row(colrow, n_fields)
             accumulate_cells(colrow, buf, wbuf, int(out[2]), edges)
             for c in range(ncol):
                 rows[a, c] = colrow[c]
-            lg[ci[a], cj[a]] = out[0]
-            sg[ci[a], cj[a]] = out[1]
-        vol, ssum = level_sums(lg, sg, area)
+            gl[g] = out[0]
+            gs[g] = out[1]
+        seg[level + 1] = gl.shape[0]
+        vol, ssum = leaf_sums(gl, gs, gchild, seg, level, ndim)
         gci = ssum / vol if vol > 0.0 else 0.0
         if level == 0 and zl > 0:
             zerr_v = abs(vol - prev_v) / vol if vol > 0.0 else (0.0 if prev_v == 0.0 else 1.0)
@@ -566,15 +661,11 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
         fflags = np.ones(n_active, dtype=np.bool_)
         if not stop:
             if faces:
-                nl = lg.shape[0]
-                nyl = lg.shape[1]
                 for a in range(n_active):
                     for axis in range(ndim - 1):
-                        idx = ci[a] if axis == 0 else cj[a]
-                        edge = nl - 1 if axis == 0 else nyl - 1
                         for side in range(2):
-                            if idx != (0 if side == 0 else edge):
-                                continue
+                            if nb[a, 2 * axis + side] >= 0:
+                                continue  # not at the box
                             if side == 0 and (mirror_x if axis == 0 else mirror_y):
                                 continue  # a mirror plane: the clamped neighbour, no ghost (flag_columns)
                             x = _centre(lo_d[0], ci[a], hx, scale)
@@ -586,12 +677,12 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                                 y = _add_product(lo_d[1], fpos, hy)
                             # with inherited fields the face column's LCI sum is its measure times the edge
                             # column's mean LCI (unless the edge column has none)
-                            ledge = lg[ci[a], cj[a]]
+                            ledge = gl[gi[a]]
                             fon = not (inherit and ledge > 0.0)
                             FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1,
                                          buf, wbuf, out, gauss_points if fon else 0)
                             evals += out[3]
-                            fs = out[1] if fon else out[0] * (sg[ci[a], cj[a]] / ledge)
+                            fs = out[1] if fon else out[0] * (gs[gi[a]] / ledge)
                             if axis == 0:
                                 fxg[side, 0, cj[a]] = out[0]
                                 fxg[side, 1, cj[a]] = fs
@@ -599,10 +690,10 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                                 fyg[side, 0, ci[a]] = out[0]
                                 fyg[side, 1, ci[a]] = fs
             ncell0 = nx * ny
-            flag_columns(lg, sg, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
+            flag_columns(gl, gs, gi, nb, ci, cj, n_active, ndim, area, tol_v * vol * beta / ncell0,
                          tol_g * vol * beta / ncell0, faces, mirror_x, mirror_y, fxg, fyg, flags)
             if field_levels >= 0 and level >= field_levels:
-                field_flags(lg, sg, ci, cj, n_active, ndim, area, tol_g * vol * beta / ncell0, fflags)
+                field_flags(gl, gs, gi, nb, n_active, ndim, area, tol_g * vol * beta / ncell0, fflags)
         n_flag = 0
         for a in range(n_active):
             if flags[a]:
@@ -634,9 +725,8 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
         par = npar
         own = nown
         prev_rows = rows
+        gl, gs, gchild, gi, nb = refine_cells(gl, gs, gchild, gi, nb, flags, n_active, ndim)
         n_active = t
-        lg = refine_grid(lg, ndim)
-        sg = refine_grid(sg, ndim)
         fxg = refine_faces(fxg, 3 if ndim == 3 else 1)
         fyg = refine_faces(fyg, 3)
         level += 1

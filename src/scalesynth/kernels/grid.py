@@ -301,7 +301,7 @@ def _population_stats(params, lo, step, shape, edges):
         row = partial[task]
         init_row(row, n_fields)
         vals = np.empty((n_fields, nz))
-        cell = np.empty(n_fields)
+        cell = np.zeros(n_fields)  # an LCI kernel writes slot 0 alone: the other fields stay 0, not garbage
         buf = np.empty((n_fields, ny * nz))
         wbuf = np.empty(ny * nz)
         m = 0
@@ -323,7 +323,7 @@ def _sample_fields(p, lo, step, shape):
     out = np.empty((nx, ny, nz, n_fields))
     for i in prange(nx):
         x = lo[0] + (i + 0.5) * step[0]
-        cell = np.empty(n_fields)
+        cell = np.zeros(n_fields)
         for j in range(ny):
             y = lo[1] + (j + 0.5) * step[1]
             for k in range(nz):
@@ -340,7 +340,7 @@ def _population_points_fields(params, pts):
     out = np.empty((n_designs, n, n_fields))
     for d in prange(n_designs):
         p = params[d]
-        cell = np.empty(n_fields)
+        cell = np.zeros(n_fields)
         for i in range(n):
             FIELD_KERNEL(p, pts[i, 0], pts[i, 1], pts[i, 2], cell)
             out[d, i, :] = cell

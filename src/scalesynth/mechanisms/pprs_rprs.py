@@ -362,7 +362,12 @@ def _force_flex(p, ll, lx, ly, lz, s, ax, ay, az, fax, fay, faz, fbx, fby, fbz, 
     return link + col + springs
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+# not inlined into _stiffness (Numba's inline="always" would type and lower its body, with 6 tip_bilinear, three
+# times): _stiffness's own compile 7.6 s -> 2.6 s with this function, and `scalesynth evaluate
+# configs/pprs_rprs.yaml`'s first-process compile 40.4 -> 30.0 s with the other changes of 2026-12-02 afternoon
+# (`python benchmarks/bench.py compile_commands`), at the same evaluation time; the stiffness statistics move by up
+# to 1.5e-9 relative (rounding near singular poses), the kinematic fields not at all
+@njit(cache=True, fastmath=FASTMATH)
 def _chain_columns(p, kk, ox, oy, oz, cx, cy, cz, bx, by, bz, dx, dy, dz, ax, ay, az, s, nx, ny, nz, hax, hay, haz,
                    hbx, hby, hbz, hk):
     """kk + the two wrench columns of one chain (column B -> D along a = (ax, ay, az), length s; link D -> C; revolute
@@ -667,8 +672,9 @@ def column_intervals(p, x, y, zlo, zhi, out):
     constant along it, s1 and s2 are z plus constants, h3 = z_C3 is z plus a constant, beta = atan2(h3, rho3) and
     s3 = sqrt(rho3^2 + h3^2) - sigma3 kappa3. Every reachability check can change only at the heights where s1, s2
     or s3 meets a stroke limit, beta a beta limit, or h3 = 0 (atan2's branch cut and mu3 = 0): those candidates cut
-    the column into pieces on which each check is constant, so each piece is classified by point_reach at its
-    midpoint and neighbouring reachable pieces are merged."""
+    the column into pieces on which each check is constant, so each piece is classified at its midpoint with
+    point_reach's checks (in its arithmetic; those that do not depend on z once per column) and neighbouring
+    reachable pieces are merged."""
     if p[_FREE_ONLY] > 0.0:
         return -1
     if not zlo <= zhi:  # also NaN
@@ -713,18 +719,38 @@ def column_intervals(p, x, y, zlo, zhi, out):
     cuts[n] = zhi
     n += 1
     sort_span(cuts, 1, n - 1)  # the candidates between zlo and zhi
-    q = np.empty(1)
+    # each piece is classified at its midpoint with point_reach's checks (_fields up to its reach verdict), in its
+    # arithmetic, so the same verdicts (tests/test_pprs_intervals.py compares them point by point): those that do
+    # not depend on z once for the column (the rails, and kappa_i real), the others per piece (the strokes s1, s2,
+    # s3 and beta). A point_reach call per piece repeated the column's checks: 0.342 against 0.185 us per column
+    # in one A/B (benchmarks/notes/pprs_rprs.md; `python benchmarks/pprs_columns.py ab` times this kernel)
+    c1x = x + p[_R1]
+    w1 = p[_RAIL] - c1x if p[_CONV] > 0.0 else c1x
+    p2 = -0.5 * c2x + SQRT3_2 * c2y
+    w2 = p[_RAIL] - p2 if p[_CONV] > 0.0 else p2
+    if (w1 < p[_WLO] or w1 > p[_WHI] or w2 < p[_WLO] or w2 > p[_WHI]
+            or not (k1 >= 0.0 and k2 >= 0.0 and k3 >= 0.0)):  # NaN: the link cannot reach
+        return 0
     k = 0
     for i in range(n - 1):
         a = cuts[i]
         b = cuts[i + 1]
         if not b > a:
             continue  # a piece of zero length: neither extends nor ends an interval
-        _fields(p, x, y, 0.5 * (a + b), q, False, False)
-        if q[0] >= 0.0:
-            k = add_piece(out, k, a, b)
-            if k < 0:
-                return -1
+        z = 0.5 * (a + b)
+        s1 = (z + p[_R1 + 2]) - p[_SG1] * k1
+        s2 = (z + p[_R2 + 2]) - p[_SG2] * k2
+        h3 = z + r3z
+        mu3sq = rho * rho + h3 * h3
+        if s1 < slo or s1 > shi or s2 < slo or s2 > shi or not mu3sq > 0.0:
+            continue
+        beta = math.atan2(h3, rho)
+        s3 = math.sqrt(mu3sq) - p[_SG3] * k3
+        if beta < p[_BLO] or beta > p[_BHI] or s3 < slo or s3 > shi:
+            continue
+        k = add_piece(out, k, a, b)
+        if k < 0:
+            return -1
     return k
 
 
