@@ -74,6 +74,22 @@ N_CROSS = 2400  # columns per cross axis of the exact-volume check (mechanisms w
 # rule along z remain (pprs-rprs: within 0.07x the GCI tolerance of 216 x 216 columns on five sets of 20 designs,
 # where the uniform N = 192 is up to 0.35x off it; benchmarks/notes/pprs_rprs.md)
 COLUMN_GCI_PLAN = ColumnPlan(324, 4, 5, 0, faces=True)
+# the mechanisms where that GCI reference was checked (4 z-cells without z-levels resolve the LCI along z only in
+# thin slabs: for rps-upu, which needs z-levels, it is 6e-3 off the uniform N = 96, itself within 1.7e-4 of N = 192
+# on the same design); elsewhere the designs
+# outside the tolerance are judged, in GCI, against the uniform grid 2x finer than the reference
+COLUMN_GCI_MECHANISMS = ("pprs-rprs",)
+# why a mechanism's 10x at equal accuracy is not met, printed under RESULTS.md's issue-15 summary when it is not
+EQUAL_ACCURACY_NOTES = {
+    "2pauu-ppap": "its uniform grid is the fast path (closed-form column intervals, quarter box, vectorised cells: "
+                  "22 672 cells per design at N = 56), so 10x leaves about 2 267 points per design. The adaptive "
+                  "evaluator makes more calls than that (the adaptive section), each dearer than a fast-path "
+                  "cell. Piecewise Gauss rules with every breakpoint of the workspace in closed form get the "
+                  "volume within budget, but the GCI is 20x the tolerance at "
+                  "5 235 points and needs about 60 000: the LCI has V-shaped zeros and layers inside the lobes "
+                  "(`python benchmarks/pauu_quadrature.py`, benchmarks/notes/uniform_plans.md). The tolerance form "
+                  "therefore runs the fast path at its calibrated N.",
+}
 
 
 def random_designs(cfg, n: int, seed: int = 0) -> list[dict[str, float]]:
@@ -196,6 +212,7 @@ def bench_mechanism(name: str) -> dict:
                  "adaptive_gci_error": float(np.abs(gci[idx] - fg).max()),
                  "reference_volume_error": float((np.abs(ref_vol[idx] - fv) / fv).max()),
                  "reference_gci_error": float(np.abs(ref_gci[idx] - fg).max())}
+        finer["within"] = (finer["adaptive_volume_error"] <= tol.volume and finer["adaptive_gci_error"] <= tol.gci)
         print(f"  {len(idx)} designs outside the tolerance; against N = {2 * n_ref}: adaptive "
               f"{100 * finer['adaptive_volume_error']:.3f} %, {finer['adaptive_gci_error']:.1e}; reference "
               f"{100 * finer['reference_volume_error']:.3f} %, {finer['reference_gci_error']:.1e}", flush=True)
@@ -203,20 +220,24 @@ def bench_mechanism(name: str) -> dict:
             # the volume against the exact column intervals; the GCI against the fine column evaluation
             sub = [designs[i] for i in idx]
             ex = exact_volumes(mech, sub, options, packed[idx], region)
-            eg = gci_of(adaptive_population_stats(mech, sub, options, packed[idx], tol, edges, region,
-                                                  plan=COLUMN_GCI_PLAN, lci_only=True).stats)
             ev = np.abs(vol[idx] - ex) / ex
-            egc = np.abs(gci[idx] - eg)
             finer["exact"] = {"N_cross": N_CROSS, "adaptive_volume_error": float(ev.max()),
-                              "reference_volume_error": float((np.abs(ref_vol[idx] - ex) / ex).max()),
-                              "gci_columns": COLUMN_GCI_PLAN.columns, "adaptive_gci_error": float(egc.max()),
-                              "reference_gci_error": float(np.abs(ref_gci[idx] - eg).max()),
-                              "within": bool(ev.max() <= tol.volume and egc.max() <= tol.gci)}
-            print(f"  against the exact column volumes ({N_CROSS}^2 columns) and {COLUMN_GCI_PLAN.columns}^2 "
-                  f"columns' GCI: adaptive {100 * finer['exact']['adaptive_volume_error']:.3f} %, "
-                  f"{finer['exact']['adaptive_gci_error']:.1e}, reference N = {n_ref} "
-                  f"{100 * finer['exact']['reference_volume_error']:.3f} %, "
-                  f"{finer['exact']['reference_gci_error']:.1e}", flush=True)
+                              "reference_volume_error": float((np.abs(ref_vol[idx] - ex) / ex).max())}
+            if name in COLUMN_GCI_MECHANISMS:
+                eg = gci_of(adaptive_population_stats(mech, sub, options, packed[idx], tol, edges, region,
+                                                      plan=COLUMN_GCI_PLAN, lci_only=True).stats)
+                egc = np.abs(gci[idx] - eg)
+                finer["exact"].update({"gci_columns": COLUMN_GCI_PLAN.columns, "adaptive_gci_error": float(egc.max()),
+                                       "reference_gci_error": float(np.abs(ref_gci[idx] - eg).max())})
+                print(f"  against the exact column volumes ({N_CROSS}^2 columns) and {COLUMN_GCI_PLAN.columns}^2 "
+                      f"columns' GCI: adaptive {100 * ev.max():.3f} %, {egc.max():.1e}, reference N = {n_ref} "
+                      f"{100 * finer['exact']['reference_volume_error']:.3f} %, "
+                      f"{finer['exact']['reference_gci_error']:.1e}", flush=True)
+            else:  # the GCI against N = 2 n_ref (above)
+                egc = np.abs(gci[idx] - fg)
+                print(f"  against the exact column volumes ({N_CROSS}^2 columns): adaptive {100 * ev.max():.3f} %, "
+                      f"reference N = {n_ref} {100 * finer['exact']['reference_volume_error']:.3f} %", flush=True)
+            finer["exact"]["within"] = bool(ev.max() <= tol.volume and egc.max() <= tol.gci)
     equal = equal_solid = None
     for n in LADDER:
         if n >= n_ref:
@@ -448,7 +469,8 @@ def finer_line(f: dict | None, n_ref: int) -> list[str]:
         return []
     out = [f"- the {len(f['designs'])} designs (not slivers) outside the tolerance, against a uniform N = {f['N']}: "
            f"adaptive {100 * f['adaptive_volume_error']:.3f} %, {f['adaptive_gci_error']:.1e}; the reference "
-           f"N = {n_ref} itself {100 * f['reference_volume_error']:.3f} %, {f['reference_gci_error']:.1e}"]
+           f"N = {n_ref} itself {100 * f['reference_volume_error']:.3f} %, {f['reference_gci_error']:.1e}"
+           + (f": tolerance {'met' if f['within'] else 'NOT met'}" if "within" in f and not f.get("exact") else "")]
     e = f.get("exact")
     if e and "gci_columns" in e:
         out.append(f"- the same designs against the exact column volumes (the closed-form column intervals summed "
@@ -526,9 +548,18 @@ def markdown(data: dict) -> list[str]:
         for m in rows:
             a, us, tol = m["adaptive"], m.get("uniform_equal_accuracy_solid"), m["tolerance"]
             acc = a["volume_error_solid"] <= tol["volume"] and a["gci_error_solid"] <= tol["gci"]
-            exact = (m.get("finer_check") or {}).get("exact")
-            acc_text = "yes" if acc else ("yes, against exact column volumes" if exact and exact["within"] else "NO")
-            acc = acc or bool(exact and exact["within"])
+            f = m.get("finer_check") or {}
+            exact = f.get("exact")
+            if acc:
+                acc_text = "yes"
+            elif exact and exact["within"]:
+                acc_text = "yes, against exact column volumes" + (
+                    "" if "gci_columns" in exact else f" and the GCI of N = {f['N']}")
+            elif not exact and f.get("within"):
+                acc_text = f"yes, against N = {f['N']}"
+            else:
+                acc_text = "NO"
+            acc = acc_text != "NO"
             if us is None:
                 eq, t_ratio = f">= N = {m['reference_N']} (none below)", m["reference_s_per_design"] / a["s_per_design"]
                 c_ratio = m["reference_N"] ** m.get("ndim", 3) / a["kernel_calls"]

@@ -702,8 +702,10 @@ def _issue15_summary(data: dict) -> list[str]:
                     elif e:
                         adaptive_acc += (f"; their volume against the exact column volumes ({e['N_cross']}^2 "
                                          f"columns): adaptive {100 * e['adaptive_volume_error']:.3f} %, the reference "
-                                         f"{100 * e['reference_volume_error']:.3f} %: "
-                                         f"{yes[e['within']]} against it")
+                                         f"{100 * e['reference_volume_error']:.3f} %; with the GCI against "
+                                         f"N = {f['N']}: {yes[e['within']]}")
+                    elif "within" in f:
+                        adaptive_acc += f": {yes[f['within']]} against it"
                 if adaptive_now:
                     acc = adaptive_acc
                 else:
@@ -766,6 +768,10 @@ def _issue15_summary(data: dict) -> list[str]:
                 elif w2 is not None:
                     sp = f"{w2:.2f} (imports included; CPU not recorded)"
             out.append(f"| {mech} | {name} | {label} | {ms} | {acc} | {loop} | {eqr} | {twin} | {cp} | {sp} |")
+    why = [f"- {mech}: {text}" for mech, text in adaptive_bench.EQUAL_ACCURACY_NOTES.items()
+           if mech in ad and "**NOT" in next((r for r in out if r.startswith(f"| {mech} |")), "")]
+    if why:
+        out += ["", "Equal accuracy not met, and why:", "", *why]
     out += ["", "Sources (each section below keeps its own machine, date and conditions):", ""]
     notes = {"adaptive": "accuracy (20 random designs, errors without slivers: reference measure below 1 % of the "
                          "median), adaptive ms/design, equal-accuracy ratio, NumPy twin",

@@ -17,7 +17,7 @@ slivers, reference volume below 1 % of the median, left out), the largest own es
 designs. ``ab``: seed 0, alternating, best of 3, one process: the search's call (``adaptive_population_stats``,
 lci_only) with the column intervals and the interval plan, with the interval plan before inherited fields
 (PLAN_BEFORE), with nodes and bisection and the node plan, and the uniform N = 32 grid (the config's resolution
-before the tolerance form).
+before the tolerance form); then the interval kernel alone, in us per column (48 x 48 columns per design).
 """
 
 from __future__ import annotations
@@ -31,11 +31,19 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from adaptive import COLUMN_GCI_PLAN, N_CROSS, SLIVER, design_set  # noqa: E402
+from adaptive import COLUMN_GCI_PLAN, N_CROSS, SLIVER, cross_volume, design_set  # noqa: E402
 from adaptive import exact_volumes as adaptive_exact_volumes  # noqa: E402
 from plan_search import Search, parse_plan  # noqa: E402
 
-from scalesynth.evaluate import ColumnPlan, Tolerance, adaptive_plan, adaptive_population_stats  # noqa: E402
+from scalesynth.evaluate import (  # noqa: E402
+    ColumnPlan,
+    Tolerance,
+    adaptive_plan,
+    adaptive_population_stats,
+    column_axis,
+    column_order,
+    design_boxes,
+)
 
 # the interval plan before inherited fields and the midpoint rule (2026-12-02 morning), for ``ab``
 PLAN_BEFORE = ColumnPlan(24, 2, 5, 3, beta=1.0, faces=True)
@@ -96,6 +104,18 @@ def ab() -> None:
             best[k] = min(best[k], (time.perf_counter() - t0) / len(s.designs) * 1e3)
     for k, v in best.items():
         print(f"{k}: {v:.2f} ms/design ({v / best['uniform N = 32']:.2f}x uniform N = 32)")
+    # the interval kernel alone, per column: 48 x 48 columns of each design's box (adaptive.cross_volume)
+    kernel = s.mech.interval_kernel_for(s.options)
+    order = column_order(3, column_axis(s.mech, s.options))
+    lo, hi = design_boxes(s.mech, s.designs, s.options, s.region)
+    cross_volume(kernel, s.packed[0], lo[0, order], hi[0, order], 8)  # compiled or loaded
+    per_column = np.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        for i, p in enumerate(s.packed):
+            cross_volume(kernel, p, lo[i, order], hi[i, order], 48)
+        per_column = min(per_column, (time.perf_counter() - t0) / (len(s.designs) * 48 * 48))
+    print(f"column_intervals: {1e6 * per_column:.3f} us per column")
 
 
 if __name__ == "__main__":
