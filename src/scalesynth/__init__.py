@@ -21,6 +21,11 @@ from typing import Any
 
 __version__ = "0.1.0"
 
+# before anything imports Numba: compile for one fixed x86-64 level, not the host CPU (numba_target)
+from scalesynth import numba_target as _numba_target  # noqa: E402
+
+_numba_target.pin()
+
 # public name -> module that defines it
 _EXPORTS = {
     "load_config": "scalesynth.api",

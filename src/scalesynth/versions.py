@@ -15,10 +15,14 @@ DEPENDENCIES = ("numpy", "numba", "llvmlite", "pymoo", "moocore", "pandas", "mat
 
 
 def installed_versions() -> dict[str, str]:
-    """{package: version} of scalesynth, Python and every dependency that a manifest records."""
+    """{package: version} of scalesynth, Python and every dependency that a manifest records, and the CPU target
+    Numba compiles for (``numba_target``: name, and '+features' where set)."""
     from scalesynth import __version__
+    from scalesynth.numba_target import describe
 
-    out = {"scalesynth": __version__, "python": platform.python_version()}
+    target = describe()
+    out = {"scalesynth": __version__, "python": platform.python_version(),
+           "numba_target": target["cpu_name"] + (f"+{target['cpu_features']}" if target["cpu_features"] else "")}
     for name in DEPENDENCIES:
         try:
             out[name] = metadata.version(name)

@@ -121,12 +121,6 @@ def init_row(row, n_fields):
         row[1 + 4 * f + 3] = -math.inf
 
 
-# The accumulator's sums are NOT reassociated: with fastmath 'reassoc' LLVM vectorises the reductions, and the
-# code it generates for a kernel compiled in this process (callees inlined from the same module) and for the same
-# kernel loaded from Numba's disk cache summed in different orders, so a run resumed in a new process or on another
-# worker differed from an uninterrupted one in the last bits (found by the kill -9 resume tests on a fresh cache).
-# Counts are sums of small integer weights (exact).
-_ACC_FASTMATH = FASTMATH
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -148,7 +142,7 @@ def gather_column(buf, wbuf, m, vals, k0, k1, w):
     return m + n
 
 
-@njit(cache=True, fastmath=_ACC_FASTMATH)
+@njit(cache=True, fastmath=FASTMATH)
 def accumulate_cells(row, buf, wbuf, m, edges):
     """Add the first m buffered cells to a statistics row; a cell of weight 0 is unreachable and ignored.
 
@@ -157,7 +151,7 @@ def accumulate_cells(row, buf, wbuf, m, edges):
     edge. The three fields every mechanism has (LCI, sigma_min, sigma_max) and the first two inner band edges go
     through one loop: its nine sums and six extremes are independent chains that overlap, where separate passes
     would each wait on the latency of one or two sequential sums (the sums are not reassociated, see
-    _ACC_FASTMATH, so they do not vectorise).
+    kernels.flags, so they do not vectorise).
     Each chain still sums the cells in index order, so the row does not depend on how the passes are grouped."""
     if m == 0:
         return
