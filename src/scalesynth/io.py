@@ -99,8 +99,20 @@ def write_text(path: Path, text: str) -> None:
     write_atomic(path, lambda fh: fh.write(text))
 
 
+def null_nan(obj: Any) -> Any:
+    """``obj`` with every float NaN (a statistic over an empty set) replaced by None, so JSON gets null, never the
+    non-JSON NaN; dicts, lists and tuples are walked, NumPy floats included."""
+    if isinstance(obj, float):  # numpy.float64 is a float too
+        return None if obj != obj else obj
+    if isinstance(obj, dict):
+        return {k: null_nan(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [null_nan(v) for v in obj]
+    return obj
+
+
 def write_json(path: Path, obj: Any) -> None:
-    write_text(path, json.dumps(obj, indent=2, sort_keys=False) + "\n")
+    write_text(path, json.dumps(null_nan(obj), indent=2, sort_keys=False) + "\n")
 
 
 def write_pickle(path: Path, obj: Any) -> None:
