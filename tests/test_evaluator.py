@@ -7,6 +7,7 @@ from scalesynth.evaluate import design_boxes, evaluate, evaluate_population, mak
 from scalesynth.kernels import grid as kgrid
 from scalesynth.kernels.conditioning import cos_third_acos, lci_2x2, lci_3x3
 from scalesynth.mechanisms import get
+from scalesynth.metrics import nullable_columns
 
 from conftest import EXACT_VOLUME, SPEC_GCI, TABLE4
 from naive import grid_metrics, grid_nodes, pauu_fields, pauu_lci
@@ -130,8 +131,9 @@ def test_torus_special_case():
 def test_empty_workspace_is_data_not_nan():
     rep = evaluate(M, TABLE4[1], {"stroke_limits": [5.0, 6.0]}, resolution=16)
     assert rep.metrics["voxels"] == 0
-    assert rep.measure == 0.0 and rep.gci == 0.0 and rep.metrics["fci"] == 0.0
-    assert all(np.isfinite(v) for v in rep.metrics.values())
+    assert rep.measure == 0.0 and rep.gci == 0.0 and np.isnan(rep.metrics["fci"])  # null: a std of nothing
+    nullable = nullable_columns(M, "m", 3)
+    assert all(np.isnan(v) if k in nullable else np.isfinite(v) for k, v in rep.metrics.items())
 
 
 def test_closed_form_conditioning_matches_svd():

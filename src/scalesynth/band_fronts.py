@@ -55,6 +55,7 @@ def band_pareto(problem, population: pd.DataFrame, band: int) -> tuple[pd.DataFr
     cols, signs = band_objectives(problem, band)
     feas = population[population["feasible"].astype(bool)] if "feasible" in population.columns else population
     F = feas[cols].to_numpy(dtype=float) * signs
+    F = np.where(np.isnan(F), np.inf, F)  # a statistic over an empty set is the worst value, never best
     front = feas[nondominated_mask(F)].drop_duplicates(subset=cols, keep="first")
     front = front.sort_values(cols[0], ascending=bool(signs[0] > 0), kind="mergesort").reset_index(drop=True)
     return front, cols

@@ -529,7 +529,7 @@ def combined_front(fronts: dict[int, Any], keys: Sequence[str], signs: np.ndarra
     # 'rank' is the rank within one seed's population: meaningless across seeds
     rows = rows[["seed", *[c for c in rows.columns if c not in ("seed", "rank")]]]
     F = rows[list(keys)].to_numpy(dtype=float) * signs
-    rows = rows[nondominated_mask(F)]
+    rows = rows[nondominated_mask(np.where(np.isnan(F), np.inf, F))]  # a statistic over nothing: worst
     order_cols = [f"__f{j}" for j in range(len(keys))]
     Fk = rows[list(keys)].to_numpy(dtype=float) * signs
     rows = rows.assign(**{c: Fk[:, j] for j, c in enumerate(order_cols)})
@@ -580,6 +580,7 @@ def write_combined(out: Path, cfg: RunConfig, records: Sequence[TaskRecord]) -> 
         plotting.close(fig)
     ref = np.array(ok[0].hv_reference or [0.0] * len(keys))
     F = front[keys].to_numpy(dtype=float) * signs if len(front) else np.zeros((0, len(keys)))
+    F = np.where(np.isnan(F), ref[None, :], F)  # a statistic over an empty set counts as the reference (worst)
     info.update(
         pareto_size=int(len(front)),
         hypervolume=hypervolume(F, ref),

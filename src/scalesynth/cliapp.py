@@ -96,7 +96,9 @@ def _mech_inputs(mech_name: str, sets: list[str] | None):
 def _print_json(obj: Any) -> None:
     """One JSON object on stdout; strict JSON (a non-finite number is a bug: exit 1 instead of printing NaN)."""
     try:
-        text = json.dumps(obj, indent=None, sort_keys=False, allow_nan=False)
+        from scalesynth.io import null_nan  # a statistic over an empty set (NaN) is printed as null
+
+        text = json.dumps(null_nan(obj), indent=None, sort_keys=False, allow_nan=False)
     except ValueError:
         from scalesynth.errors import RunError
 

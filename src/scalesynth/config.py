@@ -169,7 +169,10 @@ class OutputConfig(_Strict):
 
 
 class UnitsConfig(_Strict):
-    length: Literal[LENGTH_UNITS] = "m"  # type: ignore[valid-type]
+    """``length``: the unit every length of the config and the results is in; it must be the mechanism's own
+    (null = the mechanism's, filled in at validation): scalesynth does not convert lengths."""
+
+    length: Literal[LENGTH_UNITS] | None = None  # type: ignore[valid-type]
 
 
 class RunConfig(_Strict):
@@ -235,6 +238,7 @@ class RunConfig(_Strict):
         from scalesynth.mechanisms import get
 
         mech = get(self.mechanism)
+        self.units.length = mech.length_unit(self.units.length)
         mech.resolve_design(self.design)
         mech.resolve_options(self.options)
         for label, ref in self.references.items():

@@ -1,12 +1,13 @@
 """Workspace, task and design metrics of designs: evaluate(mechanism, design, ...) -> WorkspaceReport.
 
 Plain functions over the Numba kernels in ``kernels.grid``; which metrics exist and how each is named comes from
-the catalogue (``scalesynth.metrics``). Degenerate designs are data: an empty workspace gives measure 0 and every
-field statistic 0, never NaN.
+the catalogue (``scalesynth.metrics``). Degenerate designs are data: an empty workspace gives measure 0 and GCI 0;
+every other statistic over an empty set is NaN (null), never a number that could read as best (stats_to_metrics).
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -444,18 +445,19 @@ def tolerance_population_stats(
         # grid finds something
         err_v = np.where(vol > 0.0, np.abs(vol - vol_f) / np.where(vol > 0.0, vol, 1.0),
                          np.where(vol_f > 0.0, 1.0, 0.0))
-        err_g = np.abs(_field_mean(stats, 0) - _field_mean(fine, 0))
+        # the GCI of an empty grid is 0 here, as the reported GCI (the catalogue's empty value)
+        err_g = np.abs(np.nan_to_num(_field_mean(stats, 0)) - np.nan_to_num(_field_mean(fine, 0)))
         calls += float((2 * n_uniform) ** ndim)
     return AdaptiveResult(stats, cell, err_v, err_g, np.zeros(n, dtype=np.int64), np.full(n, calls),
                           n_uniform**ndim)
 
 
 def _field_mean(stats: np.ndarray, f: int) -> np.ndarray:
-    """Mean of field slot ``f`` over the reachable cells of statistics rows (slot 0: the GCI); 0 where nothing is
-    reachable."""
+    """Mean of field slot ``f`` over the reachable cells of statistics rows (slot 0: the GCI); NaN where nothing is
+    reachable (a statistic over nothing; ``stats_to_metrics``)."""
     count = stats[:, _grid.COL_COUNT]
     has = count > 0
-    return np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUM)] / np.where(has, count, 1.0), 0.0)
+    return np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUM)] / np.where(has, count, 1.0), np.nan)
 
 
 def stats_to_metrics(
@@ -466,8 +468,11 @@ def stats_to_metrics(
     entries: Sequence[_metrics.Metric],
     n_bands: int,
 ) -> dict[str, np.ndarray]:
-    """Metric arrays of the catalogue ``entries`` (one family) from statistics rows (n, stat_columns); an empty
-    region gives 0 for every statistic, never NaN."""
+    """Metric arrays of the catalogue ``entries`` (one family) from statistics rows (n, stat_columns). Over an
+    empty region the measure, count and coverage are 0, and every statistic over its cells (mean, std, min, max of
+    a field, band shares) is NaN: null in JSON, an empty CSV cell, the worst value in the search (problem.py);
+    never a number that could read as best (issue 27: an unreachable task box gave task_max_deflection 0). The one
+    exception is the metric's ``empty`` value (the GCI: 0 over an empty set, the documented convention)."""
     count = stats[:, _grid.COL_COUNT]
     has = count > 0
     safe = np.where(has, count, 1.0)
@@ -485,18 +490,21 @@ def stats_to_metrics(
         elif st in ("band_share", "band_measure"):
             for b in range(n_bands):
                 band = stats[:, _grid.band_column(nf, b)]
-                out[m.column_for(b)] = np.where(has, band / safe, 0.0) if st == "band_share" else band * cell_measure
+                out[m.column_for(b)] = np.where(has, band / safe, np.nan) if st == "band_share" else band * cell_measure
         else:
             f = slots[m.field]
             mean = _field_mean(stats, f)
             if st == "mean":
                 out[m.column] = mean
             elif st == "std":
-                var = np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUMSQ)] / safe - mean * mean, 0.0)
-                out[m.column] = np.sqrt(np.maximum(var, 0.0))
+                var = np.where(has, stats[:, _grid.field_column(f, _grid.STAT_SUMSQ)] / safe - mean * mean, np.nan)
+                out[m.column] = np.sqrt(np.maximum(var, 0.0))  # NaN stays NaN
             else:
                 col = _grid.field_column(f, _grid.STAT_MIN if st == "min" else _grid.STAT_MAX)
-                out[m.column] = np.where(has, stats[:, col], 0.0)
+                out[m.column] = np.where(has, stats[:, col], np.nan)
+        if m.empty is not None:
+            for col in m.columns(n_bands):
+                out[col] = np.where(has, out[col], m.empty)
     return out
 
 
@@ -559,7 +567,7 @@ class WorkspaceReport:
         metrics: {column name: value}, every metric of the catalogue that applies (``scalesynth metrics MECH``): the
             measure (``measure_key``, volume or area in the length unit), ``gci``, ``fci``, field statistics,
             ``voxels`` (reachable cells), band shares and volumes; with a task, ``task_*`` and ``path_*``.
-            Empty workspace: all 0, never NaN.
+            Empty workspace: measure and counts 0, GCI 0, every other statistic over it NaN (null in JSON).
         field_names: names of the per-voxel fields, in slot order (``lci``, ``sigma_min``, ``sigma_max``, ...).
         field_grid: only with ``keep_grid=True``: float64 array of shape (nx, ny, nz, n_fields) (nz = 1 for planar
             mechanisms), every field at each cell centre; ``field(name)`` gives one (nx, ny, nz) slice and
@@ -609,7 +617,9 @@ class WorkspaceReport:
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"mechanism": self.mechanism, "design": self.design}
-        out.update({k: (int(v) if k == "voxels" else float(v)) for k, v in self.metrics.items()})
+        # a statistic over an empty set is NaN in memory and null in JSON (json.dumps would write NaN, not JSON)
+        out.update({k: (int(v) if k == "voxels" else None if math.isnan(v) else float(v))
+                    for k, v in self.metrics.items()})
         out["band_edges"] = list(self.band_edges)
         out["resolution"] = self.resolution
         out["grid_cells"] = self.grid_cells
@@ -637,7 +647,7 @@ def evaluate(
     (WorkspaceReport.field_grid). ``cycle`` (a config CycleConfig): also the cycle metrics."""
     design = mech.resolve_design(design)
     options = mech.resolve_options(options)
-    unit = length_unit or mech.default_length_unit
+    unit = mech.length_unit(length_unit, "length_unit")
     g = make_grid(mech, design, options, resolution, region)
     edges = np.asarray(band_edges, dtype=float)
     packed = mech.pack(design, options)[None, :]
@@ -722,7 +732,7 @@ def evaluate_population(
     options = mech.resolve_options(options)
     _check_selection("families", families, _metrics.FAMILIES)
     _check_selection("fields", fields, (*mech.field_names, "estimate"))
-    unit = length_unit or mech.default_length_unit
+    unit = mech.length_unit(length_unit, "length_unit")
     resolved = [mech.resolve_design(d) for d in designs]
     n = len(resolved)
     if n == 0:

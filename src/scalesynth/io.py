@@ -99,8 +99,20 @@ def write_text(path: Path, text: str) -> None:
     write_atomic(path, lambda fh: fh.write(text))
 
 
+def null_nan(obj: Any) -> Any:
+    """``obj`` with every float NaN (a statistic over an empty set) replaced by None, so JSON gets null, never the
+    non-JSON NaN; dicts, lists and tuples are walked, NumPy floats included."""
+    if isinstance(obj, float):  # numpy.float64 is a float too
+        return None if obj != obj else obj
+    if isinstance(obj, dict):
+        return {k: null_nan(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [null_nan(v) for v in obj]
+    return obj
+
+
 def write_json(path: Path, obj: Any) -> None:
-    write_text(path, json.dumps(obj, indent=2, sort_keys=False) + "\n")
+    write_text(path, json.dumps(null_nan(obj), indent=2, sort_keys=False) + "\n")
 
 
 def write_pickle(path: Path, obj: Any) -> None:
@@ -141,11 +153,12 @@ def read_checkpoint(path: Path) -> dict[str, Any]:
 
 
 def write_csv(path: Path, frame) -> None:
-    """CSV with a fixed float format so equal numbers always give equal bytes; every number must be finite."""
+    """CSV with a fixed float format so equal numbers always give equal bytes; every number must be finite or NaN
+    (a statistic over an empty set, written as an empty cell); infinities are refused."""
     import numpy as np
 
     numeric = frame.select_dtypes(include="number")
-    bad = [c for c in numeric.columns if not np.isfinite(numeric[c].to_numpy(dtype=float)).all()]
+    bad = [c for c in numeric.columns if np.isinf(numeric[c].to_numpy(dtype=float)).any()]
     if bad:
         raise RunError(f"{path}: column {bad[0]} has a non-finite value (not written); please report it")
     write_text(path, frame.to_csv(index=False, float_format="%.12g", lineterminator="\n"))
@@ -162,9 +175,10 @@ def save_figure(fig, path: Path, dpi: int = 130) -> None:
 
 # ----- reading a results directory that may have been damaged: one-line ConfigError, never a traceback ----------
 
-def read_results_csv(path: Path, required: tuple[str, ...] | list[str] = ()):
+def read_results_csv(path: Path, required: tuple[str, ...] | list[str] = (), nullable=frozenset()):
     """A results CSV as a DataFrame; ConfigError naming the file if it is empty, not CSV, lacks a ``required``
-    column or has a non-numeric or non-finite value in one."""
+    column or has a non-numeric or non-finite value in one (an empty cell is allowed in ``nullable`` columns: a
+    statistic over an empty set)."""
     import numpy as np
     import pandas as pd
 
@@ -180,8 +194,12 @@ def read_results_csv(path: Path, required: tuple[str, ...] | list[str] = ()):
         if col not in frame.columns:
             raise ConfigError(f"{path}: column {col!r} is missing (damaged or not written by this version)")
         values = pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float)
-        if not np.isfinite(values).all():
-            row = int(np.nonzero(~np.isfinite(values))[0][0])
+        if col in nullable:
+            ok = np.isfinite(values) | (frame[col].isna().to_numpy() & np.isnan(values))
+        else:
+            ok = np.isfinite(values)
+        if not ok.all():
+            row = int(np.nonzero(~ok)[0][0])
             raise ConfigError(f"{path}: column {col!r}, row {row + 1}: not a finite number")
         frame[col] = values
     return frame

@@ -69,7 +69,9 @@ class Metric:
     hypervolume reference): a number, WORST_BOUNDING_BOX, WORST_BOUNDS_CORNERS, or None when unbounded (it can
     then be maximised or constrained, not minimised); a maximised objective's worst value is ``range[0]``.
     ``needs``: 'task', 'path', 'band' or 'options.<name>'. ``compute(ctx) -> (n,) array`` for metrics that are
-    not statistics of the voxel grids.
+    not statistics of the voxel grids. ``empty``: the value reported where the statistic's set (the reachable
+    workspace or task cells) is empty; None (every statistic but the GCI) = NaN, null in JSON and empty in CSV,
+    and the worst value where it is an objective or constraint (``problem.py``).
     """
 
     name: str
@@ -84,6 +86,7 @@ class Metric:
     needs: tuple[str, ...]
     description: str
     compute: Callable[[EvalContext], np.ndarray] | None = field(default=None, compare=False, repr=False)
+    empty: float | None = None
 
     def columns(self, n_bands: int) -> list[str]:
         """Every result column of the metric (one per band for band metrics)."""
@@ -150,11 +153,15 @@ def _field_entries(mech: Mechanism, f: Field, length_unit: str, family: str) -> 
         if family == "task":
             name, column = f"task_{name}", f"task_{column}"
         rng = _std_range(f) if stat == "std" else f.range
+        gci = f.name == "lci" and stat == "mean"
         better = ("min" if stat == "std" else f.better)
         out.append(Metric(
             name=name, column=column, family=family, field=f.name, statistic=stat, unit=unit, range=rng,
             better=better, worst=rng[1] if math.isfinite(rng[1]) else None, needs=needs,
-            description=f"{_STAT_WORDS[stat]} of {f.name} over {region}" + (f" ({unit})" if unit != "1" else ""),
+            description=f"{_STAT_WORDS[stat]} of {f.name} over {region}" + (f" ({unit})" if unit != "1" else "")
+            + ("; 0 if that is empty" if gci else "; null if that is empty"),
+            # the GCI of an empty set is 0 by convention (volume 0, GCI 0); any other statistic over nothing is null
+            empty=0.0 if gci else None,
         ))
     return out
 
@@ -221,26 +228,26 @@ def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
         return Metric(name, column, "cycle", None, None, unit, rng, better, worst, needs, description,
                       compute=compute)
 
+    from scalesynth.cycle.config import ACTUATOR_KINDS, peak_names
+
     lu = length_unit
-    kinds = set(mech.joint_units)
-    # one unit when every actuator is of one kind; mixed actuators (pprs-rprs) give a plain column name
-    mixed = len(kinds) > 1  # e.g. pprs-rprs, 2pauu-ppap: the column carries no unit, the entry names both
-    speed, accel, force = {frozenset({"angle"}): ("rad/s", "rad/s^2", "N m"),
-                           frozenset({"length"}): (f"{lu}/s", f"{lu}/s^2", "N")}.get(
-        frozenset(kinds), (f"rad/s or {lu}/s", f"rad/s^2 or {lu}/s^2", "N m or N"))
     failed = f"; {CYCLE_PENALTY:g} if the cycle cannot be followed"
+    # one unit per metric: a mechanism with revolute and prismatic actuators gets each peak per kind
+    units = {"angle": ("rad/s", "rad/s^2", "N m"), "length": (f"{lu}/s", f"{lu}/s^2", "N")}
+    words = {"speed": ("|qd_i|", 0, ""), "accel": ("|qdd_i|", 1, ""),
+             "force": ("actuator force or torque", 2, " for the payload, quasi-static plus payload inertia")}
+    peaks = []
+    for name, kinds in peak_names(mech.joint_units).items():
+        what, slot, how = words[name.split("_")[3]]
+        unit = units[kinds[0]][slot]
+        over = "the actuators" if len(set(mech.joint_units)) == 1 else f"the {ACTUATOR_KINDS[kinds[0]]} actuators"
+        peaks.append(entry(name, unit, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
+                           f"largest {what} over the cycle and {over}{how} ({unit}){failed}"))
     return [
         entry("cycle_feasible", "1", (0.0, 1.0), "max", 1.0, ("cycle",),
               "1 if the cycle stays in the workspace without branch jump or singularity, with clearance >= 0 and "
               "within the cycle's speed and force limits, else 0"),
-        entry("cycle_max_actuator_speed", speed, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
-              f"largest |qd_i| over the cycle and the actuators ({lu}/s or rad/s, per actuator type){failed}",
-              plain=mixed),
-        entry("cycle_max_actuator_accel", accel, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
-              f"largest |qdd_i| over the cycle and the actuators ({lu}/s^2 or rad/s^2){failed}", plain=mixed),
-        entry("cycle_max_actuator_force", force, (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle",),
-              f"largest actuator force or torque for the payload, quasi-static plus payload inertia (N or N m)"
-              f"{failed}", plain=mixed),
+        *peaks,
         entry("cycle_min_lci", "1", (0.0, 1.0), "max", 1.0, ("cycle",),
               "smallest LCI along the cycle (0 if it cannot be followed)"),
         entry("cycle_min_clearance", lu, (-CYCLE_PENALTY, math.inf), "max", None,
@@ -262,7 +269,7 @@ _CACHE: dict[tuple[str, str], dict[str, Metric]] = {}
 
 def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metric]:
     """Every metric of ``mech`` with columns in ``length_unit`` (default the mechanism's), in result-column order."""
-    unit = length_unit or mech.default_length_unit
+    unit = mech.length_unit(length_unit, "length_unit")
     key = (mech.name, unit)
     if key in _CACHE:
         return _CACHE[key]
@@ -279,7 +286,8 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
         Metric("voxels", "voxels", "workspace", None, "count", "1", (0.0, math.inf), "max", None, (),
                "number of reachable grid cells"),
         Metric("band_share", "band{band}_share", "workspace", "lci", "band_share", "1", (0.0, 1.0), "max", 1.0,
-               ("band",), "share of the reachable workspace whose LCI lies in dexterity band k"),
+               ("band",), "share of the reachable workspace whose LCI lies in dexterity band k; null if that is "
+               "empty"),
         Metric("band_volume", f"band{{band}}_{mkey}", "workspace", "lci", "band_measure", munit, (0.0, math.inf),
                "max", WORST_BOUNDING_BOX, ("band",), f"workspace {mname} whose LCI lies in dexterity band k ({munit})"),
     ]
@@ -318,6 +326,17 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
         out[m.name] = m
     _CACHE[key] = out
     return out
+
+
+NULLABLE_STATISTICS = (*STATISTICS, "band_share")
+
+
+def nullable_columns(mech: Mechanism, length_unit: str, n_bands: int) -> set[str]:
+    """Result columns that are null (NaN, an empty CSV cell) for a design whose set is empty: the statistics over
+    the reachable workspace or task cells without an ``empty`` value."""
+    return {c for m in catalogue(mech, length_unit).values()
+            if m.family in ("workspace", "task") and m.statistic in NULLABLE_STATISTICS and m.empty is None
+            for c in m.columns(n_bands)}
 
 
 def field_of(m: Metric) -> str | None:
@@ -388,6 +407,10 @@ def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_ba
                 if name.startswith(head) and fname in all_field_names():
                     raise ValueError(f"metric: {name}: field {fname!r} is not provided by {mech.name} "
                                      f"(fields: {', '.join(mech.field_names)})")
+        split = [n for n in cat if n.startswith(f"{name}_") and n.split("_")[-1] in ("revolute", "prismatic")]
+        if split:  # an actuator peak of a mechanism with both kinds: one unit per metric, so one per kind
+            raise ValueError(f"metric: {name} mixes units on {mech.name} (revolute and prismatic actuators); "
+                             f"did you mean {' or '.join(split)}?")
         usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options, cycle, adaptive) is None]
         raise ValueError(f"metric: unknown metric {name!r} for {mech.name} (valid: {', '.join(usable)})")
     m = cat[name]
@@ -446,6 +469,12 @@ def markdown() -> str:
         "minimised objective needs a finite worst value for the hypervolume reference: `bounding_box` is the",
         "bounding-box measure of the largest design in the bounds, `bounds_corners` the largest value over the",
         "corners of the bounds; metrics without one can be maximised or constrained.",
+        "",
+        "A statistic over an empty set (the reachable workspace or task cells) is null: `null` in JSON, an empty",
+        "CSV cell; as an objective it takes its worst value and it violates every constraint on it (the GCI of an",
+        "empty set is 0, and counts as worst where it is minimised or bounded above). No metric mixes units: a",
+        "mechanism with revolute and prismatic actuators has its actuator peaks per kind (`_revolute`,",
+        "`_prismatic`). Lengths are in the mechanism's own unit (`units.length` must name it).",
         "",
         "`scalesynth metrics [MECH] [--json]` prints the same catalogue.",
         "",

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 import os
 import platform
 import time
@@ -120,7 +121,10 @@ def constraint_column(i: int, key: str) -> str:
 
 def best_for_constraint(con: ConstraintConfig, values: np.ndarray) -> float:
     """The value closest to satisfying the constraint: the largest for a lower bound, the smallest for an upper
-    bound, the least violating for both."""
+    bound, the least violating for both; statistics over empty sets (NaN) are left out, and NaN when every one is."""
+    values = values[~np.isnan(values)]
+    if not len(values):
+        return math.nan
     if con.max is None:
         return float(values.max())
     if con.min is None:

@@ -124,19 +124,50 @@ class SynthesisProblem(Problem):
             out[:, self.metric_columns.index(k)] = np.asarray(values[k], dtype=float)
         return out
 
+    def _searched_values(self, M: np.ndarray, item: ObjectiveConfig | ConstraintConfig) -> np.ndarray:
+        """An objective's or constraint's column of M, NaN where its statistic is over an empty set: NaN already
+        (statistics without an ``empty`` value), or the GCI's conventional 0 where the measure of its set (the
+        workspace measure, task_coverage) is 0."""
+        m = metric_entry(self.cfg, item)
+        v = np.array(M[:, self.metric_columns.index(m.column_for(item.band))], dtype=float)
+        if m.empty is not None:
+            size = self.cfg.mech.measure_key(self.cfg.units.length) if m.family == "workspace" else "task_coverage"
+            if size in self.metric_columns:
+                v[M[:, self.metric_columns.index(size)] == 0.0] = np.nan
+        return v
+
+    def worst_objectives(self) -> np.ndarray:
+        """The worst value of each objective in minimisation form (the hypervolume reference), computed once."""
+        if getattr(self, "_worst", None) is None:
+            self._worst = self.hv_reference()
+        return self._worst
+
+    def minimisation_form(self, values: np.ndarray) -> np.ndarray:
+        """Objective values (n, n_obj) in minimisation form; a statistic over an empty set (NaN) counts as the
+        objective's worst value, never as best (issue 27)."""
+        F = np.asarray(values, dtype=float) * self.signs
+        return np.where(np.isnan(F), self.worst_objectives()[None, :], F)
+
     def objectives_from_metrics(self, M: np.ndarray) -> np.ndarray:
-        cols = [self.metric_columns.index(k) for k in self.objective_keys]
-        return M[:, cols] * self.signs
+        values = [self._searched_values(M, obj) for obj in self.cfg.objectives]
+        return self.minimisation_form(np.column_stack(values) if values else np.zeros((M.shape[0], 0)))
 
     def constraints_from_metrics(self, M: np.ndarray) -> np.ndarray:
-        """G <= 0 feasible; each row scaled by its bound so violations of different metrics are commensurate."""
+        """G <= 0 feasible; each row scaled by its bound so violations of different metrics are commensurate. A
+        statistic over an empty set (NaN) satisfies no bound: it violates each by at least 1 (the bound's scale),
+        or by more where the metric's worst value would."""
         rows = []
-        for con, key in zip(self.cfg.constraints, self.constraint_keys, strict=True):
-            v = M[:, self.metric_columns.index(key)]
-            if con.min is not None:
-                rows.append((con.min - v) / max(abs(con.min), 1e-12))
-            if con.max is not None:
-                rows.append((v - con.max) / max(abs(con.max), 1e-12))
+        for con in self.cfg.constraints:
+            v = self._searched_values(M, con)
+            m = metric_entry(self.cfg, con)
+            for bound, sign, worst in ((con.min, -1.0, m.range[0]),
+                                       (con.max, 1.0, m.worst if isinstance(m.worst, float) else m.range[1])):
+                if bound is None:
+                    continue
+                g = sign * (v - bound) / max(abs(bound), 1e-12)
+                at_worst = sign * (worst - bound) / max(abs(bound), 1e-12)
+                empty = max(1.0, at_worst) if np.isfinite(at_worst) else 1.0
+                rows.append(np.where(np.isnan(g), empty, g))
         return np.column_stack(rows) if rows else np.zeros((M.shape[0], 0))
 
     def _evaluate(self, X, out, *args, **kwargs):

@@ -81,7 +81,7 @@ def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
         k = choose(F, "knee")
         highlight.append(("knee", float(pareto[xk].iloc[k]), float(pareto[yk].iloc[k])))
         for r in refs:
-            fr = np.array([r["metrics"][key] for key in problem.objective_keys]) * problem.signs
+            fr = problem.minimisation_form(np.array([[r["metrics"][key] for key in problem.objective_keys]]))[0]
             r["dominated_by_front"] = dominated_by_front(F, fr)
     pop_xy = None
     if population is not None and len(population):

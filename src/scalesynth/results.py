@@ -52,7 +52,7 @@ class RunResult:
     def objective_matrix(self, frame: pd.DataFrame | None = None) -> np.ndarray:
         """Objectives of the rows (default: the front) in minimisation form."""
         frame = self.pareto if frame is None else frame
-        return frame[self.problem.objective_keys].to_numpy(dtype=float) * self.problem.signs
+        return self.problem.minimisation_form(frame[self.problem.objective_keys].to_numpy(dtype=float))
 
     def front(self) -> Front:
         """The front's design variables and objectives (as read_front gives them without pandas)."""
@@ -124,11 +124,14 @@ def load(out_dir: Path, *, require_finished: bool = True) -> RunResult:
     nb = len(cfg.dexterity.band_edges) - 1
     needed = [*problem.var_names, *problem.objective_keys, cfg.mech.measure_key(cfg.units.length),
               *(f"band{b}_share" for b in range(nb))]
-    pareto = rio.read_results_csv(out / PARETO, list(dict.fromkeys(needed)))
+    from scalesynth.metrics import nullable_columns
+
+    nullable = nullable_columns(cfg.mech, cfg.units.length, nb)
+    pareto = rio.read_results_csv(out / PARETO, list(dict.fromkeys(needed)), nullable)
     history = rio.read_results_csv(out / HISTORY, ("generation", "evaluations", "hypervolume"))
     if not len(history):
         raise ConfigError(f"{out / HISTORY}: no generations")
-    population = (rio.read_results_csv(out / POPULATION, problem.objective_keys)
+    population = (rio.read_results_csv(out / POPULATION, problem.objective_keys, nullable)
                   if (out / POPULATION).is_file() else None)
     return RunResult(out_dir=out, cfg=cfg, pareto=pareto, history=history, manifest=manifest or {},
                      population=population, problem=problem)
@@ -166,7 +169,7 @@ def read_front(out_dir: Path) -> Front | None:
     if cols is None:
         return None
     X = np.column_stack([cols[k] for k in problem.var_names])
-    F = np.column_stack([cols[k] for k in problem.objective_keys]) * problem.signs
+    F = problem.minimisation_form(np.column_stack([cols[k] for k in problem.objective_keys]))
     return Front(cfg, problem, X, F)
 
 

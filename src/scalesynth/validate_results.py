@@ -43,8 +43,12 @@ def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
     if missing:
         problems.append(f"pareto.csv: missing columns {missing}")
         return problems
-    numeric = pareto.select_dtypes(include=[np.number]).to_numpy(dtype=float)
-    if not np.all(np.isfinite(numeric)):
+    nb = len(cfg.dexterity.band_edges) - 1
+    nullable = _metrics.nullable_columns(cfg.mech, cfg.units.length, nb)  # statistics over an empty set
+    numeric = pareto.select_dtypes(include=[np.number])
+    values = numeric.to_numpy(dtype=float)
+    allowed = np.array([c in nullable for c in numeric.columns], dtype=bool)
+    if not np.all(np.isfinite(values) | (np.isnan(values) & allowed[None, :])):
         problems.append("pareto.csv: NaN or inf values")
     for k in problem.var_names:
         lo, hi = cfg.bounds[k]
@@ -53,13 +57,13 @@ def check_results(run_dir: Path, require_report: bool = True) -> list[str]:
     for m in _metrics.catalogue(cfg.mech, cfg.units.length).values():
         lo, hi = m.range
         for col in m.columns(len(cfg.dexterity.band_edges) - 1):
-            if col in pareto.columns and not pareto[col].between(lo, hi).all():
+            if col in pareto.columns and not (pareto[col].between(lo, hi) | pareto[col].isna()).all():
                 problems.append(f"pareto.csv: {col} outside [{lo:g}, {hi:g}]")
     shares = [c for c in pareto.columns if c.startswith("band") and c.endswith("_share")]
     nonempty = pareto["voxels"] > 0
     if shares and not np.allclose(pareto.loc[nonempty, shares].sum(axis=1), 1.0, atol=1e-9):
         problems.append("pareto.csv: band shares do not sum to 1")
-    F = pareto[problem.objective_keys].to_numpy(dtype=float) * problem.signs
+    F = problem.minimisation_form(pareto[problem.objective_keys].to_numpy(dtype=float))
     for i in range(len(F)):
         dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
         if dominated.any():

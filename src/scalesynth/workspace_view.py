@@ -233,7 +233,10 @@ def choose_row(result, choice: str) -> tuple[int, str]:
         sense = "max"
         if col in problem.objective_keys:
             sense = "min" if problem.signs[problem.objective_keys.index(col)] > 0 else "max"
-        row = int(np.argmin(values) if sense == "min" else np.argmax(values))
+        if np.isnan(values).all():
+            raise InvalidParameter(f"--design: best-{metric}: null on every front row (a statistic over an empty set)")
+        # a statistic over an empty set (NaN) is never the best row
+        row = int(np.nanargmin(values) if sense == "min" else np.nanargmax(values))
         return row, f"best-{col}"
     try:
         row = int(choice)

@@ -43,7 +43,10 @@ def pick_design(run_dir: Path, choice: str):
         senses = {o.metric: o.sense for o in cfg.objectives}
         sense = senses.get(entry.name, entry.better)
         values = pareto[entry.column].to_numpy(dtype=float)
-        row = int(np.argmax(values) if sense == "max" else np.argmin(values))
+        if np.isnan(values).all():
+            raise ConfigError(f"--design: best-{wanted}: null on every front row (a statistic over an empty set)")
+        # a statistic over an empty set (NaN) is never the best row
+        row = int(np.nanargmax(values) if sense == "max" else np.nanargmin(values))
     else:
         try:
             row = int(choice)

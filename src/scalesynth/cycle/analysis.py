@@ -444,7 +444,8 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
     cycle_feasible: 1 when every sample is reachable without a branch jump or singularity, the clearance is
     >= 0 and (with limits) the actuator speeds and forces stay within them, else 0.
     cycle_max_actuator_speed / _accel / _force: the largest |qd_i|, |qdd_i|, |force_i| over the cycle and the
-    actuators (their units: length unit or rad per s, per s^2; N or N m; mixed for mixed actuators).
+    actuators (length unit or rad per s, per s^2; N or N m); with revolute and prismatic actuators one of each
+    per kind (``_revolute``, ``_prismatic``), never a maximum over both units.
     cycle_min_lci, cycle_min_clearance (length unit; < 0 interference). max_cycles_per_minute: the configured
     rate times max_rate_scale (only with speed or force limits). A cycle that cannot be followed gives feasible 0,
     speed, acceleration and force CYCLE_PENALTY, LCI 0, clearance -CYCLE_PENALTY and 0 cycles per minute."""
@@ -455,10 +456,21 @@ def metrics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit
     return result_metrics(res, cyc)
 
 
+def actuator_peaks(joint_units, qd: np.ndarray, qdd: np.ndarray, force: np.ndarray) -> dict[str, np.ndarray]:
+    """The actuator peak metrics (``cycle.config.peak_names``) of D designs: qd, qdd, force (D, n, n_joints) ->
+    name -> (D,), the largest |value| over the samples and the actuators of the metric's kind."""
+    units = np.asarray(joint_units)
+    values = {"speed": qd, "accel": qdd, "force": force}
+    out = {}
+    for name, kinds in ccfg.peak_names(joint_units).items():
+        mask = np.isin(units, kinds)
+        out[name] = np.max(np.abs(values[name.split("_")[3]][..., mask]), axis=(1, 2))
+    return out
+
+
 def failed_metrics(mech: Mechanism, options, cyc: ccfg.CycleConfig) -> dict[str, float]:
     """The catalogue metrics of a cycle that cannot be followed (see ``metrics``)."""
-    bad = {"cycle_feasible": 0.0, "cycle_max_actuator_speed": CYCLE_PENALTY,
-           "cycle_max_actuator_accel": CYCLE_PENALTY, "cycle_max_actuator_force": CYCLE_PENALTY,
+    bad = {"cycle_feasible": 0.0, **dict.fromkeys(ccfg.peak_names(mech.joint_units), CYCLE_PENALTY),
            "cycle_min_lci": 0.0, "cycle_min_clearance": -CYCLE_PENALTY}
     if has_deflection(mech, options):
         bad["cycle_max_deflection"] = CYCLE_PENALTY
@@ -476,9 +488,8 @@ def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:
     ok = bool(np.min(res.clearance) >= 0.0 and scale >= 1.0)
     out = {
         "cycle_feasible": float(ok),
-        "cycle_max_actuator_speed": float(np.max(np.abs(res.qd))),
-        "cycle_max_actuator_accel": float(np.max(np.abs(res.qdd))),
-        "cycle_max_actuator_force": float(np.max(np.abs(res.force))),
+        **{k: float(v[0]) for k, v in actuator_peaks(res.joint_units, res.qd[None], res.qdd[None],
+                                                      res.force[None]).items()},
         "cycle_min_lci": float(np.min(res.lci)),
         "cycle_min_clearance": float(min(np.min(res.clearance), CYCLE_PENALTY)),
     }

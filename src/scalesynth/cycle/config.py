@@ -254,11 +254,27 @@ def limit_vector(value, n: int) -> np.ndarray | None:
     return np.full(n, float(value)) if isinstance(value, (int, float)) else np.asarray(value, dtype=float)
 
 
+# actuator kinds by joint unit: a mechanism with both has its peaks per kind (one unit each), never mixed
+ACTUATOR_KINDS = {"angle": "revolute", "length": "prismatic"}
+ACTUATOR_PEAKS = ("speed", "accel", "force")
+
+
+def peak_names(joint_units) -> dict[str, tuple[str, ...]]:
+    """Catalogue name of each actuator peak metric -> the joint kinds ('angle', 'length') it is taken over:
+    ``cycle_max_actuator_speed`` (all actuators) for a mechanism with one actuator kind,
+    ``cycle_max_actuator_speed_revolute`` and ``..._prismatic`` for one with both (a maximum over rad/s and mm/s
+    together would mix units)."""
+    kinds = sorted(set(joint_units))
+    suffixes = {"": tuple(kinds)} if len(kinds) == 1 else {f"_{ACTUATOR_KINDS[k]}": (k,) for k in kinds}
+    return {f"cycle_max_actuator_{peak}{suffix}": ks for peak in ACTUATOR_PEAKS for suffix, ks in suffixes.items()}
+
+
 CYCLE_METRICS = (
     "cycle_feasible",
     "cycle_max_actuator_speed",
     "cycle_max_actuator_accel",
     "cycle_max_actuator_force",
+    *(f"cycle_max_actuator_{peak}_{kind}" for peak in ACTUATOR_PEAKS for kind in ACTUATOR_KINDS.values()),
     "cycle_min_lci",
     "cycle_min_clearance",
     "cycle_max_deflection",

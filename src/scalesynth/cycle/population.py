@@ -194,9 +194,7 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
     min_gap = np.min(gaps, axis=1)
     cols = {
         "cycle_feasible": ((min_gap >= 0.0) & (scale >= 1.0)).astype(float),
-        "cycle_max_actuator_speed": np.max(np.abs(qd), axis=(1, 2)),
-        "cycle_max_actuator_accel": np.max(np.abs(qdd), axis=(1, 2)),
-        "cycle_max_actuator_force": np.max(np.abs(force), axis=(1, 2)),
+        **analysis.actuator_peaks(mech.joint_units, qd, qdd, force),
         "cycle_min_lci": np.min(lci, axis=1),
         "cycle_min_clearance": np.minimum(min_gap, analysis.CYCLE_PENALTY),
     }

@@ -375,6 +375,17 @@ class Mechanism(ABC):
     def measure_key(self, length_unit: str) -> str:
         return f"{self.measure_name()}_{self.measure_unit(length_unit)}"
 
+    def length_unit(self, unit: str | None, where: str = "units.length") -> str:
+        """The length unit every number of this mechanism is in: ``unit`` if it names that unit, the mechanism's
+        own unit when None. Any other unit is refused (InvalidParameter naming ``where``): the kernels, defaults
+        and options are in the mechanism's own unit and nothing converts them, so another name would only relabel
+        the numbers (issue 27)."""
+        if unit is None or unit == self.default_length_unit:
+            return self.default_length_unit
+        raise InvalidParameter(f"{where}: {self.name} computes in {self.default_length_unit}, not {unit!r}; "
+                               f"lengths are not converted, so give every length in {self.default_length_unit} "
+                               f"(units.length: {self.default_length_unit})")
+
     def check_vector(self, what: str, values, expected: int) -> np.ndarray:
         arr = np.asarray(values, dtype=float)
         if arr.shape != (expected,) or not np.all(np.isfinite(arr)):

@@ -55,8 +55,6 @@ from scalesynth.stiffness import legs as _legs_k
 from scalesynth.stiffness.sections import check_positive_option, check_stiffness_options, stiffness_options
 
 SQRT3_2 = math.sqrt(3.0) / 2.0
-# spec §1.8 search box (mm); bounding_box never extends beyond it
-SPEC_BOX = (np.array([-300.0, -300.0, 0.0]), np.array([300.0, 300.0, 500.0]))
 # fraction of the y span added on each side of bounding_box's y range where both y faces come from the w2 limits
 # (irrational: see bounding_box)
 Y_PAD = (math.sqrt(5.0) - 1.0) / 40.0
@@ -1089,10 +1087,12 @@ class PprsRprs(Mechanism):
         return options["sigma"]
 
     def bounding_box(self, design, options):
-        """Box of O1 implied by the actuator limits at the fixed orientation, intersected with the spec §1.8
-        box. x: u1.C1 = x + r1x is w1 (or R - w1); y: from u2.C2 (w2) given x, and |lambda1| = |y + r1y| <= L1,
-        widened by Y_PAD (3.09 %) of its span on each side where both y faces come from w2; z: z_Ci = s_i +
-        sigma_i kappa_i with 0 <= kappa_i <= L_i, for chains 1 and 2."""
+        """Box of O1 implied by the actuator limits at the fixed orientation (it holds every reachable position,
+        so no other box clips it: the spec §1.8 search box, +-300 x +-300 x 0-500 mm, once did, and a design
+        beyond it read volume 0, issue 27; grid.region clips on purpose). x: u1.C1 = x + r1x is w1 (or R - w1);
+        y: from u2.C2 (w2) given x, and |lambda1| = |y + r1y| <= L1, widened by Y_PAD (3.09 %) of its span on
+        each side where both y faces come from w2; z: z_Ci = s_i + sigma_i kappa_i with 0 <= kappa_i <= L_i, for
+        chains 1 and 2."""
         geo = Geometry.of(design, options)
         rk = geo.body @ rotation(*options["orientation"]).T
         wlo, whi = options["w_limits"]
@@ -1120,8 +1120,8 @@ class PprsRprs(Mechanism):
             lo_k = slo - (geo.links[k] if sig[k] < 0 else 0.0)
             hi_k = shi + (geo.links[k] if sig[k] > 0 else 0.0)
             zlo, zhi = max(zlo, lo_k - rk[k, 2]), min(zhi, hi_k - rk[k, 2])
-        lo = np.maximum(np.array([xlo, ylo, zlo]), SPEC_BOX[0])
-        hi = np.minimum(np.array([xhi, yhi, zhi]), SPEC_BOX[1])
+        lo = np.array([xlo, ylo, zlo])
+        hi = np.array([xhi, yhi, zhi])
         return lo, np.maximum(hi, lo)
 
     # ----- NumPy kinematics ----------------------------------------------------------------------------
