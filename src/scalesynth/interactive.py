@@ -89,12 +89,13 @@ def parallel_figure(pareto: pd.DataFrame, columns: Sequence[str], colour: str, t
     return fig
 
 
-def hypervolume_figure(history: pd.DataFrame, title: str):
+def hypervolume_figure(generations, values, title: str, ylabel: str):
+    """The hypervolume per generation (``values``: normalised by hv_norm, ``ylabel`` saying so)."""
     import plotly.graph_objects as go
 
-    fig = go.Figure(go.Scatter(x=history["generation"], y=history["hypervolume"], mode="lines",
+    fig = go.Figure(go.Scatter(x=np.asarray(generations), y=np.asarray(values, dtype=float), mode="lines",
                                line={"color": PALETTE[0]}, name="hypervolume"))
-    fig.update_layout(title=title, xaxis_title="generation", yaxis_title="hypervolume")
+    fig.update_layout(title=title, xaxis_title="generation [-]", yaxis_title=ylabel)
     return fig
 
 
@@ -158,9 +159,12 @@ def heatmap_figure(panel: dict, field_label: str, title: str | None = None, vmin
         fig.add_shape(type="rect", x0=bx0, x1=bx1, y0=by0, y1=by1, line={"color": PALETTE[3], "dash": "dash"})
     if panel.get("path") is not None:
         p = np.asarray(panel["path"])
-        fig.add_trace(go.Scatter(x=p[:, 0], y=p[:, 1], mode="lines+markers", name="task path",
-                                 line={"color": PALETTE[5]}))
-    fig.update_layout(title=title or panel["title"], xaxis_title=panel["xlabel"], yaxis_title=panel["ylabel"])
+        fig.add_trace(go.Scatter(x=p[:, 0], y=p[:, 1], mode="lines+markers",
+                                 name=panel.get("path_label", "task path"), line={"color": PALETTE[5]}))
+    # the legend below the axes (the colour bar holds the right side): it never covers the map
+    fig.update_layout(title=title or panel["title"], xaxis_title=panel["xlabel"], yaxis_title=panel["ylabel"],
+                      showlegend=panel.get("path") is not None,
+                      legend={"orientation": "h", "x": 0.0, "y": -0.18, "xanchor": "left", "yanchor": "top"})
     if panel.get("equal", False):
         fig.update_yaxes(scaleanchor="x", scaleratio=1)
     return fig
@@ -227,9 +231,8 @@ def show_page(cfg, fg, field, bands, panels, axis_labels, equal, title, box, pat
     for panel in panels:
         blocks.append(figs.html(heatmap_figure(panel, field_label, vmin=vmin, vmax=vmax), 480))
     if robot and "segments" in robot:
-        pose = ", ".join(f"{v:.4g}" for v in robot["pose"])
-        blocks.append(figs.html(robot_figure(robot["segments"], cfg.units.length,
-                                             f"robot at pose ({pose}), branch {robot['branch']}"), 560))
+        blocks.append(figs.html(robot_figure(robot["segments"], cfg.units.length, wv.robot_caption(cfg, robot)),
+                                560))
     elif robot:
         blocks.append(f"<p class=\"note\">Robot not drawn: {_html.escape(robot['missing'])}</p>")
     return page(title, blocks)

@@ -22,6 +22,7 @@ _NAMES = {
     "m_minus_n": "m − n",
     "link_length_sum": "Σ link lengths",
 }
+_DIMENSIONLESS_NAMES = ("gci", "fci", "min_lci", "max_lci", "lci")  # LCI statistics outside a catalogue
 _PREFIXES = ("task_", "path_", "cycle_")  # families whose names are a prefix and a workspace-style name
 _MEASURE = re.compile(r"^(?:(band\d+)_)?(volume|area)_([a-z0-9_]+)$")
 
@@ -43,35 +44,60 @@ def _pretty_name(name: str) -> str:
     return name.replace("_", " ").replace("σ min", "σ_min").replace("σ max", "σ_max")
 
 
-def labeller(cfg):
-    """A function column -> label for a run config: catalogue units for every result column it knows."""
+DIMENSIONLESS = "[-]"  # what an explicit label (report.html) writes for a quantity without a unit
+
+
+def parameter_unit(unit: str, length_unit: str) -> str:
+    """A design parameter's (or derived column's) unit text: 'length' -> the config's length unit, 'angle' ->
+    'rad', '1' -> '' (dimensionless), otherwise the text with {length} filled in."""
+    if unit == "length":
+        return length_unit
+    if unit == "angle":
+        return "rad"
+    return "" if unit in ("1", "") else unit.replace("{length}", length_unit)
+
+
+def labeller(cfg, explicit: bool = False):
+    """A function column -> label for a run config, the one place that names result columns with their units:
+    the metric catalogue's units for every metric column, the mechanism's for its design parameters and derived
+    columns. ``explicit``: a dimensionless quantity says so ('GCI [-]'), so that every axis carries a unit
+    (report.html)."""
     from scalesynth.metrics import catalogue
 
     n_bands = len(cfg.dexterity.band_edges) - 1
+    length = cfg.units.length
     units: dict[str, tuple[str, str]] = {}
-    for m in catalogue(cfg.mech, cfg.units.length).values():
+    for m in catalogue(cfg.mech, length).values():
         for col in m.columns(n_bands):
-            units[col] = (m.name, m.unit)
+            units[col] = (m.name, "" if m.unit in ("1", "") else unit_text(m.unit))
+    for p in cfg.mech.parameters:
+        units.setdefault(p.name, (p.name, unit_text(parameter_unit(p.unit, length))))
+    for col, unit in cfg.mech.derived_units:
+        units.setdefault(col, (col, unit_text(parameter_unit(unit, length))))
 
     def label(column: str) -> str:
-        if column in _NAMES or _MEASURE.match(column) or re.fullmatch(r"band\d+_share", column):
-            return metric_label(column)
-        if column in units:
+        share = re.fullmatch(r"band\d+_share", column) is not None
+        if column in units and not (share or _MEASURE.match(column)):  # measures: 'V of band 2 [m³]'
             name, unit = units[column]
-            base = _name(name)
-            return base if unit in ("1", "") else f"{base} [{unit_text(unit)}]"
-        return metric_label(column)
+            if unit:
+                return f"{_name(name)} [{unit}]"
+            return f"{_name(name)} {DIMENSIONLESS}" if explicit else _name(name)
+        text = metric_label(column)
+        known = column in units or column in _DIMENSIONLESS_NAMES or share
+        return f"{text} {DIMENSIONLESS}" if explicit and known and not text.endswith("]") else text
 
     return label
 
 
-def field_label(mech, name: str, length_unit: str) -> str:
-    """Colour-bar label of a per-voxel field: 'LCI', 'σ_min [mm/rad]'."""
+def field_label(mech, name: str, length_unit: str, explicit: bool = False) -> str:
+    """Colour-bar label of a per-voxel field: 'LCI' (``explicit``: 'LCI [-]'), 'σ_min [mm/rad]'."""
     for f in getattr(mech, "fields", ()):
         if f.name == name:
             unit = f.unit.replace("{length}", length_unit)
             base = _name(name)
-            return base if unit in ("1", "") else f"{base} [{unit_text(unit)}]"
+            if unit in ("1", ""):
+                return f"{base} {DIMENSIONLESS}" if explicit else base
+            return f"{base} [{unit_text(unit)}]"
     return _name(name)
 
 

@@ -121,11 +121,11 @@ def front_figure(
     return fig
 
 
-def hypervolume_figure(generations: np.ndarray, hv: np.ndarray, title: str):
+def hypervolume_figure(generations: np.ndarray, hv: np.ndarray, title: str, ylabel: str = "hypervolume"):
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.plot(generations, hv, c=FRONT)
     ax.set_xlabel("generation")
-    ax.set_ylabel("hypervolume")
+    ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.grid(alpha=0.3)
     fig.tight_layout()
@@ -200,14 +200,15 @@ def sections_figure(panels: Sequence[dict], band_edges: Sequence[float] | None, 
                                        ls="--", label="task box"))
         if panel.get("path") is not None:
             pth = np.asarray(panel["path"])
-            ax.plot(pth[:, 0], pth[:, 1], "-o", c="#CC79A7", lw=1.2, ms=3, label="task path")
-        if panel.get("box") is not None or panel.get("path") is not None:
-            ax.legend(fontsize=7, loc="upper right")
+            ax.plot(pth[:, 0], pth[:, 1], "-o", c="#CC79A7", lw=1.2, ms=3, label=panel.get("path_label", "task path"))
+        n_items = (panel.get("box") is not None) + (panel.get("path") is not None)
+        if n_items:  # above the axes, under the title: a legend inside would cover the map
+            ax.legend(fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.0), frameon=False, borderaxespad=0.3)
         cb = fig.colorbar(im, ax=ax, ticks=edges if edges is not None else None)
         cb.set_label(field_label + (" (band edges marked)" if edges is not None else ""))
         ax.set_xlabel(panel["xlabel"])
         ax.set_ylabel(panel["ylabel"])
-        ax.set_title(panel["title"], fontsize=9)
+        ax.set_title(panel["title"], fontsize=9, pad=8 + 12 * n_items)  # points: room for the legend
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     return fig
@@ -285,7 +286,9 @@ def robot_figure(segments: Sequence[dict], unit: str, title: str, planar: bool, 
         ax.set_zlabel(f"z [{unit}]")
         span = np.ptp(np.array(pts), axis=0) if pts else np.ones(3)
         ax.set_box_aspect(np.where(span > 0, span, max(span.max(), 1.0) * 0.05))
-    ax.legend(fontsize=7, loc="upper left")
+    # the legend right of the axes: inside, it covered links
+    fig.subplots_adjust(left=0.08, right=0.74, top=0.88, bottom=0.08)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.04, 1.0), borderaxespad=0.0)
     ax.set_title(title, fontsize=9)
     return fig
 

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from scalesynth import hv_norm
 from scalesynth import io as rio
 from scalesynth import labels as lab
 from scalesynth.config import RunConfig
@@ -100,9 +101,9 @@ def plot_front(result: RunResult, out: Path | None = None, fmt: str = "png") -> 
     )
     rio.save_figure(fig, plots / f"front.{fmt}")
     plotting.close(fig)
-    fig = plotting.hypervolume_figure(
-        history["generation"].to_numpy(), history["hypervolume"].to_numpy(), f"{cfg.name}: hypervolume per generation"
-    )
+    hv, hv_label = hv_norm.of_result(result)
+    fig = plotting.hypervolume_figure(history["generation"].to_numpy(), hv, f"{cfg.name}: hypervolume per generation",
+                                      hv_label)
     rio.save_figure(fig, plots / f"hypervolume.{fmt}")
     plotting.close(fig)
     files = [_rel(result.out_dir, plots / f"front.{fmt}"), _rel(result.out_dir, plots / f"hypervolume.{fmt}")]
@@ -253,7 +254,7 @@ def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[
             f"{'<= ' + repr(float(c.max)) if c.max is not None else ''}"
             for c, k in zip(cfg.constraints, problem.constraint_keys, strict=True)))
     lines += [
-        f"- final hypervolume: {history['hypervolume'].iloc[-1]:.6g}",
+        f"- final hypervolume: {history['hypervolume'].iloc[-1]:.6g}{hv_norm.share_text(result)}",
         f"- Pareto front: {len(pareto)} designs",
     ]
     if manifest.get("wall_seconds") is not None:

@@ -8,6 +8,7 @@ import html as _html
 from pathlib import Path
 from typing import Any
 
+from scalesynth import hv_norm
 from scalesynth import interactive as ia
 from scalesynth import io as rio
 from scalesynth import labels as lab
@@ -30,10 +31,10 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
     derived = [c for c in pareto.columns if c not in problem.var_names and c not in problem.metric_columns
                and c not in ("rank", "feasible")]
     hover = [c for c in [*problem.var_names, *derived, *problem.metric_columns] if c in pareto.columns]
-    label = lab.labeller(cfg)
+    label = lab.labeller(cfg, explicit=True)  # every axis with a unit, '[-]' where there is none
     figs = ia.Figures()
     title = f"{cfg.name}: scale synthesis of {mech.name}"
-    blocks = [f"<h1>{_html.escape(title)}</h1>", _summary(cfg, problem, pareto, history, manifest, label)]
+    blocks = [f"<h1>{_html.escape(title)}</h1>", _summary(cfg, problem, pareto, history, manifest, label, result)]
     blocks.append("<h2>Pareto front</h2><p class=\"note\">Hover a point for every design variable and metric.</p>")
     if len(pareto):
         blocks.append(figs.html(ia.front_figure(pareto, population, xk, yk, hover, featured,
@@ -45,7 +46,9 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
     else:
         blocks.append("<p>The front is empty: no feasible design.</p>")
     blocks.append("<h2>Hypervolume</h2>")
-    blocks.append(figs.html(ia.hypervolume_figure(history, "hypervolume per generation"), 380))
+    hv, hv_label = hv_norm.of_result(result)
+    blocks.append(figs.html(ia.hypervolume_figure(history["generation"], hv, "hypervolume per generation", hv_label),
+                            380))
     if featured:
         blocks.append("<h2>Featured designs</h2>")
         cols = [c for c in [*problem.var_names, *problem.objective_keys, "gci"] if c in pareto.columns]
@@ -57,13 +60,14 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
         axis_labels = [lab.axis_label(mech, a, unit) for a in range(ndim)]
         equal = lab.same_units(mech, range(ndim))
         box, path = wv.task_geometry(cfg)
+        lci_label = lab.field_label(mech, "lci", unit, explicit=True)
         for name, i in featured:
             design = result.design_of(pareto.iloc[i])
             fg = wv.sample_fields(cfg, design, VIEW_RESOLUTION if ndim == 3 else max(cfg.grid.resolution, 96))
             caption = f"{name}: " + ", ".join(f"{k}={v:.4g}" for k, v in design.items())
             if ndim == 3:
                 pts, flat = wv.boundary_points(fg.reachable, fg.axes(), ia.MAX_POINTS_3D)
-                fig = ia.workspace_figure(pts, fg.lci.ravel()[flat], axis_labels, "LCI",
+                fig = ia.workspace_figure(pts, fg.lci.ravel()[flat], axis_labels, lci_label,
                                           f"{caption} (workspace boundary, {VIEW_RESOLUTION}³ grid)", equal, box, path)
                 blocks.append(figs.html(fig, 600))
             else:
@@ -73,11 +77,11 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
                          "ylabel": axis_labels[1], "title": caption, "equal": equal,
                          "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
                          "path": None if path is None else path[:, :2]}
-                blocks.append(figs.html(ia.heatmap_figure(panel, "LCI"), 520))
+                blocks.append(figs.html(ia.heatmap_figure(panel, lci_label), 520))
             if "deflection" in wv.stiffness_map_fields(cfg):  # the stiffness map: the sections coloured by deflection
                 panels = wv.section_panels(cfg, design, "deflection")
                 vmin, vmax = wv.map_range(panels)
-                flabel = lab.field_label(mech, "deflection", unit)
+                flabel = lab.field_label(mech, "deflection", unit, explicit=True)
                 for panel in panels:
                     blocks.append(figs.html(ia.heatmap_figure(panel, flabel, f"{caption}: {flabel}, {panel['title']}",
                                                               vmin, vmax), 520))
@@ -91,7 +95,7 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
     return target
 
 
-def _summary(cfg, problem, pareto, history, manifest, label) -> str:
+def _summary(cfg, problem, pareto, history, manifest, label, result) -> str:
     objectives = ", ".join(f"{o.sense} {label(k)}"
                            for o, k in zip(cfg.objectives, problem.objective_keys, strict=True))
     items = [
@@ -100,7 +104,8 @@ def _summary(cfg, problem, pareto, history, manifest, label) -> str:
         f"workspace: {evaluator_description(cfg)}; dexterity bands "
         + ", ".join(wv.band_labels(cfg.dexterity.band_edges)),
         f"objectives: {objectives}",
-        f"final hypervolume {float(history['hypervolume'].iloc[-1]) if len(history) else 0.0:.6g}; "
+        f"final hypervolume {float(history['hypervolume'].iloc[-1]) if len(history) else 0.0:.6g}"
+        f"{hv_norm.share_text(result) if len(history) else ''}; "
         f"Pareto front {len(pareto)} designs",
     ]
     if manifest.get("wall_seconds") is not None:

@@ -50,10 +50,14 @@ def resolve_design(cfg, result, choice: str | None) -> tuple[dict[str, float], s
     return result.design_of(result.pareto.iloc[row]), label, row
 
 
-def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[list[dict], list[dict]]:
-    """Sections normal to each task axis of a 3-D mechanism (the whole map of a planar one), through the point
-    ``at`` (default: the centroid; an empty default plane moves to the nearest plane that cuts the workspace).
-    Returns (figure panels, their descriptions for show.json)."""
+def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float],
+             design: dict[str, float] | None = None) -> tuple[list[dict], list[dict]]:
+    """Sections normal to each task axis of a 3-D mechanism (the whole map of a planar one). Each plane goes where
+    ``--at`` puts it (the nearest grid plane), else through the task (wv.task_section_point: the task path's own
+    coordinate, else the task box centre; sampled exactly there, from ``design``), else through the workspace
+    centroid (an empty centroid plane moves to the nearest plane that cuts the workspace). The task or cycle path
+    is drawn in its true coordinates, its legend saying where it lies along the plane's normal. Returns (figure
+    panels, their descriptions for show.json)."""
     mech = cfg.mech
     unit = cfg.units.length
     values = fg.fields[field]
@@ -61,37 +65,51 @@ def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[l
     g = fg.grid
     ext = [(float(g.lo[a]), float(g.lo[a] + g.shape[a] * g.step[a])) for a in range(3)]
     box, path = wv.task_geometry(cfg)
+    kind = "task path"
     if path is None:
-        path = wv.cycle_path(cfg)
+        path, kind = wv.cycle_path(cfg), "cycle path"
     if mech.planar:
         panel = {"values": values[:, :, 0], "extent": (*ext[0], *ext[1]), "xlabel": lab.axis_label(mech, 0, unit),
                  "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
                  "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
-                 "path": None if path is None else path[:, :2]}
+                 "path": None if path is None else path[:, :2], "path_label": kind}
         return [panel], [{"normal": None, "cells": int(fg.reachable.sum())}]
     c = wv.centroid(fg)
+    at_task = wv.task_section_point(cfg) if design is not None else None
     panels, info = [], []
     for normal in range(3):
         requested = at.get(normal)
-        i, moved = wv.nearest_nonempty(fg, normal, c[normal] if requested is None else requested)
         if requested is not None:  # the user's plane stays where it was asked for, even if empty
-            i, moved = int(np.argmin(np.abs(axes[normal] - requested))), False
+            i = int(np.argmin(np.abs(axes[normal] - requested)))
+            plane, pos, source = np.take(values, i, axis=normal), float(axes[normal][i]), "--at"
+        elif at_task is not None:  # the task's plane, sampled exactly there, even where it misses the workspace
+            pos, source = round(float(at_task[0][normal]), 10) + 0.0, at_task[1][normal]
+            plane, _ = wv.sample_plane(cfg, design, normal, pos, g.shape[0], field)
+            if field == "lci":
+                plane = np.where(plane >= 0, plane, np.nan)
+        else:
+            i, moved = wv.nearest_nonempty(fg, normal, c[normal])
+            plane, pos = np.take(values, i, axis=normal), float(axes[normal][i])
+            source = "centroid, moved to the nearest non-empty plane" if moved else "centroid"
         a, b = [x for x in range(3) if x != normal]
-        plane = np.take(values, i, axis=normal)
         cells = int(np.isfinite(plane).sum())
-        pos = float(axes[normal][i])
         name = lab.axis_name(mech.task_axes[normal])
         title = f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at {name} = {pos:.4g}"
+        if source != "--at":
+            title += f" ({source.split(',')[0]})"
+        if not cells:
+            title += ": no reachable cell"
         panel = {"values": plane, "extent": (*ext[a], *ext[b]), "xlabel": lab.axis_label(mech, a, unit),
-                 "ylabel": lab.axis_label(mech, b, unit), "title": title, "equal": lab.same_units(mech, (a, b))}
+                 "ylabel": lab.axis_label(mech, b, unit), "title": title, "equal": lab.same_units(mech, (a, b)),
+                 "normal": normal, "position": pos, "source": source}
         if box is not None and box[0, normal] <= pos <= box[1, normal]:
             panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
         if path is not None:
             panel["path"] = path[:, [a, b]]
+            panel["path_label"] = wv.path_label(cfg, path, normal, kind)
         panels.append(panel)
-        info.append({"normal": mech.task_axes[normal], "value": pos, "cells": cells,
-                     "source": "--at" if requested is not None else ("centroid, moved to the nearest non-empty plane"
-                                                                      if moved else "centroid")})
+        info.append({"normal": mech.task_axes[normal], "value": pos, "cells": cells, "source": source,
+                     **({"path": panel["path_label"]} if path is not None else {})})
     return panels, info
 
 
@@ -128,7 +146,7 @@ def show_design(
     ndim = len(mech.task_axes)
     edges = cfg.dexterity.band_edges
     bands = wv.band_regions(fg, edges, ndim)
-    panels, section_info = sections(cfg, fg, field, at_axes)
+    panels, section_info = sections(cfg, fg, field, at_axes, chosen)
     unit = cfg.units.length
     axis_labels = [lab.axis_label(mech, a, unit) for a in range(ndim)]
     equal = lab.same_units(mech, range(ndim))
@@ -157,8 +175,15 @@ def show_design(
         "cycle_path_points": None if wv.cycle_path(cfg) is None else int(len(wv.cycle_path(cfg)) - 1),
         "files": [],
     }
-    pose_values = wv.default_pose(fg, ndim) if pose is None else _parse_pose(pose, mech)
-    summary["robot"] = wv.robot(cfg, chosen, pose_values)
+    if pose is None:
+        pose_values, pose_source = wv.robot_pose(cfg, chosen, fg)
+    else:
+        pose_values, pose_source = _parse_pose(pose, mech), "--pose"
+    if pose_values is None:
+        summary["robot"] = {"pose": None, "pose_source": pose_source, "missing": "no reachable pose: the workspace "
+                            "is empty at this resolution"}
+    else:
+        summary["robot"] = {**wv.robot(cfg, chosen, pose_values), "pose_source": pose_source}
     title = f"{mech.name} {label}: " + ", ".join(f"{k}={v:.4g}" for k, v in chosen.items())
     files = _write_views(cfg, fg, field, bands, panels, axis_labels, equal, title, target, fmt, summary["robot"])
     summary["files"] = files
@@ -205,9 +230,8 @@ def _robot_view(cfg, robot: dict, target: Path, fmt: str, title: str) -> list[st
     label = "task path"
     if path is None:
         path, label = wv.cycle_path(cfg), "cycle path"
-    pose = ", ".join(f"{lab.axis_name(a)}={v:.4g}" for a, v in zip(mech.task_axes, robot["pose"], strict=True))
-    fig = plotting.robot_figure(robot["segments"], cfg.units.length, f"{title}\nrobot at {pose} "
-                                f"(branch {robot['branch']})", mech.planar, path if cartesian else None, label)
+    fig = plotting.robot_figure(robot["segments"], cfg.units.length, f"{title}\n{wv.robot_caption(cfg, robot)}",
+                                mech.planar, path if cartesian else None, label)
     rio.save_figure(fig, target / f"robot.{fmt}")
     plotting.close(fig)
     return [f"robot.{fmt}"]

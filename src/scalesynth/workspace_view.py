@@ -210,6 +210,90 @@ def task_geometry(cfg):
     return box, path
 
 
+# ----- where sections go with a task ---------------------------------------------------------------------------------
+def task_section_point(cfg) -> tuple[np.ndarray, list[str]] | None:
+    """Where sections go when the config has a task: per task axis, the task path's own coordinate where the path
+    is level along that axis (all its points share it: a path at one height gets its xy section at that height),
+    otherwise the task box centre. Returns (point (3,), per task axis the source: 'task path' or 'task box
+    centre'), or None without a task."""
+    box, path = task_geometry(cfg)
+    if box is None:
+        return None
+    point = 0.5 * (box[0] + box[1])
+    sources = []
+    for a in range(len(cfg.mech.task_axes)):
+        if path is not None and np.ptp(path[:, a]) <= 1e-9 * max(1.0, float(np.abs(path[:, a]).max())):
+            point[a] = float(path[0, a])
+            sources.append("task path")
+        else:
+            sources.append("task box centre")
+    return point, sources
+
+
+def path_label(cfg, path: np.ndarray, normal: int | None, kind: str = "task path") -> str:
+    """Legend text of a path drawn on a section normal to task axis ``normal``: where the path lies along that
+    axis ('task path at z = 0.4 m', or 'task path, z 0.3 to 0.5 m (projected)'); planar maps: ``kind`` alone."""
+    if normal is None:
+        return kind
+    name = lab.axis_name(cfg.mech.task_axes[normal])
+    unit = lab.axis_unit(cfg.mech, normal, cfg.units.length)
+    lo, hi = float(np.min(path[:, normal])), float(np.max(path[:, normal]))
+    if hi - lo <= 1e-9 * max(1.0, abs(lo), abs(hi)):
+        return f"{kind} at {name} = {lo:.4g} {unit}"
+    return f"{kind}, {name} {lo:.4g} to {hi:.4g} {unit} (projected)"
+
+
+def _packed_cells(cfg, design: Mapping[str, float], lo, step, shape) -> np.ndarray:
+    mech = cfg.mech
+    return _grid.sample_fields(mech.field_kernel, mech.n_fields, _packed(cfg, design), np.asarray(lo, dtype=float),
+                               np.asarray(step, dtype=float), np.asarray(shape, dtype=np.int64))
+
+
+def reachable_points(cfg, design: Mapping[str, float], points: np.ndarray) -> np.ndarray:
+    """True where the field kernel reaches a task point (rows of ``points``, task coordinates padded to 3): the
+    same test as the workspace's cells (LCI >= 0), each point evaluated on its own."""
+    ndim = len(cfg.mech.task_axes)
+    out = np.zeros(len(points), dtype=bool)
+    step = np.ones(3)
+    for k, p in enumerate(np.asarray(points, dtype=float)):
+        lo = np.zeros(3)
+        lo[:ndim] = p[:ndim] - 0.5
+        out[k] = _packed_cells(cfg, design, lo, step, (1, 1, 1))[0, 0, 0, 0] >= 0
+    return out
+
+
+TASK_POSE_CELLS = 8  # cells per axis of the task box searched for a reachable pose when its centre is not
+
+
+def task_pose(cfg, design: Mapping[str, float]) -> tuple[np.ndarray, str] | None:
+    """A reachable point of the config's task to draw the robot at: the first reachable vertex of the task path,
+    else the task box centre, else the reachable cell of a TASK_POSE_CELLS grid over the task box nearest its
+    centre (distance in box widths). Returns (pose (ndim,), what it is), or None when no such point is reachable
+    (or there is no task)."""
+    box, path = task_geometry(cfg)
+    if box is None:
+        return None
+    ndim = len(cfg.mech.task_axes)
+    centre = 0.5 * (box[0] + box[1])
+    named = [(p, f"task path point {k + 1}") for k, p in enumerate(path)] if path is not None else []
+    named.append((centre, "task box centre"))
+    ok = reachable_points(cfg, design, np.array([p for p, _ in named]))
+    for (p, what), hit in zip(named, ok, strict=True):
+        if hit:
+            return p[:ndim].copy(), what
+    shape = np.array([TASK_POSE_CELLS] * ndim + [1] * (3 - ndim), dtype=np.int64)
+    lo, step = np.zeros(3), np.ones(3)
+    lo[:ndim] = box[0, :ndim]
+    step[:ndim] = (box[1, :ndim] - box[0, :ndim]) / TASK_POSE_CELLS
+    lci = _packed_cells(cfg, design, lo, step, shape)[..., 0]
+    idx = np.argwhere(lci >= 0)
+    if not len(idx):
+        return None
+    centres = lo + (idx + 0.5) * step
+    k = int(np.argmin((((centres - centre) / step)[:, :ndim] ** 2).sum(axis=1)))
+    return centres[k, :ndim], "reachable task cell nearest the task box centre"
+
+
 # ----- choosing a design of a run ----------------------------------------------------------------------------------
 def choose_row(result, choice: str) -> tuple[int, str]:
     """Row of a run's pareto.csv for ``choice``: 'knee', 'best-<metric>' (a column of pareto.csv, or 'volume'/'area'
@@ -277,17 +361,34 @@ def cycle_path(cfg) -> np.ndarray | None:
     return np.pad(v, ((0, 0), (0, 3 - v.shape[1])))[:, :3]
 
 
-def default_pose(fg: FieldGrid, ndim: int) -> np.ndarray:
-    """The reachable grid node nearest to the workspace centroid (task coordinates, ``ndim`` entries)."""
-    c = centroid(fg)
+def default_pose(fg: FieldGrid, ndim: int, near: np.ndarray | None = None) -> np.ndarray | None:
+    """The reachable grid node nearest to ``near`` (default: the workspace centroid), in task coordinates
+    (``ndim`` entries); None for an empty workspace (no pose is reachable)."""
+    c = centroid(fg) if near is None else np.pad(np.asarray(near, dtype=float)[:3], (0, 3 - min(len(near), 3)))
     idx = np.argwhere(fg.reachable)
     if not len(idx):
-        return c[:ndim]
+        return None
     axes = fg.axes()
     pts = np.column_stack([axes[a][idx[:, a]] for a in range(3)])
     span = np.where(fg.grid.step > 0, fg.grid.step, 1.0)  # distance in cells: axes of different units
     k = int(np.argmin((((pts - c) / span) ** 2).sum(axis=1)))
     return pts[k, :ndim]
+
+
+def robot_pose(cfg, design: Mapping[str, float], fg: FieldGrid) -> tuple[np.ndarray | None, str]:
+    """Where ``show`` draws the robot by default, and what that pose is: a reachable point of the task when the
+    config has one (task_pose), else the reachable grid node nearest the task box centre (no point of the task is
+    reachable) or, without a task, nearest the workspace centroid; never an unreachable pose (None: the
+    workspace is empty)."""
+    ndim = len(cfg.mech.task_axes)
+    box, _ = task_geometry(cfg)
+    if box is not None:
+        found = task_pose(cfg, design)
+        if found is not None:
+            return found
+        pose = default_pose(fg, ndim, 0.5 * (box[0] + box[1]))
+        return pose, "no point of the task is reachable: the reachable grid node nearest the task box centre"
+    return default_pose(fg, ndim), "the reachable grid node nearest the workspace centroid"
 
 
 def robot(cfg, design, pose) -> dict[str, Any]:
@@ -314,6 +415,13 @@ def robot(cfg, design, pose) -> dict[str, Any]:
     return {"pose": pose, "branch": sol.label, "segments": segs}
 
 
+def robot_caption(cfg, robot: dict) -> str:
+    """'robot at x=0.1, y=0, z=0.4 (task path point 1), branch ++': the pose, where it comes from, the branch."""
+    pose = ", ".join(f"{lab.axis_name(a)}={v:.4g}" for a, v in zip(cfg.mech.task_axes, robot["pose"], strict=True))
+    source = robot.get("pose_source")
+    return f"robot at {pose}{f' ({source})' if source else ''}, branch {robot['branch']}"
+
+
 # ----- report sections (report.md and report.html) ------------------------------------------------------------------
 # per-voxel fields drawn as their own section maps in a run's report, when the mechanism has them
 STIFFNESS_MAP_FIELDS = ("deflection", "stiffness_min")
@@ -330,10 +438,13 @@ def stiffness_map_fields(cfg) -> tuple[str, ...]:
 
 def section_panels(cfg, design: dict[str, float], field: str = "lci") -> list[dict[str, Any]]:
     """Workspace sections coloured by a per-voxel field (default LCI), each sampled on its plane only (never a full
-    grid): for a 3-D mechanism the planes normal to its second and third task axes through the workspace centroid
-    (from a coarse grid; an empty plane moves to the nearest one that cuts the workspace), for seed 000 the xz and
-    xy sections; one map for planar mechanisms. Axis labels carry units; axes of different units are not drawn to
-    equal scale."""
+    grid): for a 3-D mechanism the planes normal to its second and third task axes, for seed 000 the xz and xy
+    sections; one map for planar mechanisms. With a task the planes go through it (task_section_point: the task
+    path's own height, else the task box centre) and the task path is drawn in its true coordinates, its legend
+    saying where it lies along the plane's normal; without one through the workspace centroid (from a coarse grid;
+    an empty plane moves to the nearest one that cuts the workspace). Each panel records its ``normal`` (task
+    axis), ``position`` and ``source``. Axis labels carry units; axes of different units are not drawn to equal
+    scale."""
     mech = cfg.mech
     unit = cfg.units.length
     res = max(cfg.grid.resolution, SECTION_RESOLUTION)
@@ -343,8 +454,12 @@ def section_panels(cfg, design: dict[str, float], field: str = "lci") -> list[di
         return [{"values": values, "extent": ext, "xlabel": lab.axis_label(mech, 0, unit),
                  "ylabel": lab.axis_label(mech, 1, unit), "title": "workspace", "equal": lab.same_units(mech, (0, 1)),
                  "box": None if box is None else (box[0, 0], box[1, 0], box[0, 1], box[1, 1]),
-                 "path": None if path is None else path[:, :2]}]
-    point = default_section_point(cfg, design)
+                 "path": None if path is None else path[:, :2], "normal": None}]
+    at_task = task_section_point(cfg)
+    if at_task is None:
+        point, sources = default_section_point(cfg, design), ["centroid"] * 3
+    else:
+        point, sources = at_task
     panels = []
     for normal in (1, 2):
         a, b = [x for x in range(3) if x != normal]
@@ -354,9 +469,13 @@ def section_panels(cfg, design: dict[str, float], field: str = "lci") -> list[di
         panel = {"values": values, "extent": ext, "xlabel": lab.axis_label(mech, a, unit),
                  "ylabel": lab.axis_label(mech, b, unit), "equal": lab.same_units(mech, (a, b)),
                  "title": f"{lab.axis_name(mech.task_axes[a])}{lab.axis_name(mech.task_axes[b])} section at "
-                          f"{name} = {point[normal]:.4g} (centroid)"}
+                          f"{name} = {point[normal]:.4g} ({sources[normal]})",
+                 "normal": normal, "position": float(point[normal]), "source": sources[normal]}
         if box is not None and box[0, normal] <= point[normal] <= box[1, normal]:
             panel["box"] = (box[0, a], box[1, a], box[0, b], box[1, b])
+        if path is not None:
+            panel["path"] = path[:, [a, b]]
+            panel["path_label"] = path_label(cfg, path, normal)
         panels.append(panel)
     return panels
 

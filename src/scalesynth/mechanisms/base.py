@@ -130,6 +130,9 @@ class Mechanism(ABC):
     default_length_unit: str = "m"
     fields: tuple[Field, ...] = field(default_factory=tuple)  # slots of the field kernel; starts with base_fields
     design_metrics: tuple[DesignMetric, ...] = field(default_factory=tuple)
+    # (column, unit) of each derived_columns entry, unit as Parameter.unit ('length', 'angle', '1' or a text with
+    # {length}); the labels of plots and report.html read them. A tuple: the mechanism stays hashable
+    derived_units: tuple[tuple[str, str], ...] = ()
 
     @property
     def n_fields(self) -> int:

@@ -1071,6 +1071,7 @@ MECHANISM = PauuPpap(
     fields=(*base_fields("{length}/rad", "J = dx/dq (q = theta1, theta2 in rad and d: the d column is "
                          "dimensionless; not rescaled, as in the LCI)"), CLEARANCE, *STIFFNESS_FIELDS),
     design_metrics=DESIGN_METRICS,
+    derived_units=(("m_minus_n", "length"),),
 )
 assert MECHANISM.n_fields == N_KERNEL_FIELDS and MECHANISM.field_names[_F_CLEARANCE] == "clearance"
 assert MECHANISM.field_names[_F_STIFFNESS_MIN :] == ("stiffness_min", "deflection")
