@@ -1,0 +1,69 @@
+"""What pinning Numba's CPU target costs: the same kernels compiled for the host CPU, plain x86-64 and x86-64-v3.
+
+Each target runs in its own process with its own Numba cache (compiled once, then timed warm), rounds alternating
+so the machine's load falls on every target alike. Timed: 2pauu-ppap's uniform evaluator (8 designs, N = 72,
+3 calls) and ups-sspr's adaptive evaluator (one design, 20 calls), CPU seconds, one Numba thread.
+
+    python benchmarks/cpu_target.py [ROUNDS]
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+
+PROBE = r"""
+import json, time
+import numpy as np
+from scalesynth.evaluate import Tolerance, adaptive_population_stats, make_grid
+from scalesynth.kernels import grid as kgrid
+from scalesynth.mechanisms import get
+from scalesynth.numba_target import describe
+
+out = {"target": describe()["cpu_name"]}
+e = np.array([0.0, 0.3, 1.0])
+m = get("2pauu-ppap")
+d, o = m.default_design(), m.resolve_options({})
+g = make_grid(m, d, o, 72)
+p = np.repeat(m.pack(d, o)[None, :], 8, axis=0)
+lo, st = np.repeat(g.lo[None, :], 8, axis=0), np.repeat(g.step[None, :], 8, axis=0)
+kgrid.population_stats(m.field_kernel, m.n_fields, p[:1], lo[:1], st[:1], g.shape, e)
+t = time.process_time()
+for _ in range(3):
+    kgrid.population_stats(m.field_kernel, m.n_fields, p, lo, st, g.shape, e)
+out["2pauu-ppap uniform N=72, 24 designs (CPU s)"] = round(time.process_time() - t, 3)
+m = get("ups-sspr")
+d, o = m.resolve_design({}), m.resolve_options({})
+pk = m.pack(d, o)[None, :]
+adaptive_population_stats(m, [d], o, pk, Tolerance(), e)
+t = time.process_time()
+for _ in range(20):
+    adaptive_population_stats(m, [d], o, pk, Tolerance(), e)
+out["ups-sspr adaptive, 20 calls (CPU s)"] = round(time.process_time() - t, 4)
+print(json.dumps(out))
+"""
+
+
+def _host() -> dict[str, str]:
+    import llvmlite.binding as ll
+
+    return {"NUMBA_CPU_NAME": ll.get_host_cpu_name(), "NUMBA_CPU_FEATURES": ll.get_host_cpu_features().flatten()}
+
+
+def main(rounds: int) -> None:
+    targets = {"host": _host(), "x86-64": {"NUMBA_CPU_NAME": "x86-64", "NUMBA_CPU_FEATURES": ""},
+               "x86-64-v3 (pinned)": {"NUMBA_CPU_NAME": "x86-64-v3", "NUMBA_CPU_FEATURES": ""}}
+    with tempfile.TemporaryDirectory() as tmp:
+        for rnd in range(rounds + 1):  # round 0 compiles
+            for label, extra in targets.items():
+                env = dict(os.environ, NUMBA_NUM_THREADS="1", NUMBA_CACHE_DIR=os.path.join(tmp, label), **extra)
+                out = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True,
+                                     timeout=1800, check=True)
+                if rnd:
+                    print(label, out.stdout.strip().splitlines()[-1], flush=True)
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 2)
