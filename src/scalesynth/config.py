@@ -530,14 +530,17 @@ def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConf
 def read_limited(path: Path, limit: int) -> str:
     """The UTF-8 text of a file of at most ``limit`` bytes; ConfigError (one line) for a larger one, checked by its
     size before reading and by reading at most ``limit + 1`` bytes (a sparse or growing file is never read whole)."""
-    too_big = f"{path}: more than the {limit} bytes a config may have"
+    def too_big(size: str) -> ConfigError:
+        return ConfigError(f"{path}: {size} bytes, more than the {limit} a config may have")
+
     try:
         with open(path, "rb") as fh:
-            if os.fstat(fh.fileno()).st_size > limit:
-                raise ConfigError(too_big)
+            size = os.fstat(fh.fileno()).st_size
+            if size > limit:
+                raise too_big(str(size))
             data = fh.read(limit + 1)
         if len(data) > limit:
-            raise ConfigError(too_big)
+            raise too_big(f"{limit + 1} or more")
         return data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as err:
         raise ConfigError(f"{path}: cannot read ({err.__class__.__name__})") from None
