@@ -254,12 +254,12 @@ def test_ci_workflow_runs_a_small_batch_and_uploads_its_directory(root):
 def test_unreachable_scheduler_is_a_one_line_error_exit_1(tmp_path, monkeypatch):
     from scalesynth import cluster
 
-    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(cluster, "CONNECT_SECONDS", 1.0)
     cfg_path = _write(tmp_path / "alpha.yaml", ALPHA)
     t0 = time.monotonic()
     r = CliRunner().invoke(app, ["batch", str(cfg_path), "--out", str(tmp_path / "out"),
                                  "--scheduler", "tcp://127.0.0.1:9"])
-    assert time.monotonic() - t0 < 30  # bounded by CONNECT_TIMEOUT (1 s here), not dask's retries forever
+    assert time.monotonic() - t0 < 30  # bounded by CONNECT_SECONDS (1 s here), not dask's retries forever
     assert r.exit_code == 1, r.output
     lines = r.output.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: --scheduler tcp://127.0.0.1:9: cannot connect"), lines

@@ -11,17 +11,22 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from scalesynth.config import RunConfig, config_from_dict, load_config
-from scalesynth.evaluate import DEFAULT_BAND_EDGES, WorkspaceReport
-from scalesynth.evaluate import evaluate as _evaluate
-from scalesynth.evaluate import evaluate_config as _evaluate_config
-from scalesynth.mechanisms import available as _available
-from scalesynth.mechanisms import get as _get
-from scalesynth.mechanisms.base import Mechanism
-from scalesynth.optimize import ProgressFn
-from scalesynth.optimize import run as _run
-from scalesynth.results import RunResult
-from scalesynth.results import load as _load_result
+from scalesynth import environment as _environment
+
+_environment.check()  # NUMBA_* before anything imports Numba (one ConfigError line, not an import traceback)
+
+from scalesynth.config import RunConfig, check_grid_arguments, config_from_dict, load_config  # noqa: E402
+from scalesynth.errors import ConfigError  # noqa: E402
+from scalesynth.evaluate import DEFAULT_BAND_EDGES, WorkspaceReport  # noqa: E402
+from scalesynth.evaluate import evaluate as _evaluate  # noqa: E402
+from scalesynth.evaluate import evaluate_config as _evaluate_config  # noqa: E402
+from scalesynth.mechanisms import available as _available  # noqa: E402
+from scalesynth.mechanisms import get as _get  # noqa: E402
+from scalesynth.mechanisms.base import Mechanism  # noqa: E402
+from scalesynth.optimize import ProgressFn  # noqa: E402
+from scalesynth.optimize import run as _run  # noqa: E402
+from scalesynth.results import RunResult  # noqa: E402
+from scalesynth.results import load as _load_result  # noqa: E402
 
 ConfigLike = RunConfig | str | Path | Mapping[str, Any]
 
@@ -67,7 +72,8 @@ def evaluate(
         design: parameter values in the mechanism's length unit (m for 2pauu-ppap, mm for the others; angles in
             rad); missing parameters take the mechanism's defaults (``get_mechanism(name).default_design()``).
         options: working mode, joint limits and the like (``default_options()``); missing ones take defaults.
-        resolution: cells per task axis; the grid spans the mechanism's bounding box of this design, or
+        resolution: cells per task axis, 4 to 1024 as ``grid.resolution`` of a config; the grid spans the
+            mechanism's bounding box of this design, or
             ``region`` ({axis name: [lo, hi]} in task units) for the axes it names.
         band_edges: dexterity band edges in LCI, increasing from 0 to 1; band k is (edges[k], edges[k+1]].
         length_unit: unit of the measure column name (e.g. ``"m"`` gives ``volume_m3``); default the mechanism's.
@@ -87,8 +93,26 @@ def evaluate(
           ``(grid.axis(0)[i], grid.axis(1)[j], grid.axis(2)[k])`` in the units of ``Mechanism.task_axes``, and
           ``grid.cell_measure`` is the measure of one cell, so ``(lci_grid >= 0).sum() * grid.cell_measure`` is the
           workspace measure and the mean of the reachable cells is the GCI.
+
+    Raises:
+        ConfigError (a ``ScalesynthError``), one line naming the argument, for what a config would refuse: a
+        resolution outside 4..1024, a region that is not ``{task axis: [lo, hi]}`` with finite lo < hi, band edges
+        that do not rise from 0 to 1, an unknown length unit, or ``keep_grid`` arrays above the memory limit;
+        ``InvalidParameter`` for a bad design value or option.
     """
-    mech = _get(mechanism) if isinstance(mechanism, str) else mechanism
+    if isinstance(mechanism, str):
+        mech = _get(mechanism)
+    elif isinstance(mechanism, Mechanism):
+        mech = mechanism
+    else:
+        raise ConfigError(f"mechanism: expected a name or a Mechanism, got {type(mechanism).__name__}")
+    check_grid_arguments(mech, resolution, region, band_edges, length_unit)
+    if keep_grid:
+        from scalesynth import memory
+
+        cells = float(resolution) ** len(mech.task_axes)
+        memory.check([("keep_grid", f"the per-voxel fields of a {resolution}-cell grid",
+                       cells * mech.n_fields * memory.F8)])
     return _evaluate(
         mech,
         design or {},

@@ -189,6 +189,14 @@ def main(argv: list[str] | None = None) -> None:
     except ImportError:  # pragma: no cover - older typer on upstream click
         from click import exceptions as click_errors
 
+    from scalesynth import environment
+    from scalesynth.errors import ScalesynthError
+
+    try:
+        environment.check()  # NUMBA_* variables, before any command imports Numba
+    except ScalesynthError as err:
+        typer.echo(f"error: {err}", err=True)
+        sys.exit(err.exit_code)
     try:
         rv = app(args=argv, prog_name="scalesynth", standalone_mode=False)
     except click_errors.NoArgsIsHelpError as err:

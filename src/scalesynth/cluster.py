@@ -18,7 +18,7 @@ from typing import Any
 
 from scalesynth.errors import ConfigError, RunError
 
-CONNECT_TIMEOUT = "20s"  # for --scheduler: how long to try to reach the scheduler
+CONNECT_SECONDS = 20.0  # for --scheduler: every wait to reach the scheduler and hear from it ends within this
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
 _HOST = re.compile(r"^(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+)$")
 # packages whose versions must match between client and workers for byte-identical results (+ scalesynth itself)
@@ -76,16 +76,78 @@ def _dask():
     return distributed
 
 
+def check_protocol(address: str) -> None:
+    """ConfigError (exit 2, one line) naming --scheduler when this installation cannot speak the address's protocol:
+    ucx without distributed-ucxx (dask removed its own UCX support), tls and wss without TLS certificates in the
+    dask configuration (``distributed.comm.tls.*``)."""
+    scheme = address.partition("://")[0]
+    if scheme == "ucx":
+        import importlib.util
+
+        if importlib.util.find_spec("distributed_ucxx") is None:
+            raise ConfigError(f"--scheduler {address}: the ucx protocol is not available here (dask needs the "
+                              "distributed-ucxx package for it); use tcp://")
+    elif scheme in ("tls", "wss"):
+        _dask()
+        from distributed.security import Security
+
+        if Security().get_connection_args("client").get("ssl_context") is None:
+            raise ConfigError(f"--scheduler {address}: the {scheme} protocol needs TLS certificates in the dask "
+                              "configuration (distributed.comm.tls.ca-file, client.cert), and none are set")
+
+
+def probe_scheduler(address: str, seconds: float) -> None:
+    """Connect to ``address`` and ask it for its identity, all within ``seconds``: RunError (exit 1, one line) if it
+    cannot be reached or does not answer in time. dask's own Client bounds only the connection, so a port that
+    accepts and never answers would make it wait for ever."""
+    import asyncio
+    import threading
+
+    from distributed.comm import connect
+
+    async def identity():
+        comm = await connect(address, timeout=seconds)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    outcome: dict[str, Any] = {}
+
+    def run() -> None:  # its own thread and event loop: the caller may be inside one (a notebook)
+        try:
+            outcome["reply"] = asyncio.run(asyncio.wait_for(identity(), seconds))
+        except BaseException as err:  # noqa: BLE001 - reported by the caller
+            outcome["error"] = err
+
+    thread = threading.Thread(target=run, name="scalesynth-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(seconds + 5.0)  # wait_for ends the probe at ``seconds``; the margin covers its clean-up
+    err = outcome.get("error")
+    if thread.is_alive() or isinstance(err, (asyncio.TimeoutError, TimeoutError)):
+        raise RunError(f"--scheduler {address}: no answer within {seconds:g} s (is a dask scheduler listening "
+                       "there?)")
+    if err is not None:
+        from scalesynth.batch_task import one_line
+
+        raise RunError(f"--scheduler {address}: cannot connect ({one_line(err)})")
+    if not isinstance(outcome.get("reply"), dict):
+        raise RunError(f"--scheduler {address}: the answer is not a dask scheduler's")
+
+
 @contextmanager
 def dask_client(scheduler: str | None, n_tasks: int) -> Iterator[Any]:
-    """A dask Client: on the cluster at ``scheduler`` (used as it is; an unreachable one is a RunError after
-    CONNECT_TIMEOUT), else on an embedded LocalCluster of worker processes with ``threads`` threads each and
-    NUMBA_NUM_THREADS = threads, so the machine is not oversubscribed."""
+    """A dask Client: on the cluster at ``scheduler`` (used as it is; one that cannot be reached, or does not answer,
+    within CONNECT_SECONDS is a RunError), else on an embedded LocalCluster of worker processes with ``threads``
+    threads each and NUMBA_NUM_THREADS = threads, so the machine is not oversubscribed."""
     distributed = _dask()
     if scheduler:
         address = check_address(scheduler)
+        check_protocol(address)
+        probe_scheduler(address, CONNECT_SECONDS)
         try:
-            client = distributed.Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
+            client = distributed.Client(address, timeout=f"{CONNECT_SECONDS}s", set_as_default=False)
         except (OSError, TimeoutError, ValueError) as err:
             from scalesynth.batch_task import one_line
 

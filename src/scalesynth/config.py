@@ -7,7 +7,9 @@ Every validation problem becomes a one-line ConfigError that names the field pat
 from __future__ import annotations
 
 import math
+import os
 import re
+import sys
 from pathlib import Path
 from typing import Any, Literal
 
@@ -52,6 +54,7 @@ class GridConfig(_Strict):
             if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
             _magnitude(axis, lo, hi)
+            _width(axis, lo, hi)
         return v
 
     @property
@@ -71,13 +74,32 @@ class GridConfig(_Strict):
 
 
 def _magnitude(key: str, *values: float) -> None:
-    """ValueError naming ``key`` for a value beyond MAX_MAGNITUDE (mechanisms.base: where arithmetic overflows)."""
-    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+    """ValueError naming ``key`` for a value beyond MAX_MAGNITUDE (mechanisms.base: where arithmetic overflows) or
+    a subnormal one (where it underflows)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE, SUBNORMAL, is_subnormal
 
     for v in values:
         if abs(v) > MAX_MAGNITUDE:
             raise ValueError(f"{key}: {v:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth "
                              "computes with (products of such values overflow)")
+        if is_subnormal(v):
+            raise ValueError(f"{key}: {v:g} is {SUBNORMAL}")
+
+
+# A range [lo, hi] must hold more than this many floats: the optimiser's operators (pymoo's SBX and polynomial
+# mutation) divide by hi - lo and by differences of values inside the range, and a grid splits it into cells, so a
+# range of one or two representable numbers gives 0/0 there
+MIN_RANGE_ULPS = 64
+
+
+def _width(key: str, lo: float, hi: float) -> None:
+    """ValueError naming ``key`` for a range too narrow to compute in: fewer than MIN_RANGE_ULPS floats between
+    lo and hi, or a width that is not a normal float."""
+    width = hi - lo
+    ulp = math.ulp(max(abs(lo), abs(hi)))
+    if not width >= MIN_RANGE_ULPS * ulp or width < sys.float_info.min:
+        raise ValueError(f"{key}: the range [{lo!r}, {hi!r}] is too narrow to compute in (width {width:.3g}; "
+                         f"at least {MIN_RANGE_ULPS} float steps, {MIN_RANGE_ULPS * ulp:.3g}, are needed)")
 
 
 class DexterityConfig(_Strict):
@@ -110,6 +132,7 @@ class TaskConfig(_Strict):
             if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
                 raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
             _magnitude(axis, lo, hi)
+            _width(axis, lo, hi)
         return v
 
     @field_validator("path")
@@ -231,6 +254,7 @@ class RunConfig(_Strict):
             if not lo < hi:
                 raise ValueError(f"{key}: lower bound {lo} must be below upper bound {hi}")
             _magnitude(key, lo, hi)
+            _width(key, lo, hi)
         return v
 
     @model_validator(mode="after")
@@ -503,12 +527,58 @@ def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConf
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: no such config file")
+    text = read_limited(path, MAX_YAML_BYTES)
+    return config_from_dict(safe_yaml(text, str(path)), overrides)
+
+
+def read_limited(path: Path, limit: int) -> str:
+    """The UTF-8 text of a file of at most ``limit`` bytes; ConfigError (one line) for a larger one, checked by its
+    size before reading and by reading at most ``limit + 1`` bytes (a sparse or growing file is never read whole)."""
+    def too_big(size: str) -> ConfigError:
+        return ConfigError(f"{path}: {size} bytes, more than the {limit} a config may have")
+
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as fh:
+            size = os.fstat(fh.fileno()).st_size
+            if size > limit:
+                raise too_big(str(size))
+            data = fh.read(limit + 1)
+        if len(data) > limit:
+            raise too_big(f"{limit + 1} or more")
+        return data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as err:
         raise ConfigError(f"{path}: cannot read ({err.__class__.__name__})") from None
-    return config_from_dict(safe_yaml(text, str(path)), overrides)
 
 
 def dump_config(cfg: RunConfig) -> str:
     return yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False)
+
+
+def check_grid_arguments(mech, resolution: Any, region: Any, band_edges: Any, length_unit: Any) -> None:
+    """The grid arguments of the Python API's ``evaluate``, checked as a config checks ``grid.resolution``,
+    ``grid.region``, ``dexterity.band_edges`` and ``units.length``: ConfigError, one line naming the argument."""
+    limit = GridConfig.model_fields["resolution"].metadata
+    lo_res = next(m.ge for m in limit if hasattr(m, "ge"))
+    hi_res = next(m.le for m in limit if hasattr(m, "le"))
+    if isinstance(resolution, bool):
+        raise ConfigError(f"resolution: expected an integer, got {resolution}")
+    if isinstance(resolution, int) and not lo_res <= resolution <= hi_res:
+        raise ConfigError(f"resolution: {resolution} cells per axis is outside {lo_res}..{hi_res}, the grids "
+                          f"scalesynth evaluates (as grid.resolution of a config)")
+    if region is not None and not isinstance(region, dict):
+        try:
+            region = dict(region)
+        except (TypeError, ValueError):
+            raise ConfigError(f"region: expected {{task axis: [lo, hi]}}, got {_quote(region)}") from None
+    if length_unit is not None and length_unit not in LENGTH_UNITS:
+        raise ConfigError(f"length_unit: must be one of {', '.join(LENGTH_UNITS)}, got {_quote(length_unit)}")
+    try:
+        GridConfig.model_validate({"resolution": resolution, "region": region})
+        DexterityConfig.model_validate({"band_edges": band_edges if isinstance(band_edges, list)
+                                        else list(band_edges) if isinstance(band_edges, tuple) else band_edges})
+    except ValidationError as err:
+        raise ConfigError(_one_line(_format_validation_error(err))) from None
+    axes = ", ".join(mech.task_axes)
+    for axis in region or {}:
+        if axis not in mech.task_axes:
+            raise ConfigError(f"region.{_quote(axis)[1:-1]}: not a task axis of {mech.name} ({axes})")

@@ -151,3 +151,18 @@ def evaluate_estimates(cfg) -> list[tuple[str, str, float]]:
 
 def task_map_estimate(resolution: int, field: str = "--resolution") -> list[tuple[str, str, float]]:
     return [(field, f"a {resolution} x {resolution} LCI map", TASK_MAP_BYTES_PER_CELL * float(resolution) ** 2)]
+
+
+# show: per cell, the sampled fields and their NaN-masked copies (2 x 8 bytes per field), the LCI and band index
+# arrays (8 + 8), one int32 region-label array per band kept for the figures, one more for the face count, and
+# boolean masks (about 8)
+SHOW_FIXED_BYTES_PER_CELL = 8 + 8 + 4 + 8
+
+
+def show_estimate(cfg, resolution: int, field: str) -> list[tuple[str, str, float]]:
+    """What ``scalesynth show`` allocates: every per-voxel array of a ``resolution``-cell grid over the task axes."""
+    mech = cfg.mech
+    cells = float(resolution) ** len(mech.task_axes)
+    n_bands = len(cfg.dexterity.band_edges) - 1
+    per_cell = 2 * mech.n_fields * F8 + 4 * n_bands + SHOW_FIXED_BYTES_PER_CELL
+    return [(field, f"the fields of a {resolution}-cell grid ({cells:.3g} cells)", cells * per_cell)]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Sequence
 
 import numpy as np
@@ -31,7 +32,27 @@ def check_polyline(points: list[list[float]], dims: tuple[int, ...] | None = Non
                                  "computes with (products of such values overflow)")
     if closed and all(p == points[0] for p in points):
         raise ValueError("all points coincide: the path has no length")
+    _check_segment_lengths(points, closed)
     return points
+
+
+def _check_segment_lengths(points: list[list[float]], closed: bool) -> None:
+    """Every segment between two different points has a length that is a normal float as the code computes it
+    (np.linalg.norm of the difference): points a denormal apart give a difference whose square underflows, a
+    segment of length 0 that is dropped or divided by (cycle.trajectory, sample_path)."""
+    pts = np.asarray(points, dtype=float)
+    if closed:
+        pts = np.vstack([pts, pts[:1]])
+    diff = np.diff(pts, axis=0)
+    length = np.linalg.norm(diff, axis=1)
+    moving = np.any(diff != 0.0, axis=1)
+    short = np.flatnonzero(moving & ~(length >= sys.float_info.min))
+    if short.size:
+        i = int(short[0])
+        j = (i + 1) % (len(pts) - 1) if closed else i + 1
+        raise ValueError(f"{j}: point {j} is only {float(np.max(np.abs(diff[i]))):.3g} from point {i}, so close "
+                         "that the segment's squared length underflows to 0 (give equal points or points further "
+                         "apart)")
 
 
 def sample_path(points: Sequence[Sequence[float]], samples: int) -> np.ndarray:

@@ -137,6 +137,9 @@ def show_design(
     res = resolution or cfg.grid.resolution
     if not 4 <= res <= 512:
         raise ConfigError(f"--resolution: must be between 4 and 512 cells per axis, got {res}")
+    from scalesynth import memory
+
+    memory.check(memory.show_estimate(cfg, res, "--resolution" if resolution else "grid.resolution"))
     chosen, label, row = resolve_design(cfg, result, design)
     target = Path(out) if out is not None else (run_dir or cfg.output_dir()) / "show" / label
     rio.ensure_dir(target)

@@ -36,13 +36,15 @@ def batch_cmd(
     unfinished ones resumed); write OUT/batch.json and, per config, the combined front and a hypervolume plot.
     The client writes every file: workers need no access to OUT. Exit code 1 if any task failed."""
     from scalesynth.batch import format_table, run_batch
-    from scalesynth.cluster import address_from_file, check_address
+    from scalesynth.cluster import address_from_file, check_address, check_protocol
     from scalesynth.config import load_config
     from scalesynth.errors import ConfigError
 
     if scheduler and scheduler_file:
         raise ConfigError("--scheduler, --scheduler-file: give one of them")
     scheduler = address_from_file(scheduler_file) if scheduler_file else check_address(scheduler) if scheduler else None
+    if scheduler:
+        check_protocol(scheduler)  # one this installation cannot speak: refused before anything is loaded
     loaded = [(str(path), load_config(path, sets)) for path in configs]  # all validated before any task starts
     summary = run_batch(loaded, out, seeds=seeds, scheduler=scheduler, echo=lambda line: typer.echo(line, err=True))
     if as_json:

@@ -37,14 +37,16 @@ METRES_PER_UNIT = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001}
 
 
 def _within_magnitude(*values: float) -> None:
-    """ValueError for a value beyond +-MAX_MAGNITUDE (as every other number of a config)."""
-    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+    """ValueError for a value beyond +-MAX_MAGNITUDE or subnormal (as every other number of a config)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE, SUBNORMAL, is_subnormal
 
     for i, v in enumerate(values):
+        where = f"{i}: " if len(values) > 1 else ""
         if abs(v) > MAX_MAGNITUDE:
-            where = f"{i}: " if len(values) > 1 else ""
             raise ValueError(f"{where}{v:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude scalesynth computes "
                              "with (products of such values overflow)")
+        if is_subnormal(v):
+            raise ValueError(f"{where}{v:g} is {SUBNORMAL}")
 
 
 class CycleConfig(BaseModel):

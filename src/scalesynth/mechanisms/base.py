@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -463,11 +464,24 @@ MAX_MAGNITUDE = 1e12
 
 
 def check_magnitude(field_name: str, value: float) -> float:
-    """``value``, or InvalidParameter naming the field if |value| > MAX_MAGNITUDE (the caller checks finiteness)."""
+    """``value``, or InvalidParameter naming the field if |value| > MAX_MAGNITUDE or if it is subnormal (the caller
+    checks finiteness)."""
     if abs(value) > MAX_MAGNITUDE:
         raise InvalidParameter(f"{field_name}: {value:g} is beyond +-{MAX_MAGNITUDE:g}, the largest magnitude "
                                "scalesynth computes with (products of such values overflow)")
+    if is_subnormal(value):
+        raise InvalidParameter(f"{field_name}: {value:g} is {SUBNORMAL}")
     return value
+
+
+# the message of a subnormal number: every product with it underflows to 0 and a division by it overflows
+SUBNORMAL = (f"subnormal (non-zero below {sys.float_info.min:.4g}, products with it underflow to 0): "
+             "give 0 or a larger number")
+
+
+def is_subnormal(value: float) -> bool:
+    """Whether ``value`` is non-zero and below the smallest normal float in magnitude."""
+    return value != 0.0 and abs(value) < sys.float_info.min
 
 
 def _check_magnitudes(field_name: str, value: Any) -> None:

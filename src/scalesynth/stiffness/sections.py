@@ -16,6 +16,13 @@ from typing import Any
 from scalesynth.errors import InvalidParameter
 from scalesynth.mechanisms.base import Option
 
+# Every positive stiffness input (Young's modulus, tube diameter and wall, actuator stiffness) lies in
+# [SMALLEST, MAX_MAGNITUDE]: the kernels divide by the rigidities (L / EA, L^3 / 3 EI, 1 / k) and multiply the
+# compliances together and by lengths up to MAX_MAGNITUDE, so a tiny positive value (5e-324, a 1e-300 tube whose
+# d^4 underflows to 0) would divide by zero or overflow there. 1e-12 is far below any physical value in any unit.
+SMALLEST = 1e-12
+# a tube wall below this share of its diameter: d^4 - (d - 2 t)^4 loses all its digits (0 for t < ulp(d))
+MIN_WALL_SHARE = 1e-9
 GPA_TO_N_PER_LENGTH2 = {"mm": 1e3, "m": 1e9}  # 1 GPa = 1e3 N/mm^2 = 1e9 N/m^2
 MM_IN = {"mm": 1.0, "m": 1e-3}
 
@@ -58,9 +65,15 @@ def _number(name: str, value: Any) -> float:
 
 
 def _positive(name: str, value: Any) -> float:
+    """A stiffness input in [SMALLEST, MAX_MAGNITUDE] (see SMALLEST: the arithmetic it enters)."""
+    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+
     v = _number(name, value)
     if not (v > 0 and math.isfinite(v)):
         raise InvalidParameter(f"options.{name}: must be a finite number > 0, got {value!r}")
+    if not SMALLEST <= v <= MAX_MAGNITUDE:
+        raise InvalidParameter(f"options.{name}: {v:g} is outside [{SMALLEST:g}, {MAX_MAGNITUDE:g}], the range the "
+                               "stiffness kernels compute with (their divisions and products stay finite there)")
     return v
 
 
@@ -71,6 +84,9 @@ def _tube(name: str, value: Any) -> list[float]:
     t = _positive(f"{name}[1]", value[1])
     if t > d / 2:
         raise InvalidParameter(f"options.{name}: wall {t:g} is more than half the outer diameter {d:g}")
+    if t < MIN_WALL_SHARE * d:
+        raise InvalidParameter(f"options.{name}: wall {t:g} is below {MIN_WALL_SHARE:g} of the outer diameter {d:g} "
+                               "(the section's area and inertia would round to 0)")
     return [d, t]
 
 
