@@ -425,3 +425,24 @@ def test_force_merge_refuses_a_type_clash_before_moving_anything(tmp_path):
         with pytest.raises(RunError, match="pareto.csv: cannot replace a directory"):
             rd.commit()
     assert _snapshot(out) == before
+
+
+def test_resuming_a_forced_run_needs_force_again_and_keeps_the_users_files(tmp_path):
+    """A run forced into the user's directory and stopped: resuming it without --force is refused (the swap would
+    drop the user's report.md and plots/, names a run owns), with --force it moves only its own files in."""
+    from scalesynth.errors import ConfigError, RunError
+
+    mine = _users_directory(tmp_path / "mine")
+    before = _snapshot(mine)
+    cfg = config_from_dict(copy.deepcopy(SMALL))
+    with pytest.raises(RunError, match="stopped after 2 generations"):
+        run(cfg, mine, plots=False, stop_after=2, force=True)
+    with pytest.raises(ConfigError, match="not a scalesynth run directory"):
+        run(cfg, mine, plots=False, resume=True)
+    assert _snapshot(mine) == before
+    run(cfg, mine, plots=False, resume=True, force=True)
+    after = _snapshot(mine)
+    written = set(json.loads(after["manifest.json"])["files"])
+    assert written == {"pareto.csv", "population.csv", "history.csv", "config.yaml", "manifest.json"}
+    assert {k: v for k, v in after.items() if k not in written} == {k: v for k, v in before.items()
+                                                                     if k not in written}

@@ -228,7 +228,7 @@ def run(
     fresh_algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
     algorithm = None
     # ---- run directory (scalesynth.rundir, issue 11): lock the target, write into its staging directory -------
-    with rundir.claim(target, rundir.RUN, force) as claimed:
+    with rundir.claim(target, rundir.RUN, force, resuming=resume) as claimed:
         out = claimed.continued() if resume else None
         ckpt_path = claimed.work / rio.CHECKPOINT
         if out is not None and ckpt_path.exists():

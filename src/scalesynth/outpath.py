@@ -23,10 +23,10 @@ PSEUDO_FILE_SYSTEMS = {
 }
 
 
-def shown(path) -> str:
+def shown(path, limit: int = 80) -> str:
     """A path as a message shows it: the user's text, its start cut when long, so the line stays short."""
     text = str(path)
-    return text if len(text) <= 80 else "..." + text[-77:]
+    return text if len(text) <= limit else "..." + text[3 - limit:]
 
 
 def _fail(option: str, path, problem: str) -> ConfigError:
@@ -43,10 +43,10 @@ def _existing_part(path: Path, option: str, given) -> tuple[Path, list[str]]:
             return cur, missing
         except FileNotFoundError:
             if os.path.lexists(cur):
-                raise _fail(option, given, f"{shown(cur)} is a dangling symbolic link") from None
+                raise _fail(option, given, f"{shown(cur, 50)} is a dangling symbolic link") from None
         except OSError as err:
             if err.errno == errno.ELOOP:
-                raise _fail(option, given, f"symbolic link loop at {shown(cur)}") from None
+                raise _fail(option, given, f"symbolic link loop at {shown(cur, 50)}") from None
             if err.errno == errno.ENOTDIR:
                 raise _fail(option, given, "cannot create output directory (a part of the path is a file)") from None
             if err.errno == errno.ENAMETOOLONG:
@@ -116,4 +116,4 @@ def _check_writable_ancestor(directory: Path, option: str, given) -> None:
     while not cur.exists() and cur.parent != cur:
         cur = cur.parent
     if not os.access(cur, os.W_OK | os.X_OK):
-        raise _fail(option, given, f"cannot create output directory ({shown(cur)} is not writable)")
+        raise _fail(option, given, f"cannot create output directory ({shown(cur, 50)} is not writable)")

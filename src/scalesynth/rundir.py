@@ -196,10 +196,13 @@ class RunDir:
         self.release()
 
 
-def claim(target: Path, output: Output = RUN, force: bool = False, option: str = "--out") -> RunDir:
+def claim(target: Path, output: Output = RUN, force: bool = False, option: str = "--out",
+          resuming: bool = False) -> RunDir:
     """Check ``target`` (``outpath.check_dir``), lock it for this process (RunError naming the holder's pid if
     another run has it), repair a swap that a kill interrupted, and refuse (ConfigError naming ``option``) a
-    directory that is neither empty nor ``output``'s own unless ``force``. Use as ``with claim(target) as rd:``."""
+    directory that is neither empty nor ``output``'s own unless ``force``. ``resuming``: a target with an unfinished
+    run's checkpoint (staged beside it, or inside it from scalesynth < 0.2) counts as the run's own too when the
+    swap would drop nothing of it but temp files and that checkpoint. Use as ``with claim(target) as rd:``."""
     given = target
     target = outpath.check_dir(target, option)
     created = [p for p in reversed(target.parents) if not p.exists()]
@@ -234,7 +237,8 @@ def claim(target: Path, output: Output = RUN, force: bool = False, option: str =
     rd.created = created
     try:
         _repair(target)
-        rd.merge = not _is_own(target, output)
+        unfinished = resuming and any(p.is_file() for p in (rd.work / rio.CHECKPOINT, target / rio.CHECKPOINT))
+        rd.merge = not (_is_own(target, output) or (unfinished and not _would_drop(target, output)))
         if rd.merge and not force:
             raise _refusal(given, output, option)
     except BaseException:
@@ -267,6 +271,16 @@ def _is_own(target: Path, output: Output) -> bool:
     except OSError as err:
         raise RunError(f"{target}: cannot read ({err.strerror or err})") from None
     return output.manifest_of(target) is not None
+
+
+def _would_drop(target: Path, output: Output) -> bool:
+    """Whether swapping a new output in would drop a file of ``target`` other than temp files and a checkpoint."""
+    owned = output.owns(target)
+    for path in target.rglob("*"):
+        rel = path.relative_to(target).as_posix()
+        if not path.is_dir() and owned(rel) and not _TEMP.match(path.name) and rel != rio.CHECKPOINT:
+            return True
+    return False
 
 
 @contextmanager
