@@ -210,9 +210,9 @@ def test_optimize_refuses_bad_flags(flags, code, needle, tmp_path, capsys, monke
                     monkeypatch)
 
 
-def test_optimize_into_a_file_is_exit_1(tmp_path, capsys, monkeypatch):
-    (tmp_path / "f").write_text("x")
-    _assert_refused(["optimize", QUICK, "--out", tmp_path / "f", "-q"], 1, "cannot create output directory",
+def test_optimize_into_a_file_is_exit_2(tmp_path, capsys, monkeypatch):
+    (tmp_path / "f").write_text("x")  # a bad --out, refused before any work (issue 27)
+    _assert_refused(["optimize", QUICK, "--out", tmp_path / "f", "-q"], 2, "cannot create output directory",
                     tmp_path, capsys, monkeypatch)
 
 

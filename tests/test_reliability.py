@@ -237,13 +237,13 @@ def _cli(*args):
                           timeout=120)
 
 
-def test_output_under_a_regular_file_is_a_clear_error_exit_1(tmp_path):
+def test_output_under_a_regular_file_is_a_clear_error_exit_2(tmp_path):
     cfg_path = tmp_path / "cfg.yaml"
     cfg_path.write_text(yaml.safe_dump(small()))
     blocker = tmp_path / "results"
     blocker.write_text("I am a file\n")
     r = _cli("optimize", str(cfg_path), "--out", str(blocker / "run"), "--no-plots", "-q")
-    assert r.returncode == 1, r.stderr
+    assert r.returncode == 2, r.stderr  # a bad --out, refused before any work (issue 27)
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and "cannot create output directory" in lines[0]
     assert str(blocker / "run") in lines[0]

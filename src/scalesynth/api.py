@@ -143,6 +143,7 @@ def optimize(
     plots: bool = True,
     progress: ProgressFn | None = None,
     overrides: list[str] | None = None,
+    force: bool = False,
 ) -> RunResult:
     """Run the config's NSGA-II synthesis and write its results directory (``docs/results.md``).
 
@@ -155,6 +156,8 @@ def optimize(
         plots: write ``plots/*.png`` and ``report.md`` as well.
         progress: called once per generation with a dict (generation, evaluations, hypervolume, ...).
         overrides: ``"key=value"`` strings as for ``--set``.
+        force: write into a directory that is neither new, empty nor a run directory (ConfigError otherwise),
+            replacing only files of the names a run writes.
 
     Returns:
         :class:`RunResult` with ``out_dir``, ``pareto`` (pandas DataFrame, one row per non-dominated design),
@@ -162,7 +165,7 @@ def optimize(
     """
     cfg = as_config(config, overrides)
     return _run(cfg, None if out_dir is None else Path(out_dir), seed=seed, resume=resume, plots=plots,
-                progress=progress)
+                progress=progress, force=force)
 
 
 def load_result(run_dir: str | Path) -> RunResult:

@@ -31,6 +31,8 @@ SetOpt = Annotated[
     typer.Option("--set", "-s", help="override: design parameter, option or dotted config path, as key=value"),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout and nothing else")]
+ForceOpt = Annotated[bool, typer.Option(
+    "--force", help="write into an --out directory that is not this command's own (replacing only files it writes)")]
 
 
 def _fail(message: str, code: int) -> None:

@@ -17,12 +17,17 @@ import pandas as pd
 
 from scalesynth import io as rio
 from scalesynth import labels as lab
+from scalesynth import rundir
 from scalesynth.errors import ConfigError
 
 NOT_METRICS = {"rank", "feasible", "voxels"}
 # preferred axes of the figure when the runs share no two objectives: by catalogue family, task metrics first
 FAMILY_PREFERENCE = ("task", "workspace", "design", "cycle", "path")
 _ROW = re.compile(r"\(row (\d+) of pareto\.csv\)")
+MANIFEST = "compare.json"
+_FILES = ("compare.csv", MANIFEST, *(f"compare.{fmt}" for fmt in rio.FIGURE_FORMATS))
+# a compare directory is recognised by its compare.json (scalesynth.rundir), which lists the files beside it
+OUTPUT = rundir.Output("compare", MANIFEST, ("runs", "shared_metrics", "files"), owned=lambda name: name in _FILES)
 
 
 def _selected(result) -> list[tuple[str, int]]:
@@ -88,12 +93,14 @@ def run_label(run: dict) -> str:
 
 
 def compare_runs(run_dirs: Sequence[Path], out: Path | None = None, fmt: str = "png",
-                 x: str | None = None, y: str | None = None) -> dict[str, Any]:
-    """Write compare.csv and compare.<fmt> into ``out`` (default ./compare); return the table and file names."""
-    from scalesynth import plotting
-
+                 x: str | None = None, y: str | None = None, force: bool = False) -> dict[str, Any]:
+    """Write compare.csv, compare.<fmt> and compare.json into ``out`` (default ./compare), staged and swapped in
+    whole (``scalesynth.rundir``; new, empty or a compare directory unless ``force``); return the table and file
+    names."""
     if fmt not in rio.FIGURE_FORMATS:
         raise ConfigError(f"--format: must be one of {', '.join(rio.FIGURE_FORMATS)}, got {fmt!r}")
+    target = Path(out) if out is not None else Path("compare")
+    rundir.check(target, OUTPUT, force)  # before reading the runs; claimed when the table is ready
     runs = load_runs(run_dirs)
     shared = shared_metrics(runs)
     xk, yk = figure_axes(runs, shared)
@@ -112,7 +119,17 @@ def compare_runs(run_dirs: Sequence[Path], out: Path | None = None, fmt: str = "
             row["design_values"] = "; ".join(f"{k}={float(r['pareto'][k].iloc[i]):.6g}" for k in r["problem"].var_names)
             rows.append(row)
     table = pd.DataFrame(rows)
-    target = rio.ensure_dir(Path(out) if out is not None else Path("compare"))
+    files = ["compare.csv", f"compare.{fmt}", MANIFEST]
+    with rundir.staged(target, OUTPUT, force) as staged:
+        _write(staged.work, runs, table, xk, yk, fmt)
+        rio.write_json(staged.work / MANIFEST, {"runs": [str(r["dir"]) for r in runs], "shared_metrics": shared,
+                                                "axes": [xk, yk], "files": files})
+    return {"shared_metrics": shared, "axes": [xk, yk], "table": table, "out": str(target), "files": files[:2]}
+
+
+def _write(target: Path, runs: list[dict], table: pd.DataFrame, xk: str, yk: str, fmt: str) -> None:
+    from scalesynth import plotting
+
     rio.write_csv(target / "compare.csv", table)
     series = [{"label": run_label(r), "x": r["pareto"][xk].to_numpy(), "y": r["pareto"][yk].to_numpy(),
                "selected": [(s, float(r["pareto"][xk].iloc[i]), float(r["pareto"][yk].iloc[i]))
@@ -122,5 +139,3 @@ def compare_runs(run_dirs: Sequence[Path], out: Path | None = None, fmt: str = "
                                   f"{len(runs)} runs on their shared metrics")
     rio.save_figure(fig, target / f"compare.{fmt}")
     plotting.close(fig)
-    return {"shared_metrics": shared, "axes": [xk, yk], "table": table, "out": str(target),
-            "files": ["compare.csv", f"compare.{fmt}"]}

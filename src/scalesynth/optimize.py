@@ -206,6 +206,7 @@ def run(
     plots: bool = True,
     stop_after: int | None = None,
     on_checkpoint: Callable[[Path, int], None] | None = None,
+    force: bool = False,
 ) -> RunResult:
     """Run NSGA-II for ``cfg`` and write the results directory.
 
@@ -213,6 +214,9 @@ def run(
     exists for tests of resume and for chunked runs. ``on_checkpoint(path, generation)`` is called after every
     checkpoint write (the last one too, before the results are written); an exception it raises ends the run
     there, leaving that checkpoint (the batch runner ships checkpoints to its client this way).
+
+    The target must be new, empty or a run directory (``scalesynth.rundir``); ``force`` lets the run add its files
+    to any other directory, replacing only files of the names it writes.
     """
     if seed is not None:
         cfg = cfg.model_copy(update={"algorithm": cfg.algorithm.model_copy(update={"seed": seed})})
@@ -228,7 +232,7 @@ def run(
     fresh_algorithm.setup(problem, termination=("n_gen", cfg.algorithm.n_gen), seed=cfg.algorithm.seed, verbose=False)
     algorithm = None
     # ---- run directory (scalesynth.rundir, issue 11): lock the target, write into its staging directory -------
-    with rundir.claim(target) as claimed:
+    with rundir.claim(target, rundir.RUN, force, resuming=resume) as claimed:
         out = claimed.continued() if resume else None
         ckpt_path = claimed.work / rio.CHECKPOINT
         if out is not None and ckpt_path.exists():
@@ -329,6 +333,7 @@ def _run_generations(cfg, problem, algorithm, out, ckpt_path, ref, digest, histo
         from scalesynth.report import write_plots_and_report
 
         write_plots_and_report(result)  # from the run in memory: the same figures as the manifest
+    manifest["files"] = [*rundir.listing(out), results.MANIFEST]  # what the next run on this directory replaces
     results.write_manifest(result)  # last: its presence marks a finished run
     if ckpt_path.exists():
         ckpt_path.unlink()
@@ -342,7 +347,7 @@ def _numba_threads() -> int:
 
 
 def reproduce(
-    run_dir: Path, out_dir: Path, on_versions: Callable[[list[str]], None] | None = None
+    run_dir: Path, out_dir: Path, on_versions: Callable[[list[str]], None] | None = None, force: bool = False
 ) -> dict[str, Any]:
     """Re-run a finished run from its manifest's config and seed into ``out_dir``; compare pareto.csv bytes.
 
@@ -362,7 +367,7 @@ def reproduce(
     differences = version_differences(original.manifest.get("versions"))
     if on_versions is not None:
         on_versions(differences)
-    result = run(cfg, out_dir, plots=False)
+    result = run(cfg, out_dir, plots=False, force=force)
     same = (Path(run_dir) / results.PARETO).read_bytes() == (Path(out_dir) / results.PARETO).read_bytes()
     return {
         "identical": same,

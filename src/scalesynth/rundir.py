@@ -15,6 +15,14 @@ A results directory is always either the previous finished run, untouched, or th
 
 The lock, staging and old directories are hidden (leading dot) and sit in the target's parent, on the same file
 system, so the swap is a rename and ``results/*/`` globs never see them.
+
+Every command that writes a directory (a run, ``cycle``, ``show``, ``compare``) uses this module, with an
+``Output`` saying which file marks a directory as its own (its manifest) and which entries its output owns. A
+command writes only into a directory that is new, empty or its own (``claim`` checks the path with
+``scalesynth.outpath`` and refuses anything else with exit code 2 before any work); with ``force`` it also writes
+into another directory, but then moves its files in one by one and touches nothing else there. A manifest that
+lists the files of its output (``"files"``) says exactly what the next output replaces; everything else (a user's
+notes, a ``plots/my.png``) is carried over, down to single files.
 """
 
 from __future__ import annotations
@@ -22,18 +30,71 @@ from __future__ import annotations
 import ctypes
 import errno
 import fcntl
+import json
 import os
 import re
 import shutil
 import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 from scalesynth import io as rio
-from scalesynth.errors import RunError
+from scalesynth import outpath
+from scalesynth.errors import ConfigError, RunError
+
+_TEMP = re.compile(r"^\..+\.tmp$")
+_MANIFEST_LIMIT = 16 * 2**20  # a manifest larger than this is not one of ours (and is not read whole)
+
+
+@dataclass(frozen=True)
+class Output:
+    """What one command writes into its output directory."""
+
+    what: str  # the command, as messages name it
+    manifest: str  # the JSON file that marks a directory as this command's output
+    keys: tuple[str, ...]  # keys that manifest always has
+    owned: Callable[[str], bool]  # top-level names the output owns when its manifest lists no "files" (older ones)
+    always: Callable[[str], bool] = lambda rel: False  # paths the output owns whatever its manifest lists
+
+    def manifest_of(self, directory: Path) -> dict | None:
+        """The directory's manifest as this command writes it, or None if it has none."""
+        path = Path(directory) / self.manifest
+        try:
+            if not path.is_file() or path.is_symlink() or path.stat().st_size > _MANIFEST_LIMIT:
+                return None
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+        if not isinstance(data, dict) or any(k not in data for k in self.keys):
+            return None
+        return data
+
+    def owns(self, directory: Path) -> Callable[[str], bool]:
+        """Which paths (relative, '/'-separated) of the existing output in ``directory`` the next one replaces."""
+        files = (self.manifest_of(directory) or {}).get("files")
+        if isinstance(files, list) and all(isinstance(f, str) for f in files):
+            listed = {*files, self.manifest}
+            base = listed.__contains__
+        else:
+            base = lambda rel: self.owned(rel.split("/", 1)[0])  # noqa: E731
+        return lambda rel: base(rel) or self.always(rel) or bool(_TEMP.match(rel.rsplit("/", 1)[-1]))
+
 
 # entries of a results directory that belong to the run that wrote it (replaced by the next run, never carried)
-RUN_OWNED = (*rio.RESULT_FILES, rio.CHECKPOINT, "plots")
-_RUN_OWNED_PATTERN = re.compile(r"^selected_[a-z]+\.yaml$|^\..+\.tmp$")  # `select` outputs, temp files
+RUN_OWNED = (*rio.RESULT_FILES, rio.CHECKPOINT, "plots", "bands", "report.html")
+_SELECTED = re.compile(r"^selected_[a-z]+\.yaml$")  # `select` outputs: they name rows of the old front
+
+RUN = Output("run", "manifest.json", ("config", "status"), owned=lambda name: name in RUN_OWNED,
+             always=lambda rel: bool(_SELECTED.match(rel)) or rel == rio.CHECKPOINT)
+
+
+def listing(directory: Path) -> list[str]:
+    """Every file under ``directory`` (relative, '/'-separated, sorted), for a manifest's ``"files"``."""
+    directory = Path(directory)
+    return sorted(p.relative_to(directory).as_posix() for p in directory.rglob("*")
+                  if not p.is_dir() and not _TEMP.match(p.name) and p.name != rio.CHECKPOINT)
 
 
 def staging_path(target: Path) -> Path:
@@ -56,11 +117,17 @@ def _absolute(target: Path) -> Path:
 
 
 class RunDir:
-    """A claimed target: ``work`` is the staging directory to write into; ``commit()`` swaps it in."""
+    """A claimed target: ``work`` is the staging directory to write into; ``commit()`` swaps it in.
 
-    def __init__(self, target: Path, fd: int):
+    ``merge``: the target is another directory that ``force`` lets the command write into: ``commit()`` then moves
+    the staged files in one by one instead of swapping the directory."""
+
+    def __init__(self, target: Path, fd: int, output: Output = RUN, merge: bool = False):
         self.target = target
         self.work = staging_path(target)
+        self.output = output
+        self.merge = merge
+        self.created: list[Path] = []  # directories claim made for the target's parent (removed by discard)
         self._fd = fd
         self.committed = False
 
@@ -82,12 +149,24 @@ class RunDir:
         rio.remove_stale_temps(self.work)
         return self.work
 
+    def discard(self) -> None:
+        """Forget a failed output: its staging directory, and the parent directories claim created for it."""
+        _remove_tree(self.work)
+        for path in reversed(self.created):
+            try:
+                path.rmdir()
+            except OSError:
+                break
+
     # --- swap ---------------------------------------------------------------------------------------------------
     def commit(self) -> None:
-        """Make the staged run the target, atomically; the previous run (if any) is deleted afterwards."""
+        """Make the staged output the target: atomically, the previous output (if any) deleted afterwards; or, in a
+        directory that is not the command's own (``merge``), file by file."""
         target, work = self.target, self.work
-        if target.is_dir():
-            _carry_foreign_entries(target, work)
+        if self.merge:
+            _merge(work, target)
+        elif target.is_dir():
+            _carry_foreign_entries(target, work, self.output.owns(target))
             if not _exchange(work, target):
                 old = _old_path(target)
                 _remove_tree(old)
@@ -117,12 +196,16 @@ class RunDir:
         self.release()
 
 
-def claim(target: Path) -> RunDir:
-    """Lock ``target`` for this process (RunError naming the holder's pid if another run has it) and repair a
-    swap that a kill interrupted. Use as ``with claim(target) as rd: ...``."""
-    target = _absolute(target)
-    if target.exists() and not target.is_dir():
-        raise RunError(f"{target}: cannot create output directory (a file of that name exists)")
+def claim(target: Path, output: Output = RUN, force: bool = False, option: str = "--out",
+          resuming: bool = False) -> RunDir:
+    """Check ``target`` (``outpath.check_dir``), lock it for this process (RunError naming the holder's pid if
+    another run has it), repair a swap that a kill interrupted, and refuse (ConfigError naming ``option``) a
+    directory that is neither empty nor ``output``'s own unless ``force``. ``resuming``: a target with an unfinished
+    run's checkpoint (staged beside it, or inside it from scalesynth < 0.2) counts as the run's own too when the
+    swap would drop nothing of it but temp files and that checkpoint. Use as ``with claim(target) as rd:``."""
+    given = target
+    target = outpath.check_dir(target, option)
+    created = [p for p in reversed(target.parents) if not p.exists()]
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
     except OSError as err:
@@ -150,13 +233,68 @@ def claim(target: Path) -> RunDir:
         os.close(fd)
     os.ftruncate(fd, 0)
     os.write(fd, f"{os.getpid()}\n".encode())
-    rd = RunDir(target, fd)
+    rd = RunDir(target, fd, output)
+    rd.created = created
     try:
         _repair(target)
+        unfinished = resuming and any(p.is_file() for p in (rd.work / rio.CHECKPOINT, target / rio.CHECKPOINT))
+        rd.merge = not (_is_own(target, output) or (unfinished and not _would_drop(target, output)))
+        if rd.merge and not force:
+            raise _refusal(given, output, option)
     except BaseException:
         rd.release()
         raise
     return rd
+
+
+def check(target: Path, output: Output = RUN, force: bool = False, option: str = "--out") -> Path:
+    """``claim``'s checks of ``target`` without taking or creating anything (for a command that reads its inputs
+    before claiming); returns the resolved path."""
+    real = outpath.check_dir(target, option)
+    if not force and not _is_own(real, output):
+        raise _refusal(target, output, option)
+    return real
+
+
+def _refusal(given, output: Output, option: str) -> ConfigError:
+    return ConfigError(f"{option}: {outpath.shown(given)}: not empty and not a scalesynth {output.what} directory "
+                       f"(no {output.manifest}); use a new or empty one, or --force")
+
+
+def _is_own(target: Path, output: Output) -> bool:
+    """New, empty, or holding ``output``'s manifest."""
+    if not target.is_dir():
+        return True
+    try:
+        if next(target.iterdir(), None) is None:
+            return True
+    except OSError as err:
+        raise RunError(f"{target}: cannot read ({err.strerror or err})") from None
+    return output.manifest_of(target) is not None
+
+
+def _would_drop(target: Path, output: Output) -> bool:
+    """Whether swapping a new output in would drop a file of ``target`` other than temp files and a checkpoint."""
+    owned = output.owns(target)
+    for path in target.rglob("*"):
+        rel = path.relative_to(target).as_posix()
+        if not path.is_dir() and owned(rel) and not _TEMP.match(path.name) and rel != rio.CHECKPOINT:
+            return True
+    return False
+
+
+@contextmanager
+def staged(target: Path, output: Output, force: bool = False, option: str = "--out") -> Iterator[RunDir]:
+    """Claim ``target`` and yield it with an empty staging directory (``.work``) to write into: swapped in when the
+    block ends normally, discarded (the target untouched) when the block raises, an interrupt included."""
+    with claim(target, output, force, option) as rd:
+        rd.fresh()
+        try:
+            yield rd
+            rd.commit()
+        except BaseException:
+            rd.discard()  # after a failed swap too: the next claim puts an interrupted fallback swap right
+            raise
 
 
 def _holder(path: Path) -> str:
@@ -182,18 +320,60 @@ def _repair(target: Path) -> None:
             _rename(old, target)
 
 
-def _carry_foreign_entries(target: Path, work: Path) -> None:
-    """Hard-link (copy where links are not possible) what the old directory holds besides the run's own files."""
-    for entry in target.iterdir():
-        if entry.name in RUN_OWNED or _RUN_OWNED_PATTERN.match(entry.name) or (work / entry.name).exists():
+def _carry_foreign_entries(target: Path, work: Path, owned: Callable[[str], bool], rel: str = "") -> bool:
+    """Hard-link (copy where links are not possible) into ``work`` what ``target`` holds besides the previous
+    output's own files (``owned``) and what the new output replaces; returns whether ``target/rel`` held any
+    owned entry. A directory holding nothing owned is carried whole; one that does is carried file by file, and
+    left out when nothing of it remains."""
+    any_owned = False
+    source = target / rel if rel else target
+    for entry in sorted(source.iterdir()):
+        name = f"{rel}{entry.name}"
+        dst = work / name
+        if owned(name):
+            any_owned = True
             continue
         try:
             if entry.is_dir() and not entry.is_symlink():
-                shutil.copytree(entry, work / entry.name, symlinks=True, copy_function=_link_or_copy)
-            else:
-                _link_or_copy(entry, work / entry.name)
+                if os.path.lexists(dst) and not (dst.is_dir() and not dst.is_symlink()):
+                    continue  # the new output has a file of that name
+                made = not os.path.lexists(dst)
+                if made:
+                    dst.mkdir()
+                if _carry_foreign_entries(target, work, owned, name + "/"):
+                    any_owned = True
+                    if made and next(dst.iterdir(), None) is None:
+                        dst.rmdir()  # held only the previous output's files
+                        continue
+                if made:
+                    shutil.copystat(entry, dst)
+            elif not os.path.lexists(dst):
+                _link_or_copy(entry, dst)
         except OSError as err:
-            raise RunError(f"{entry}: cannot carry over into the new run ({err.strerror or err})") from None
+            raise RunError(f"{entry}: cannot carry over into the new output ({err.strerror or err})") from None
+    return any_owned
+
+
+def _merge(work: Path, target: Path) -> None:
+    """Move every file of ``work`` to the same place under ``target`` (replacing a file of that name), creating
+    directories as needed and touching nothing else; checked first, so a conflict moves nothing."""
+    moves = []
+    for src in sorted(work.rglob("*")):
+        dst = target / src.relative_to(work)
+        src_dir = src.is_dir() and not src.is_symlink()
+        dst_dir = dst.is_dir() and not dst.is_symlink()
+        if os.path.lexists(dst) and src_dir != dst_dir:
+            raise RunError(f"{dst}: cannot replace a {'file' if src_dir else 'directory'} of that name with the "
+                           f"new {'directory' if src_dir else 'file'} (nothing was moved)")
+        if not src_dir:
+            moves.append((src, dst))
+    for src, dst in moves:
+        try:
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(src, dst)
+        except OSError as err:
+            raise RunError(f"{dst}: cannot move the new file into place ({err.strerror or err})") from None
+    _remove_tree(work)
 
 
 def _link_or_copy(src, dst) -> None:

@@ -58,10 +58,15 @@ def extremes(F: np.ndarray) -> list[int]:
     return list(dict.fromkeys(int(i) for i in np.argmin(np.asarray(F), axis=0)))
 
 
-def select_design(run_dir, method: str = "knee", weights: Sequence[float] | None = None, out=None) -> dict:
+SIGNATURE = "written by `scalesynth select`"  # in the first line of every config select writes
+
+
+def select_design(run_dir, method: str = "knee", weights: Sequence[float] | None = None, out=None,
+                  force: bool = False) -> dict:
     """Choose a design of a finished run's front and write it as an evaluate-ready config.
 
     Returns {"method", "design", "metrics", "config"}; the config is the run's config with ``design`` replaced.
+    An existing file at ``out`` is replaced only if select wrote it (its first line says so) or with ``force``.
     """
     from pathlib import Path
 
@@ -71,6 +76,8 @@ def select_design(run_dir, method: str = "knee", weights: Sequence[float] | None
     from scalesynth import results
 
     run_dir = Path(run_dir)
+    given = Path(out) if out is not None else run_dir / f"selected_{method}.yaml"
+    target = check_target(given, force)
     result = results.load(run_dir, require_finished=False)
     cfg, pareto, problem = result.cfg, result.pareto, result.problem
     if not len(pareto):
@@ -82,7 +89,25 @@ def select_design(run_dir, method: str = "knee", weights: Sequence[float] | None
     data = cfg.model_dump(mode="json")
     data["design"] = design
     data["name"] = f"{cfg.name}-{method}"
-    target = Path(out) if out is not None else run_dir / f"selected_{method}.yaml"
-    header = f"# {method} design of {run_dir} (row {i} of pareto.csv), written by `scalesynth select`\n"
+    header = f"# {method} design of {run_dir} (row {i} of pareto.csv), {SIGNATURE}\n"
+    rio.ensure_dir(target.parent)
     rio.write_text(target, header + yaml.safe_dump(data, sort_keys=False))
-    return {"method": method, "row": int(i), "design": design, "metrics": metrics, "config": str(target)}
+    return {"method": method, "row": int(i), "design": design, "metrics": metrics, "config": str(given)}
+
+
+def check_target(target, force: bool = False):
+    """The resolved file ``select`` may write (``scalesynth.outpath.check_file``); an existing file that select did
+    not write is refused (ConfigError naming --out) unless ``force``."""
+    from scalesynth import outpath
+
+    real, exists = outpath.check_file(target)
+    if exists and not force:
+        try:
+            with open(real, "rb") as fh:
+                first = fh.readline(4096).decode("utf-8", errors="replace")
+        except OSError as err:
+            raise InvalidParameter(f"--out: {outpath.shown(target)}: cannot read ({err.strerror or err})") from None
+        if not first.startswith("#") or SIGNATURE not in first:
+            raise InvalidParameter(f"--out: {outpath.shown(target)}: exists and was not written by select; "
+                                   "give a new file name, or --force to replace it")
+    return real

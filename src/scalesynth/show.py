@@ -17,10 +17,15 @@ import numpy as np
 
 from scalesynth import io as rio
 from scalesynth import labels as lab
+from scalesynth import rundir
 from scalesynth import workspace_view as wv
 from scalesynth.errors import ConfigError
 
 FORMATS = ("png", "svg", "pdf", "html")
+_VIEWS = ("show.json", "show.html", *(f"{view}.{fmt}" for view in ("workspace_3d", "bands_3d", "sections", "robot")
+                                       for fmt in FORMATS[:3]))
+# a show directory is recognised by its show.json (scalesynth.rundir); its "files" list the views beside it
+OUTPUT = rundir.Output("show", "show.json", ("design_choice", "sections", "files"), owned=lambda name: name in _VIEWS)
 CONNECTIVITY = "26-connected: cells sharing a face, an edge or a corner (8 in 2-D); face-only count beside it"
 
 
@@ -123,9 +128,11 @@ def show_design(
     resolution: int | None = None,
     sets: Sequence[str] | None = None,
     pose: str | None = None,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Write the views of one design into ``out`` (default <run or results/<name>>/show/<design label>/) and
-    return what show.json holds."""
+    return what show.json holds. The directory is staged and swapped in whole (``scalesynth.rundir``); it must be
+    new, empty or a show directory unless ``force``."""
     t0 = time.perf_counter()
     if fmt not in FORMATS:
         raise ConfigError(f"--format: must be one of {', '.join(FORMATS)}, got {fmt!r}")
@@ -142,7 +149,15 @@ def show_design(
     memory.check(memory.show_estimate(cfg, res, "--resolution" if resolution else "grid.resolution"))
     chosen, label, row = resolve_design(cfg, result, design)
     target = Path(out) if out is not None else (run_dir or cfg.output_dir()) / "show" / label
-    rio.ensure_dir(target)
+    with rundir.staged(target, OUTPUT, force) as staged:  # --out checked and locked before the sampling
+        summary = _show(cfg, source, label, row, chosen, field, at_axes, res, fmt, pose, staged.work, t0)
+    summary["out"] = str(staged.target)
+    return summary
+
+
+def _show(cfg, source, label, row, chosen, field, at_axes, res, fmt, pose, target: Path, t0: float) -> dict:
+    """Sample the design's fields, write its views and show.json into ``target``; return show.json's content."""
+    mech = cfg.mech
     t1 = time.perf_counter()
     fg = wv.sample_fields(cfg, chosen, res)
     t_sample = time.perf_counter() - t1
@@ -192,7 +207,6 @@ def show_design(
     summary["files"] = files
     summary["seconds"] = {"sample": round(t_sample, 3), "total": round(time.perf_counter() - t0, 3)}
     rio.write_json(target / "show.json", summary)
-    summary["out"] = str(target)
     return summary
 
 

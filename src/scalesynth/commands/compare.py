@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import _print_json, app, handles_errors
+from scalesynth.cliapp import ForceOpt, _print_json, app, handles_errors
 
 
 @app.command("compare")
@@ -19,11 +19,12 @@ def compare_cmd(
     x: Annotated[str | None, typer.Option("--x", help="shared metric on the figure's x axis")] = None,
     y: Annotated[str | None, typer.Option("--y", help="shared metric on the figure's y axis")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print the table as one JSON object")] = False,
+    force: ForceOpt = False,
 ) -> None:
     """Compare runs (also of different mechanisms) on their shared metrics, with each run's selected designs."""
     from scalesynth.compare import compare_runs
 
-    info = compare_runs(run_dirs, out, fmt, x, y)
+    info = compare_runs(run_dirs, out, fmt, x, y, force)
     table = info["table"]
     if as_json:
         _print_json({"shared_metrics": info["shared_metrics"], "axes": info["axes"], "out": info["out"],

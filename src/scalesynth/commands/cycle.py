@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import JsonOpt, SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import ForceOpt, JsonOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 
 
@@ -58,9 +58,13 @@ def pick_design(run_dir: Path, choice: str):
     return cfg, result.design_of(pareto.iloc[row]), label
 
 
-def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None):
-    """Analyse the cycle and write its files; returns the summary dict (cycle.json's content plus file paths)."""
-    from scalesynth import io as rio
+def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None,
+              force: bool = False):
+    """Analyse the cycle and write its files; returns the summary dict (cycle.json's content plus file paths).
+
+    The output directory is staged and swapped in whole (``scalesynth.rundir``): a failure or an interrupt leaves
+    the previous one as it was. It must be new, empty or a cycle directory unless ``force``."""
+    from scalesynth import rundir
     from scalesynth.config import load_config
     from scalesynth.cycle import analysis, output
 
@@ -79,14 +83,11 @@ def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | 
     if cfg.cycle is None:
         raise ConfigError("cycle: the config has no cycle section (cycle.path or cycle.preset)")
     options = cfg.resolved_options()
-    res = analysis.analyse(cfg.mech, design, options, cfg.cycle, cfg.units.length)
-    metrics = analysis.result_metrics(res, cfg.cycle)
-    out_dir = rio.ensure_dir(Path(out_dir))
-    output.write_csv(out_dir / "cycle.csv", res)
-    info = output.summary(res, metrics, design, cfg.cycle)
-    plots = output.write_plots(out_dir, cfg, design, options, res)
-    rio.write_json(out_dir / "cycle.json", info)
-    info["files"] = [str(out_dir / "cycle.csv"), str(out_dir / "cycle.json")] + [str(p) for p in plots]
+    with rundir.staged(out_dir, output.OUTPUT, force) as staged:  # --out checked and locked before the analysis
+        res = analysis.analyse(cfg.mech, design, options, cfg.cycle, cfg.units.length)
+        metrics = analysis.result_metrics(res, cfg.cycle)
+        info = output.write_all(staged.work, cfg, design, options, res, metrics)
+    info["files"] = [str(staged.target / name) for name in info["files"]]
     return info
 
 
@@ -100,9 +101,10 @@ def cycle_cmd(
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", help="output directory")] = None,
     as_json: JsonOpt = False,
+    force: ForceOpt = False,
 ) -> None:
     """Pick-and-place cycle of a design: actuator curves and forces, LCI and link clearance (cycle.csv, plots)."""
-    info = run_cycle(source, sets, design, out)
+    info = run_cycle(source, sets, design, out, force)
     if as_json:
         _print_json(info)
         return

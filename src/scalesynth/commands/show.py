@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import ForceOpt, SetOpt, _print_json, app, handles_errors
 
 
 @app.command("show")
@@ -28,12 +28,13 @@ def show_cmd(
         "--pose", help="task coordinates of the robot drawing, comma-separated (default: near the centroid)")] = None,
     sets: SetOpt = None,
     as_json: Annotated[bool, typer.Option("--json", help="print show.json's content on stdout")] = False,
+    force: ForceOpt = False,
 ) -> None:
     """3-D workspace coloured by a field, each dexterity band's connected regions (counted, 26-connectivity),
     sections with the task box and path; writes the figures and show.json."""
     from scalesynth.show import show_design
 
-    info = show_design(source, design, field, at, out, fmt, resolution, sets, pose)
+    info = show_design(source, design, field, at, out, fmt, resolution, sets, pose, force)
     if as_json:
         _print_json(info)
         return

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import SetOpt, app, handles_errors
+from scalesynth.cliapp import ForceOpt, SetOpt, app, handles_errors
 
 
 @app.command("optimize")
@@ -22,6 +22,7 @@ def optimize_cmd(
     sets: SetOpt = None,
     no_plots: Annotated[bool, typer.Option("--no-plots", help="skip plots and report.md")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no progress output")] = False,
+    force: ForceOpt = False,
 ) -> None:
     """Run the NSGA-II synthesis and write pareto.csv, history.csv, manifest.json, config.yaml, plots, report.md."""
     from scalesynth.config import load_config
@@ -32,7 +33,7 @@ def optimize_cmd(
     cfg = load_config(config, sets)
     progress = make_progress(cfg.algorithm.n_gen, quiet)
     try:
-        result = run(cfg, out, seed=seed, resume=resume, progress=progress, plots=not no_plots)
+        result = run(cfg, out, seed=seed, resume=resume, progress=progress, plots=not no_plots, force=force)
     finally:
         if progress is not None:
             progress.close()
@@ -89,6 +90,8 @@ def select_cmd(
         Path | None, typer.Option("--out", help="config to write (default RUN_DIR/selected_<method>.yaml)")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
+    force: Annotated[bool, typer.Option("--force", help="replace an existing --out file that select did not write")
+                     ] = False,
 ) -> None:
     """Choose one design from the front; print it and write it as a config that `scalesynth evaluate` accepts."""
     from scalesynth.errors import InvalidParameter
@@ -100,7 +103,7 @@ def select_cmd(
             w = [float(v) for v in weights.split(",")]
         except ValueError:
             raise InvalidParameter(f"--weights: expected comma-separated numbers, got {weights!r}") from None
-    chosen = select_design(run_dir, method, w, out)
+    chosen = select_design(run_dir, method, w, out, force=force)
     if as_json:
         from scalesynth.cliapp import _print_json
 
@@ -116,6 +119,7 @@ def select_cmd(
 def reproduce_cmd(
     run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
     out: Annotated[Path | None, typer.Option("--out", help="where to re-run (default: a temporary directory)")] = None,
+    force: ForceOpt = False,
 ) -> None:
     """Re-run a finished run from its manifest (config and seed) and check pareto.csv is byte-identical."""
     import tempfile
@@ -128,7 +132,8 @@ def reproduce_cmd(
                        "byte-identical results are expected only with the same versions and machine type", err=True)
 
     with tempfile.TemporaryDirectory() as tmp:
-        info = reproduce(run_dir, out if out is not None else Path(tmp) / "rerun", on_versions=warn_versions)
+        info = reproduce(run_dir, out if out is not None else Path(tmp) / "rerun", on_versions=warn_versions,
+                         force=force)
     verdict = "identical" if info["identical"] else "DIFFERENT"
     typer.echo(f"pareto.csv {verdict}: HV {info['hypervolume']:.6g} (original {info['original_hypervolume']:.6g}), "
                f"re-run took {info['wall_seconds']:.1f} s")

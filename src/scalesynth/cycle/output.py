@@ -2,8 +2,8 @@
 
 * ``cycle.csv``: the columns of :meth:`CycleResult.columns` (units in ``cycle.json`` and the README), 12
   significant digits;
-* ``cycle.json``: design, cycle settings, units of every column, the catalogue metrics and where the minimum
-  clearance occurs;
+* ``cycle.json``: design, cycle settings, units of every column, the catalogue metrics, where the minimum
+  clearance occurs and the directory's files (it marks the directory as a cycle output, ``scalesynth.rundir``);
 * ``actuators.png`` (q, qd, qdd, force of every actuator over t, the vertices marked), ``path.png`` (the path on
   an LCI section of the workspace), ``quality.png`` (LCI, clearance and, with a stiffness model, the deflection over t).
 """
@@ -17,8 +17,12 @@ import numpy as np
 
 from scalesynth import io as rio
 from scalesynth.cycle.analysis import CycleResult
+from scalesynth.rundir import Output
 
 PATH_SECTION_RESOLUTION = 160
+FILES = ("cycle.csv", "cycle.json", "actuators.png", "path.png", "quality.png")
+# a cycle directory is recognised by its cycle.json (scalesynth.rundir); "files" in it lists what it holds
+OUTPUT = Output("cycle", "cycle.json", ("cycle", "metrics", "units"), owned=lambda name: name in FILES)
 
 
 def write_csv(path: Path, res: CycleResult) -> None:
@@ -111,3 +115,13 @@ def write_plots(out_dir: Path, cfg, design, options, res: CycleResult) -> list[P
         plotting.close(fig)
         paths.append(out_dir / name)
     return paths
+
+
+def write_all(out_dir: Path, cfg, design, options, res: CycleResult, metrics: dict[str, float]) -> dict[str, Any]:
+    """cycle.csv, the plots and, last, cycle.json (listing them) into ``out_dir``; returns cycle.json's content."""
+    write_csv(out_dir / "cycle.csv", res)
+    info = summary(res, metrics, design, cfg.cycle)
+    plots = write_plots(out_dir, cfg, design, options, res)
+    info["files"] = ["cycle.csv", "cycle.json", *(p.name for p in plots)]
+    rio.write_json(out_dir / "cycle.json", info)
+    return info
