@@ -4,7 +4,10 @@ Each target runs in its own process with its own Numba cache (compiled once, the
 so the machine's load falls on every target alike. Timed: 2pauu-ppap's uniform evaluator (8 designs, N = 72,
 3 calls) and ups-sspr's adaptive evaluator (one design, 20 calls), CPU seconds, one Numba thread.
 
-    python benchmarks/cpu_target.py [ROUNDS]
+    python benchmarks/cpu_target.py [ROUNDS] [--before TREE]
+
+``--before TREE`` adds another checkout's sources (e.g. a worktree of the commit before fast-math was turned off),
+compiled for the host CPU, as one more variant of the same run.
 """
 
 from __future__ import annotations
@@ -20,9 +23,9 @@ import numpy as np
 from scalesynth.evaluate import Tolerance, adaptive_population_stats, make_grid
 from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import get
-from scalesynth.numba_target import describe
+from numba.core import config
 
-out = {"target": describe()["cpu_name"]}
+out = {"target": config.CPU_NAME or "host"}
 e = np.array([0.0, 0.3, 1.0])
 m = get("2pauu-ppap")
 d, o = m.default_design(), m.resolve_options({})
@@ -52,9 +55,11 @@ def _host() -> dict[str, str]:
     return {"NUMBA_CPU_NAME": ll.get_host_cpu_name(), "NUMBA_CPU_FEATURES": ll.get_host_cpu_features().flatten()}
 
 
-def main(rounds: int) -> None:
+def main(rounds: int, before: str | None = None) -> None:
     targets = {"host": _host(), "x86-64": {"NUMBA_CPU_NAME": "x86-64", "NUMBA_CPU_FEATURES": ""},
                "x86-64-v3 (pinned)": {"NUMBA_CPU_NAME": "x86-64-v3", "NUMBA_CPU_FEATURES": ""}}
+    if before:
+        targets["before, host"] = {**_host(), "PYTHONPATH": os.path.join(os.path.abspath(before), "src")}
     with tempfile.TemporaryDirectory() as tmp:
         for rnd in range(rounds + 1):  # round 0 compiles
             for label, extra in targets.items():
@@ -66,4 +71,10 @@ def main(rounds: int) -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 2)
+    args = sys.argv[1:]
+    tree = None
+    if "--before" in args:
+        k = args.index("--before")
+        tree = args[k + 1]
+        del args[k : k + 2]
+    main(int(args[0]) if args else 2, tree)
