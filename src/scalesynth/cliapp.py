@@ -31,10 +31,32 @@ SetOpt = Annotated[
     typer.Option("--set", "-s", help="override: design parameter, option or dotted config path, as key=value"),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout and nothing else")]
+DesignOpt = Annotated[
+    str | None,
+    typer.Option("--design", help="of a results directory: knee (default), best-<metric> (e.g. best-gci) or a row "
+                 "of pareto.csv"),
+]
+
+SourceArg = Annotated[
+    str,
+    typer.Argument(metavar="MECHANISM|CONFIG|RUN_DIR", help="mechanism name (its default design; see `scalesynth "
+                   "mechanisms`), run config (YAML), or a results directory (with --design)"),
+]
+
+MAX_ERROR_LINE = 200  # characters of an error line, "error: " included (the project's promise)
+
+
+def error_line(message: str) -> str:
+    """The one line every error is printed as: 'error: ' and the message, line breaks escaped, cut to
+    MAX_ERROR_LINE characters (a message quoting a long value or list ends in '...')."""
+    from scalesynth.config import _one_line
+
+    line = f"error: {_one_line(str(message))}"
+    return line if len(line) <= MAX_ERROR_LINE else line[: MAX_ERROR_LINE - 3] + "..."
 
 
 def _fail(message: str, code: int) -> None:
-    typer.echo(f"error: {message}", err=True)
+    typer.echo(error_line(message), err=True)
     raise typer.Exit(code)
 
 
@@ -91,6 +113,14 @@ def _mech_inputs(mech_name: str, sets: list[str] | None):
     design = mech.resolve_design(data.get("design"))
     options = mech.resolve_options(data.get("options"))
     return mech, design, options
+
+
+def _design_inputs(source: str, design: str | None, sets: list[str] | None):
+    """(mechanism, design, options) of a pose-level command's MECHANISM|CONFIG|RUN_DIR (selection.load_design)."""
+    from scalesynth.selection import load_design
+
+    chosen = load_design(source, design, sets, mechanism_ok=True)
+    return chosen.mech, chosen.design, chosen.options
 
 
 def _print_json(obj: Any) -> None:

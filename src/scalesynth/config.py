@@ -16,6 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from scalesynth.cycle import config as cycle_config
 from scalesynth.errors import ConfigError, ScalesynthError
+from scalesynth.names import hint
 
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
@@ -245,7 +246,7 @@ class RunConfig(_Strict):
         params = {p.name: p for p in mech.parameters}
         for key, (lo, _) in self.bounds.items():
             if key not in params:
-                raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} (known: {', '.join(params)})")
+                raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} " + hint(str(key), params))
             if params[key].positive and lo <= 0:
                 raise ValueError(f"bounds.{key}: lower bound must be > 0 for a length, got {lo}")
         self._check_metrics(mech)

@@ -24,30 +24,11 @@ FORMATS = ("png", "svg", "pdf", "html")
 CONNECTIVITY = "26-connected: cells sharing a face, an edge or a corner (8 in 2-D); face-only count beside it"
 
 
-def load_source(source: Path, sets: Sequence[str] | None = None):
-    """(config, RunResult or None) for a config file or a results directory."""
-    from scalesynth.config import load_config
+def load_source(source: Path, sets: Sequence[str] | None = None, design: str | None = None):
+    """The selection.DesignSource of ``show SOURCE [--design ...] [--set ...]`` (a config or a results directory)."""
+    from scalesynth.selection import load_design
 
-    source = Path(source)
-    if source.is_dir():
-        from scalesynth.results import load  # pandas and pymoo: only for a results directory
-
-        result = load(source, require_finished=False)
-        if sets:
-            return load_config(source / "config.yaml", list(sets)), result
-        return result.cfg, result
-    return load_config(source, list(sets or [])), None
-
-
-def resolve_design(cfg, result, choice: str | None) -> tuple[dict[str, float], str, int | None]:
-    """(design, label, row of pareto.csv or None) for ``--design``."""
-    if result is None:
-        if choice not in (None, "config"):
-            raise ConfigError(f"--design {choice}: a config shows its own design; give a results directory to "
-                              "choose knee, best-<metric> or a row")
-        return cfg.resolved_design(), "config", None
-    row, label = wv.choose_row(result, choice or "knee")
-    return result.design_of(result.pareto.iloc[row]), label, row
+    return load_design(source, design, sets)
 
 
 def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float]) -> tuple[list[dict], list[dict]]:
@@ -111,7 +92,8 @@ def show_design(
     t0 = time.perf_counter()
     if fmt not in FORMATS:
         raise ConfigError(f"--format: must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    cfg, result = load_source(source, sets)
+    chosen_source = load_source(source, sets, design)
+    cfg, result = chosen_source.cfg, chosen_source.result
     run_dir = None if result is None else result.out_dir
     mech = cfg.mech
     wv.check_field(mech, field)
@@ -119,7 +101,7 @@ def show_design(
     res = resolution or cfg.grid.resolution
     if not 4 <= res <= 512:
         raise ConfigError(f"--resolution: must be between 4 and 512 cells per axis, got {res}")
-    chosen, label, row = resolve_design(cfg, result, design)
+    chosen, label, row = chosen_source.design, chosen_source.label, chosen_source.row
     target = Path(out) if out is not None else (run_dir or cfg.output_dir()) / "show" / label
     rio.ensure_dir(target)
     t1 = time.perf_counter()

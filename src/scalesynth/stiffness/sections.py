@@ -15,6 +15,7 @@ from typing import Any
 
 from scalesynth.errors import InvalidParameter
 from scalesynth.mechanisms.base import Option
+from scalesynth.names import hint
 
 GPA_TO_N_PER_LENGTH2 = {"mm": 1e3, "m": 1e9}  # 1 GPa = 1e3 N/mm^2 = 1e9 N/m^2
 MM_IN = {"mm": 1.0, "m": 1e-3}
@@ -88,7 +89,7 @@ def check_stiffness_options(options: dict[str, Any], dim: int, groups: tuple[str
         raise InvalidParameter(f"options.sections: expected a mapping {{group: [diameter, wall]}}, got {sections!r}")
     for key in sections:
         if key not in groups:
-            raise InvalidParameter(f"options.sections.{key}: unknown link group (known: {', '.join(groups)})")
+            raise InvalidParameter(f"options.sections.{key}: unknown link group " + hint(str(key), groups))
     options["sections"] = {k: _tube(f"sections.{k}", v) for k, v in sections.items()}
     options["actuator_stiffness"] = _positive("actuator_stiffness", options["actuator_stiffness"])
     load = options["load"]
