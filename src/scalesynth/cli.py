@@ -175,6 +175,23 @@ def _print_solutions(names, rows, as_json: bool, empty_msg: str) -> None:
         typer.echo(f"{r['branch']:>6}: {vals}{extra}")
 
 
+@app.callback()
+def _root(
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no notice when Numba compiles (any command)")] = False,
+) -> None:
+    """Multi-objective dimensional synthesis of parallel mechanisms."""
+    if quiet:
+        from scalesynth import compile_notice
+
+        compile_notice.enable(quiet=True)
+
+
+def _quiet(argv: list[str]) -> bool:
+    """-q/--quiet anywhere before '--' (before the command, or a command's own, e.g. optimize -q)."""
+    words = argv[: argv.index("--")] if "--" in argv else argv
+    return any(w in ("-q", "--quiet") for w in words)
+
+
 def _load_commands() -> None:
     """Register the commands defined in ``scalesynth.commands`` (one module per command group)."""
     import importlib
@@ -197,14 +214,26 @@ def _usage_message(err) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     """The console entry point: usage errors (unknown option, bad value, missing argument) become one line on
-    stderr with exit code 2, like every other bad input, instead of click's framed box."""
+    stderr with exit code 2, like every other bad input, instead of click's framed box. A process that compiles
+    Numba kernels says so in one line on stderr, unless -q/--quiet (scalesynth.compile_notice)."""
+    from scalesynth import compile_notice
+
+    args = list(sys.argv[1:] if argv is None else argv)
+    compile_notice.enable(quiet=_quiet([str(a) for a in args]))  # one line on stderr if this process compiles
+    try:
+        _run(args)
+    finally:  # main() called in-process (tests, scripts): the notice does not outlive it
+        compile_notice.enable(quiet=True)
+
+
+def _run(args: list[str]) -> None:
     try:  # typer >= 0.22 vendors click
         from typer._click import exceptions as click_errors
     except ImportError:  # pragma: no cover - older typer on upstream click
         from click import exceptions as click_errors
 
     try:
-        rv = app(args=argv, prog_name="scalesynth", standalone_mode=False)
+        rv = app(args=args, prog_name="scalesynth", standalone_mode=False)
     except click_errors.NoArgsIsHelpError as err:
         typer.echo(err.ctx.get_help() if err.ctx is not None else str(err), err=True)
         sys.exit(2)
