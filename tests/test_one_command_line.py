@@ -189,8 +189,9 @@ ERROR_CASES = [
     (["evaluate", QUICK, "--set", "design.l=1"], "'l1'"),
     (["evaluate", QUICK, "--set", "e2=1"], "did you mean 'e'"),
     (["evaluate", QUICK, "--set", f"{LONG}=1"], "unknown option"),
-    (["evaluate", f"{LONG}.yaml"], "no such config file"),
-    (["evaluate", QUICK, "--set", "bounds.ll=[1, 2]"], "did you mean 'l1'"),
+    (["evaluate", "a/" * 150 + "c.yaml"], "no such config file"),
+    (["evaluate", f"{LONG}.yaml"], "File name too long"),
+    (["evaluate", QUICK, "--set", "bounds.cc=[0.1, 0.5]"], "did you mean 'c'"),
     (["ik", "planar-fivebr", POSE], "did you mean 'planar-fivebar'"),
     (["ik", LONG, POSE], "unknown mechanism"),
     (["example", "quik"], "did you mean 'quick'"),
@@ -224,7 +225,8 @@ def test_compare_axis_and_run_directory_errors_say_did_you_mean(runs, capsys):
 def test_the_guard_cuts_any_error_line_to_200_characters():
     from scalesynth.cliapp import error_line
 
-    assert error_line("a" * 1000) == "error: " + "a" * 190 + "..."
+    assert error_line("a" * 300) == "error: " + "a" * 20 + "..." + "a" * 17  # a long word: shortened inside
+    assert error_line("ab " * 100) == "error: " + ("ab " * 100)[:190] + "..."  # short words: the line is cut
     assert error_line("line\nbreak") == "error: line\\nbreak"
 
 

@@ -47,11 +47,21 @@ MAX_ERROR_LINE = 200  # characters of an error line, "error: " included (the pro
 
 
 def error_line(message: str) -> str:
-    """The one line every error is printed as: 'error: ' and the message, line breaks escaped, cut to
-    MAX_ERROR_LINE characters (a message quoting a long value or list ends in '...')."""
+    """The one line every error is printed as: 'error: ' and the message, line breaks escaped, at most
+    MAX_ERROR_LINE characters: a long word (a path, a value or name quoted from the user) is shortened in its
+    middle first, so the sentence around it stays whole; only then is the line cut, ending in '...'."""
+    import re
+
     from scalesynth.config import _one_line
 
     line = f"error: {_one_line(str(message))}"
+    words = re.split(r"(\s+)", line)
+    while len("".join(words)) > MAX_ERROR_LINE:
+        k = max(range(len(words)), key=lambda i: len(words[i]))
+        if len(words[k]) <= 40:
+            break
+        words[k] = words[k][:20] + "..." + words[k][-17:]
+    line = "".join(words)
     return line if len(line) <= MAX_ERROR_LINE else line[: MAX_ERROR_LINE - 3] + "..."
 
 

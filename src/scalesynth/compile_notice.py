@@ -67,6 +67,10 @@ def _what(dispatcher) -> str:
 def notice_line(dispatcher) -> str:
     """The notice: what compiles, that it happens once, where it is cached; at most 200 characters."""
     cache = getattr(getattr(dispatcher, "_cache", None), "_cache_path", None)
+    if cache:  # NUMBA_CACHE_DIR itself rather than its per-source subdirectory
+        from numba.core import config
+
+        cache = config.CACHE_DIR or cache
     where = f"cached in {cache}" if cache else "cached"
     line = (f"note: compiling {_what(dispatcher)} with Numba (first run only, may take minutes; {where} for later "
             "runs)")

@@ -498,7 +498,11 @@ def _one_line(message: str) -> str:
 def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConfig:
     """Read a YAML config (safe loader: no object construction), apply overrides and validate."""
     path = Path(path)
-    if not path.is_file():
+    try:
+        is_file = path.is_file()
+    except OSError as err:  # e.g. a name too long for the file system: bad input, not an I/O failure
+        raise ConfigError(f"{path}: {err.strerror or err}") from None
+    if not is_file:
         raise ConfigError(f"{path}: no such config file")
     try:
         text = path.read_text(encoding="utf-8")

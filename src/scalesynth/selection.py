@@ -197,7 +197,11 @@ def load_design(source: str | Path, design: str | None = None, sets: Sequence[st
     sets = list(sets or [])
     text = str(source)
     path = Path(source)
-    if path.is_dir():
+    try:
+        is_dir, is_file = path.is_dir(), path.is_file()
+    except OSError:  # e.g. a name too long for a file name: not a path, maybe a (misspelt) mechanism name
+        is_dir = is_file = False
+    if is_dir:
         from scalesynth import results
 
         result = results.load(path, require_finished=False)
@@ -213,7 +217,7 @@ def load_design(source: str | Path, design: str | None = None, sets: Sequence[st
                 label += "-set"
         cfg = cfg.model_copy(update={"design": chosen})
         return DesignSource(mech, chosen, cfg.resolved_options(), cfg, label, row, result)
-    if path.is_file() or _looks_like_path(text) or not mechanism_ok:
+    if is_file or _looks_like_path(text) or not mechanism_ok:
         if design not in (None, "config"):
             raise InvalidParameter(f"--design {design[:40]}: a config uses its own design (change it with --set); "
                                    f"give a results directory to choose {SELECTOR}")
