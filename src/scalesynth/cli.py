@@ -25,7 +25,6 @@ from scalesynth.cliapp import (  # noqa: F401 - re-exported: app and the shared 
     SourceArg,
     _design_inputs,
     _fail,
-    _mech_inputs,
     _parse_vector,
     _print_json,
     _warn,

@@ -111,20 +111,6 @@ def _quote(text: str, limit: int = 80) -> str:
     return repr(text if len(text) <= limit else text[:limit] + "...")
 
 
-def _mech_inputs(mech_name: str, sets: list[str] | None):
-    from scalesynth.config import apply_overrides
-    from scalesynth.mechanisms import get
-
-    mech = get(mech_name)
-    data = apply_overrides({}, sets, set(mech.parameter_names))
-    extra = set(data) - {"design", "options"}
-    if extra:
-        raise InvalidPose(f"--set {sorted(extra)[0]}: only design parameters and options apply here")
-    design = mech.resolve_design(data.get("design"))
-    options = mech.resolve_options(data.get("options"))
-    return mech, design, options
-
-
 def _design_inputs(source: str, design: str | None, sets: list[str] | None):
     """(mechanism, design, options) of a pose-level command's MECHANISM|CONFIG|RUN_DIR (selection.load_design)."""
     from scalesynth.selection import load_design

@@ -18,14 +18,6 @@ from scalesynth.cliapp import JsonOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 
 
-def pick_design(run_dir: Path, choice: str):
-    """(config, design, label) of a results directory's front row chosen by ``choice`` (selection.choose_row)."""
-    from scalesynth.selection import load_design
-
-    chosen = load_design(run_dir, choice)
-    return chosen.cfg, chosen.design, chosen.label
-
-
 def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None):
     """Analyse the cycle and write its files; returns the summary dict (cycle.json's content plus file paths)."""
     from scalesynth import io as rio
