@@ -185,7 +185,9 @@ def test_unreadable_bytes_and_directories(tmp_path, capsys, monkeypatch):
     (tmp_path / "dir.yaml").mkdir()
     _assert_refused(["evaluate", "bin.yaml"], 2, "bin.yaml: cannot read (UnicodeDecodeError)", tmp_path, capsys,
                     monkeypatch)
-    _assert_refused(["evaluate", "dir.yaml"], 2, "dir.yaml: no such config file", tmp_path, capsys, monkeypatch)
+    # a directory is read as a results directory (evaluate takes one with --design)
+    _assert_refused(["evaluate", "dir.yaml"], 2, "dir.yaml: not a scalesynth results directory", tmp_path, capsys,
+                    monkeypatch)
     _assert_refused(["evaluate", "missing.yaml"], 2, "missing.yaml: no such config file", tmp_path, capsys,
                     monkeypatch)
 

@@ -95,7 +95,9 @@ def test_unknown_family_or_field_names_are_one_line_errors():
     from scalesynth.evaluate import evaluate_population
 
     cfg = config_from_dict(FIVEBAR)
-    with pytest.raises(InvalidParameter, match=r"^families: unknown name 'tasks' \(known: workspace, task, "):
+    with pytest.raises(InvalidParameter,
+                       match=r"^families: unknown name 'tasks' \(did you mean 'task'\?; known: workspace, task, "):
         evaluate_population(cfg.mech, designs(2), families={"tasks"})
-    with pytest.raises(InvalidParameter, match=r"^fields: unknown name 'LCI' \(known: lci, sigma_min, "):
+    with pytest.raises(InvalidParameter,
+                       match=r"^fields: unknown name 'LCI' \(did you mean 'lci'\?; known: lci, sigma_min, "):
         evaluate_population(cfg.mech, designs(2), fields={"LCI"})

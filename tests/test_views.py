@@ -253,7 +253,7 @@ def test_show_of_a_run_dir_designs_formats_and_errors(small_run, tmp_path):
         res = runner.invoke(app, ["show", str(small_run), "--resolution", "8", "--out", str(tmp_path / "e"), *args])
         assert res.exit_code == 2 and message in res.stderr and len(res.stderr.strip().splitlines()) == 1, res.output
     res = runner.invoke(app, ["show", str(ROOT / "configs" / "quick.yaml"), "--design", "knee"])
-    assert res.exit_code == 2 and "a config shows its own design" in res.stderr
+    assert res.exit_code == 2 and "a config uses its own design" in res.stderr
 
 
 def test_show_colours_by_any_field_of_the_kernel(tmp_path):
@@ -357,7 +357,11 @@ def test_compare_two_runs_of_different_mechanisms(small_run, other_mechanism_run
     table = pd.read_csv(tmp_path / "compare.csv")
     assert set(table["mechanism"]) == {"2pauu-ppap", "pprs-rprs"}
     assert (tmp_path / "compare.png").stat().st_size > 1000
-    assert "gci" in table.columns and "volume_m3" not in table.columns and "volume_mm3" not in table.columns
+    # matched by catalogue name: pprs-rprs's volume in mm3 is converted to the first run's m3 (1 mm3 = 1e-9 m3)
+    assert "gci" in table.columns and "volume_m3" in table.columns and "volume_mm3" not in table.columns
+    other = pd.read_csv(other_mechanism_run / "pareto.csv")
+    row = table[table["mechanism"] == "pprs-rprs"].iloc[0]
+    assert row["volume_m3"] == pytest.approx(other["volume_mm3"].iloc[int(row["pareto_row"])] * 1e-9, rel=1e-12)
     small_pareto = pd.read_csv(small_run / "pareto.csv")
     knee = table[(table["run"] == "small") & (table["design"] == "knee")].iloc[0]
     assert knee["gci"] == pytest.approx(small_pareto["gci"].iloc[int(knee["pareto_row"])], rel=1e-12)

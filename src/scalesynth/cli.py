@@ -19,14 +19,17 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import typer  # noqa: E402
 
 from scalesynth.cliapp import (  # noqa: F401 - re-exported: app and the shared helpers live in cliapp
+    DesignOpt,
     JsonOpt,
     SetOpt,
+    SourceArg,
+    _design_inputs,
     _fail,
-    _mech_inputs,
     _parse_vector,
     _print_json,
     _warn,
     app,
+    error_line,
     handles_errors,
 )
 
@@ -65,24 +68,26 @@ def mechanisms_cmd(as_json: JsonOpt = False) -> None:
 @app.command("evaluate")
 @handles_errors
 def evaluate_cmd(
-    config: Annotated[Path, typer.Argument(help="run config (YAML)")],
+    config: Annotated[Path, typer.Argument(help="run config (YAML), or a results directory with --design")],
+    design_choice: DesignOpt = None,
     sets: SetOpt = None,
     resolution: Annotated[int | None, typer.Option(help="cells per axis; forces the uniform grid")] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Evaluate one design: workspace measure, GCI, FCI, band shares, voxels, seconds."""
-    from scalesynth.config import load_config
     from scalesynth.evaluate import evaluate_config
+    from scalesynth.selection import load_design
 
     overrides = list(sets or [])
     if resolution is not None:
         overrides.append(f"grid.resolution={resolution}")
-    cfg = load_config(config, overrides)
+    chosen = load_design(config, design_choice, overrides)
+    cfg = chosen.cfg
     from scalesynth import memory
 
     memory.check(memory.evaluate_estimates(cfg))
     mech = cfg.mech
-    design = cfg.resolved_design()
+    design = chosen.design
     for key, (lo, hi) in cfg.bounds.items():
         if not lo <= design[key] <= hi:
             _warn(f"design.{key}={design[key]:g} is outside the optimisation bounds [{lo:g}, {hi:g}]")
@@ -119,13 +124,14 @@ def evaluate_cmd(
 @app.command("ik")
 @handles_errors
 def ik_cmd(
-    mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
+    mechanism: SourceArg,
     pose: Annotated[str, typer.Option("--pose", help="task coordinates, comma-separated")],
+    design_choice: DesignOpt = None,
     sets: SetOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """All inverse-kinematics branches of a pose."""
-    mech, design, options = _mech_inputs(mechanism, sets)
+    mech, design, options = _design_inputs(mechanism, design_choice, sets)
     p = _parse_vector("--pose", pose, len(mech.task_axes))
     sols = mech.inverse_kinematics(design, options, p)
     rows = []
@@ -140,13 +146,14 @@ def ik_cmd(
 @app.command("fk")
 @handles_errors
 def fk_cmd(
-    mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
+    mechanism: SourceArg,
     inputs: Annotated[str, typer.Option("--inputs", help="joint inputs, comma-separated")],
+    design_choice: DesignOpt = None,
     sets: SetOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """All forward-kinematics assembly modes of a joint-input vector."""
-    mech, design, options = _mech_inputs(mechanism, sets)
+    mech, design, options = _design_inputs(mechanism, design_choice, sets)
     q = _parse_vector("--inputs", inputs, len(mech.joints))
     rows = [s.as_dict() for s in mech.forward_kinematics(design, options, q)]
     _print_solutions(mech.pose_axes, rows, as_json, "no isolated assembly: inputs out of reach or degenerate")
@@ -167,6 +174,23 @@ def _print_solutions(names, rows, as_json: bool, empty_msg: str) -> None:
         typer.echo(f"{r['branch']:>6}: {vals}{extra}")
 
 
+@app.callback()
+def _root(
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="no notice when Numba compiles (any command)")] = False,
+) -> None:
+    """Multi-objective dimensional synthesis of parallel mechanisms."""
+    if quiet:
+        from scalesynth import compile_notice
+
+        compile_notice.enable(quiet=True)
+
+
+def _quiet(argv: list[str]) -> bool:
+    """-q/--quiet anywhere before '--' (before the command, or a command's own, e.g. optimize -q)."""
+    words = argv[: argv.index("--")] if "--" in argv else argv
+    return any(w in ("-q", "--quiet") for w in words)
+
+
 def _load_commands() -> None:
     """Register the commands defined in ``scalesynth.commands`` (one module per command group)."""
     import importlib
@@ -181,9 +205,27 @@ def _load_commands() -> None:
 _load_commands()
 
 
+def _usage_message(err) -> str:
+    """click's message (it already says "did you mean" for a misspelt command or option) and where help is."""
+    hint = f" (try `{err.ctx.command_path} --help`)" if err.ctx is not None else ""
+    return f"{err.format_message()}{hint}"
+
+
 def main(argv: list[str] | None = None) -> None:
     """The console entry point: usage errors (unknown option, bad value, missing argument) become one line on
-    stderr with exit code 2, like every other bad input, instead of click's framed box."""
+    stderr with exit code 2, like every other bad input, instead of click's framed box. A process that compiles
+    Numba kernels says so in one line on stderr, unless -q/--quiet (scalesynth.compile_notice)."""
+    from scalesynth import compile_notice
+
+    args = list(sys.argv[1:] if argv is None else argv)
+    compile_notice.enable(quiet=_quiet([str(a) for a in args]))  # one line on stderr if this process compiles
+    try:
+        _run(args)
+    finally:  # main() called in-process (tests, scripts): the notice does not outlive it
+        compile_notice.enable(quiet=True)
+
+
+def _run(args: list[str]) -> None:
     try:  # typer >= 0.22 vendors click
         from typer._click import exceptions as click_errors
     except ImportError:  # pragma: no cover - older typer on upstream click
@@ -198,27 +240,21 @@ def main(argv: list[str] | None = None) -> None:
         typer.echo(f"error: {err}", err=True)
         sys.exit(err.exit_code)
     try:
-        rv = app(args=argv, prog_name="scalesynth", standalone_mode=False)
+        rv = app(args=args, prog_name="scalesynth", standalone_mode=False)
     except click_errors.NoArgsIsHelpError as err:
         typer.echo(err.ctx.get_help() if err.ctx is not None else str(err), err=True)
         sys.exit(2)
     except click_errors.UsageError as err:
-        from scalesynth.config import _one_line
-
-        hint = f" (try `{err.ctx.command_path} --help`)" if err.ctx is not None else ""
-        typer.echo(f"error: {_one_line(err.format_message())}{hint}", err=True)
+        typer.echo(error_line(_usage_message(err)), err=True)
         sys.exit(2)
     except typer.Abort:
-        typer.echo("error: interrupted", err=True)
+        typer.echo(error_line("interrupted"), err=True)
         sys.exit(1)
     except Exception as err:  # a bug: still one line, never a traceback (SCALESYNTH_DEBUG=1 shows it)
         import os
 
         if os.environ.get("SCALESYNTH_DEBUG"):
             raise
-        from scalesynth.config import _one_line
-
-        typer.echo(f"error: internal error ({err.__class__.__name__}: {_one_line(str(err))}); please report it",
-                   err=True)
+        typer.echo(error_line(f"internal error ({err.__class__.__name__}: {err}); please report it"), err=True)
         sys.exit(1)
     sys.exit(rv if isinstance(rv, int) else 0)

@@ -34,9 +34,42 @@ JsonOpt = Annotated[bool, typer.Option("--json", help="print one JSON object on 
 ForceOpt = Annotated[bool, typer.Option(
     "--force", help="write into an --out directory that is not this command's own (replacing only files it writes)")]
 
+DesignOpt = Annotated[
+    str | None,
+    typer.Option("--design", help="of a results directory: knee (default), best-<metric> (e.g. best-gci) or a row "
+                 "of pareto.csv"),
+]
+
+SourceArg = Annotated[
+    str,
+    typer.Argument(metavar="MECHANISM|CONFIG|RUN_DIR", help="mechanism name (its default design; see `scalesynth "
+                   "mechanisms`), run config (YAML), or a results directory (with --design)"),
+]
+
+MAX_ERROR_LINE = 200  # characters of an error line, "error: " included (the project's promise)
+
+
+def error_line(message: str) -> str:
+    """The one line every error is printed as: 'error: ' and the message, line breaks escaped, at most
+    MAX_ERROR_LINE characters: a long word (a path, a value or name quoted from the user) is shortened in its
+    middle first, so the sentence around it stays whole; only then is the line cut, ending in '...'."""
+    import re
+
+    from scalesynth.config import _one_line
+
+    line = f"error: {_one_line(str(message))}"
+    words = re.split(r"(\s+)", line)
+    while len("".join(words)) > MAX_ERROR_LINE:
+        k = max(range(len(words)), key=lambda i: len(words[i]))
+        if len(words[k]) <= 40:
+            break
+        words[k] = words[k][:20] + "..." + words[k][-17:]
+    line = "".join(words)
+    return line if len(line) <= MAX_ERROR_LINE else line[: MAX_ERROR_LINE - 3] + "..."
+
 
 def _fail(message: str, code: int) -> None:
-    typer.echo(f"error: {message}", err=True)
+    typer.echo(error_line(message), err=True)
     raise typer.Exit(code)
 
 
@@ -81,18 +114,12 @@ def _quote(text: str, limit: int = 80) -> str:
     return repr(text if len(text) <= limit else text[:limit] + "...")
 
 
-def _mech_inputs(mech_name: str, sets: list[str] | None):
-    from scalesynth.config import apply_overrides
-    from scalesynth.mechanisms import get
+def _design_inputs(source: str, design: str | None, sets: list[str] | None):
+    """(mechanism, design, options) of a pose-level command's MECHANISM|CONFIG|RUN_DIR (selection.load_design)."""
+    from scalesynth.selection import load_design
 
-    mech = get(mech_name)
-    data = apply_overrides({}, sets, set(mech.parameter_names))
-    extra = set(data) - {"design", "options"}
-    if extra:
-        raise InvalidPose(f"--set {sorted(extra)[0]}: only design parameters and options apply here")
-    design = mech.resolve_design(data.get("design"))
-    options = mech.resolve_options(data.get("options"))
-    return mech, design, options
+    chosen = load_design(source, design, sets, mechanism_ok=True)
+    return chosen.mech, chosen.design, chosen.options
 
 
 def _print_json(obj: Any) -> None:

@@ -18,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from scalesynth.cycle import config as cycle_config
 from scalesynth.errors import ConfigError, ScalesynthError
+from scalesynth.names import hint
 
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
@@ -273,7 +274,7 @@ class RunConfig(_Strict):
         params = {p.name: p for p in mech.parameters}
         for key, (lo, _) in self.bounds.items():
             if key not in params:
-                raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} (known: {', '.join(params)})")
+                raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} " + hint(str(key), params))
             if params[key].positive and lo <= 0:
                 raise ValueError(f"bounds.{key}: lower bound must be > 0 for a length, got {lo}")
         self._check_metrics(mech)
@@ -525,7 +526,11 @@ def _one_line(message: str) -> str:
 def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConfig:
     """Read a YAML config (safe loader: no object construction), apply overrides and validate."""
     path = Path(path)
-    if not path.is_file():
+    try:
+        is_file = path.is_file()
+    except OSError as err:  # e.g. a name too long for the file system: bad input, not an I/O failure
+        raise ConfigError(f"{path}: {err.strerror or err}") from None
+    if not is_file:
         raise ConfigError(f"{path}: no such config file")
     text = read_limited(path, MAX_YAML_BYTES)
     return config_from_dict(safe_yaml(text, str(path)), overrides)

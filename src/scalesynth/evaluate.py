@@ -19,6 +19,7 @@ from scalesynth import metrics as _metrics
 from scalesynth.errors import InvalidParameter
 from scalesynth.kernels import grid as _grid
 from scalesynth.mechanisms.base import Mechanism
+from scalesynth.names import hint
 from scalesynth.paths import sample_path  # noqa: F401 - re-exported for callers of evaluate
 
 DEFAULT_BAND_EDGES = (0.0, 0.1, 0.3, 1.0)
@@ -771,7 +772,7 @@ def _check_selection(what: str, names: Collection[str] | None, known: Sequence[s
     otherwise just select nothing)."""
     for name in names or ():
         if name not in known:
-            raise InvalidParameter(f"{what}: unknown name {name!r} (known: {', '.join(known)})")
+            raise InvalidParameter(f"{what}: unknown name {name!r} " + hint(str(name), known))
 
 
 def evaluator_description(cfg) -> str:

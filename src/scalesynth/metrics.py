@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from scalesynth.mechanisms.base import Field, Mechanism, option_set
+from scalesynth.names import hint
 from scalesynth.paths import sample_path
 
 FAMILIES = ("workspace", "task", "path", "design", "cycle")
@@ -406,13 +407,14 @@ def resolve(mech: Mechanism, length_unit: str, name: str, band: int | None, n_ba
                 fname = name[len(head):]
                 if name.startswith(head) and fname in all_field_names():
                     raise ValueError(f"metric: {name}: field {fname!r} is not provided by {mech.name} "
-                                     f"(fields: {', '.join(mech.field_names)})")
+                                     + hint(fname, mech.field_names, "fields"))
         split = [n for n in cat if n.startswith(f"{name}_") and n.split("_")[-1] in ("revolute", "prismatic")]
         if split:  # an actuator peak of a mechanism with both kinds: one unit per metric, so one per kind
             raise ValueError(f"metric: {name} mixes units on {mech.name} (revolute and prismatic actuators); "
                              f"did you mean {' or '.join(split)}?")
         usable = [m.name for m in cat.values() if applicable(m, has_task, has_path, options, cycle, adaptive) is None]
-        raise ValueError(f"metric: unknown metric {name!r} for {mech.name} (valid: {', '.join(usable)})")
+        raise ValueError(f"metric: unknown metric {name!r} for {mech.name} "
+                         + hint(name, usable, "valid", more=f"see `scalesynth metrics {mech.name}`"))
     m = cat[name]
     why = applicable(m, has_task, has_path, options, cycle, adaptive)
     if why is not None:

@@ -29,30 +29,11 @@ OUTPUT = rundir.Output("show", "show.json", ("design_choice", "sections", "files
 CONNECTIVITY = "26-connected: cells sharing a face, an edge or a corner (8 in 2-D); face-only count beside it"
 
 
-def load_source(source: Path, sets: Sequence[str] | None = None):
-    """(config, RunResult or None) for a config file or a results directory."""
-    from scalesynth.config import load_config
+def load_source(source: Path, sets: Sequence[str] | None = None, design: str | None = None):
+    """The selection.DesignSource of ``show SOURCE [--design ...] [--set ...]`` (a config or a results directory)."""
+    from scalesynth.selection import load_design
 
-    source = Path(source)
-    if source.is_dir():
-        from scalesynth.results import load  # pandas and pymoo: only for a results directory
-
-        result = load(source, require_finished=False)
-        if sets:
-            return load_config(source / "config.yaml", list(sets)), result
-        return result.cfg, result
-    return load_config(source, list(sets or [])), None
-
-
-def resolve_design(cfg, result, choice: str | None) -> tuple[dict[str, float], str, int | None]:
-    """(design, label, row of pareto.csv or None) for ``--design``."""
-    if result is None:
-        if choice not in (None, "config"):
-            raise ConfigError(f"--design {choice}: a config shows its own design; give a results directory to "
-                              "choose knee, best-<metric> or a row")
-        return cfg.resolved_design(), "config", None
-    row, label = wv.choose_row(result, choice or "knee")
-    return result.design_of(result.pareto.iloc[row]), label, row
+    return load_design(source, design, sets)
 
 
 def sections(cfg, fg: wv.FieldGrid, field: str, at: dict[int, float],
@@ -136,7 +117,8 @@ def show_design(
     t0 = time.perf_counter()
     if fmt not in FORMATS:
         raise ConfigError(f"--format: must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    cfg, result = load_source(source, sets)
+    chosen_source = load_source(source, sets, design)
+    cfg, result = chosen_source.cfg, chosen_source.result
     run_dir = None if result is None else result.out_dir
     mech = cfg.mech
     wv.check_field(mech, field)
@@ -147,7 +129,7 @@ def show_design(
     from scalesynth import memory
 
     memory.check(memory.show_estimate(cfg, res, "--resolution" if resolution else "grid.resolution"))
-    chosen, label, row = resolve_design(cfg, result, design)
+    chosen, label, row = chosen_source.design, chosen_source.label, chosen_source.row
     target = Path(out) if out is not None else (run_dir or cfg.output_dir()) / "show" / label
     with rundir.staged(target, OUTPUT, force) as staged:  # --out checked and locked before the sampling
         summary = _show(cfg, source, label, row, chosen, field, at_axes, res, fmt, pose, staged.work, t0)

@@ -1,6 +1,6 @@
 """One design's workspace as data for views: per-voxel fields on a grid, dexterity-band regions and their
-connected components, the centroid, sections (planes sampled on their own, never through a full grid), and the
-design chosen from a results directory (knee, best-<metric>, row).
+connected components, the centroid and sections (planes sampled on their own, never through a full grid). A design
+of a results directory is chosen by ``scalesynth.selection.choose_row``.
 
 Connectivity of regions: two cells of a band belong to one region when they share a face, an edge or a corner
 (26-connectivity in 3-D, 8 in 2-D, ``scipy.ndimage.label``); the face-only count (6 / 4) is reported beside it.
@@ -18,6 +18,7 @@ from scalesynth import labels as lab
 from scalesynth.errors import ConfigError, InvalidParameter
 from scalesynth.evaluate import Grid, make_grid
 from scalesynth.kernels import grid as _grid
+from scalesynth.names import hint
 
 CENTROID_RESOLUTION = 24  # coarse grid locating a section's default position (24^3 = 14k points)
 MAX_POINTS = 20_000  # boundary voxels drawn per 3-D panel (deterministic thinning beyond; drawing dominates show)
@@ -31,7 +32,7 @@ def available_fields(mech) -> tuple[str, ...]:
 def check_field(mech, name: str) -> str:
     known = available_fields(mech)
     if name not in known:
-        raise ConfigError(f"--field: unknown per-voxel field {name!r} of {mech.name} (known: {', '.join(known)})")
+        raise ConfigError(f"--field: unknown per-voxel field {name!r} of {mech.name} " + hint(name, known))
     return name
 
 
@@ -292,43 +293,6 @@ def task_pose(cfg, design: Mapping[str, float]) -> tuple[np.ndarray, str] | None
     centres = lo + (idx + 0.5) * step
     k = int(np.argmin((((centres - centre) / step)[:, :ndim] ** 2).sum(axis=1)))
     return centres[k, :ndim], "reachable task cell nearest the task box centre"
-
-
-# ----- choosing a design of a run ----------------------------------------------------------------------------------
-def choose_row(result, choice: str) -> tuple[int, str]:
-    """Row of a run's pareto.csv for ``choice``: 'knee', 'best-<metric>' (a column of pareto.csv, or 'volume'/'area'
-    for the workspace measure; best = the objective's sense, otherwise the largest) or a row number. ``result``:
-    a results.RunResult. Returns (row, label)."""
-    from scalesynth.selection import choose
-
-    problem, pareto = result.problem, result.pareto
-    measure_key = result.cfg.mech.measure_key(result.cfg.units.length)
-    if not len(pareto):
-        raise InvalidParameter("--design: the front is empty (no feasible design), nothing to show")
-    if choice == "knee":
-        return choose(result.objective_matrix(), "knee"), "knee"
-    if choice.startswith("best-"):
-        metric = choice[5:]
-        col = measure_key if metric in ("volume", "area", "measure") else metric
-        if col not in pareto.columns:
-            known = ", ".join(c for c in pareto.columns if c not in problem.var_names)
-            raise InvalidParameter(f"--design: unknown metric {metric!r} in pareto.csv (known: {known})")
-        values = pareto[col].to_numpy(dtype=float)
-        sense = "max"
-        if col in problem.objective_keys:
-            sense = "min" if problem.signs[problem.objective_keys.index(col)] > 0 else "max"
-        if np.isnan(values).all():
-            raise InvalidParameter(f"--design: best-{metric}: null on every front row (a statistic over an empty set)")
-        # a statistic over an empty set (NaN) is never the best row
-        row = int(np.nanargmin(values) if sense == "min" else np.nanargmax(values))
-        return row, f"best-{col}"
-    try:
-        row = int(choice)
-    except ValueError:
-        raise InvalidParameter(f"--design: expected knee, best-<metric> or a row number, got {choice!r}") from None
-    if not 0 <= row < len(pareto):
-        raise InvalidParameter(f"--design: row {row} is not in pareto.csv (rows 0..{len(pareto) - 1})")
-    return row, f"row{row}"
 
 
 def parse_at(items: Sequence[str] | None, mech) -> dict[int, float]:

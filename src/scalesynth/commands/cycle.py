@@ -2,8 +2,9 @@
 
 CONFIG is a run config with a ``cycle:`` section (its ``design`` is analysed); RUN_DIR is a results directory,
 whose config must have one, with ``--design knee`` (default), ``best-<metric>`` (the front row with the best
-value of a metric) or a row number of pareto.csv. Writes cycle.csv, cycle.json, actuators.png, path.png, quality.png to
-``--out`` (default: <results dir>/cycle for a config, RUN_DIR/cycle-<design> for a run).
+value of a metric) or a row number of pareto.csv (``scalesynth.selection``); ``--set`` overrides either. Writes
+cycle.csv, cycle.json, actuators.png, path.png, quality.png to ``--out`` (default: <results dir>/cycle for a config,
+RUN_DIR/cycle-<design> for a run).
 """
 
 from __future__ import annotations
@@ -17,47 +18,6 @@ from scalesynth.cliapp import ForceOpt, JsonOpt, SetOpt, _print_json, app, handl
 from scalesynth.errors import ConfigError
 
 
-def pick_design(run_dir: Path, choice: str):
-    """(config, design, label) of a results directory's front row chosen by ``choice``: knee, best-<metric> (a
-    catalogue metric name or result column; the best value in the objective's sense, or the catalogue's better
-    direction for a metric that is not an objective) or a row number of pareto.csv."""
-    import numpy as np
-
-    from scalesynth import results
-    from scalesynth.metrics import catalogue
-    from scalesynth.selection import choose
-
-    result = results.load(run_dir, require_finished=False)
-    cfg, pareto = result.cfg, result.pareto
-    if not len(pareto):
-        raise ConfigError(f"{run_dir}: the front is empty (no feasible design)")
-    if choice == "knee":
-        row = choose(result.objective_matrix(), "knee")
-    elif choice.startswith("best-"):
-        wanted = choice.removeprefix("best-")
-        cat = catalogue(cfg.mech, cfg.units.length)
-        entry = next((m for m in cat.values() if wanted in (m.name, m.column) and "band" not in m.needs), None)
-        if entry is None or entry.column not in pareto.columns or entry.better is None:
-            known = [m.name for m in cat.values() if m.column in pareto.columns and m.better is not None]
-            raise ConfigError(f"--design: best-{wanted}: not a metric of the run's results (known: {', '.join(known)})")
-        senses = {o.metric: o.sense for o in cfg.objectives}
-        sense = senses.get(entry.name, entry.better)
-        values = pareto[entry.column].to_numpy(dtype=float)
-        if np.isnan(values).all():
-            raise ConfigError(f"--design: best-{wanted}: null on every front row (a statistic over an empty set)")
-        # a statistic over an empty set (NaN) is never the best row
-        row = int(np.nanargmax(values) if sense == "max" else np.nanargmin(values))
-    else:
-        try:
-            row = int(choice)
-        except ValueError:
-            raise ConfigError(f"--design: expected knee, best-<metric> or a row number, got {choice!r}") from None
-        if not 0 <= row < len(pareto):
-            raise ConfigError(f"--design: row {row} out of range (pareto.csv has {len(pareto)} rows)")
-    label = choice if choice.startswith(("knee", "best-")) else f"row{row}"
-    return cfg, result.design_of(pareto.iloc[row]), label
-
-
 def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None,
               force: bool = False):
     """Analyse the cycle and write its files; returns the summary dict (cycle.json's content plus file paths).
@@ -65,21 +25,18 @@ def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | 
     The output directory is staged and swapped in whole (``scalesynth.rundir``): a failure or an interrupt leaves
     the previous one as it was. It must be new, empty or a cycle directory unless ``force``."""
     from scalesynth import rundir
-    from scalesynth.config import load_config
     from scalesynth.cycle import analysis, output
+    from scalesynth.selection import load_design
 
     source = Path(source)
-    if source.is_dir():
-        if sets:
-            raise ConfigError("--set: applies to a config file, not to a results directory")
-        cfg, design, label = pick_design(source, design_choice or "knee")
-        out_dir = out if out is not None else source / f"cycle-{label}"
+    chosen = load_design(source, design_choice, sets)
+    cfg, design = chosen.cfg, chosen.design
+    if out is not None:
+        out_dir = out
+    elif chosen.result is not None:
+        out_dir = source / f"cycle-{chosen.label}"
     else:
-        if design_choice is not None:
-            raise ConfigError("--design: applies to a results directory, not to a config file")
-        cfg = load_config(source, sets)
-        design = cfg.resolved_design()
-        out_dir = out if out is not None else cfg.output_dir() / "cycle"
+        out_dir = cfg.output_dir() / "cycle"
     if cfg.cycle is None:
         raise ConfigError("cycle: the config has no cycle section (cycle.path or cycle.preset)")
     options = cfg.resolved_options()
@@ -97,7 +54,7 @@ def cycle_cmd(
     source: Annotated[Path, typer.Argument(help="run config (YAML) with a cycle section, or a results directory")],
     sets: SetOpt = None,
     design: Annotated[
-        str | None, typer.Option("--design", help="results directory only: knee (default), best-<metric> or a row")
+        str | None, typer.Option("--design", help="of a results directory: knee (default), best-<metric> or a row")
     ] = None,
     out: Annotated[Path | None, typer.Option("--out", help="output directory")] = None,
     as_json: JsonOpt = False,

@@ -17,7 +17,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cliapp import _print_json, app, handles_errors
+from scalesynth.cliapp import DesignOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError, InvalidPose
 from scalesynth.io import ensure_dir, save_figure, write_text
 
@@ -76,7 +76,10 @@ def _parse_center(text: str) -> tuple[float, float]:
 @app.command("drives")
 @handles_errors
 def drives_cmd(
-    config: Annotated[Path, typer.Argument(help="run config (YAML) of a pprs-rprs design")],
+    config: Annotated[Path, typer.Argument(help="run config (YAML) of a pprs-rprs design, or a results directory "
+                                           "with --design")],
+    design_choice: DesignOpt = None,
+    sets: SetOpt = None,
     z: Annotated[float, typer.Option("--z", help="height of the square path (mm)")] = 200.0,
     side: Annotated[float, typer.Option("--side", help="side of the square (mm)")] = 20.0,
     center: Annotated[str, typer.Option("--center", help="centre x,y of the square (mm)")] = DEFAULT_CENTER,
@@ -85,12 +88,12 @@ def drives_cmd(
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
 ) -> None:
     """Drive-displacement curves of a pprs-rprs design along a closed square E-F-G-H-E: drives.csv, drives.png."""
-    from scalesynth.config import load_config
     from scalesynth.cycle import analysis
     from scalesynth.cycle.config import CycleConfig
     from scalesynth.mechanisms.pprs_rprs import MECHANISM
+    from scalesynth.selection import load_design
 
-    cfg = load_config(config)
+    cfg = load_design(config, design_choice, sets).cfg
     if cfg.mechanism != MECHANISM.name:
         raise ConfigError(f"mechanism: drives needs {MECHANISM.name}, got {cfg.mechanism!r}")
     if not (np.isfinite(side) and side > 0):

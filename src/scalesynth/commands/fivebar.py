@@ -14,8 +14,9 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import DesignOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
+from scalesynth.names import hint
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ def task_map(cfg, resolution: int | None = None, field: str = "lci") -> TaskMap:
     if field == "lci":
         return TaskMap(xs=xs, ys=ys, lci=lci, path=path)
     if field not in mech.field_names:
-        raise ConfigError(f"--field: unknown field {field!r} of {mech.name} (fields: {', '.join(mech.field_names)})")
+        raise ConfigError(f"--field: unknown field {field!r} of {mech.name} " + hint(field, mech.field_names, "fields"))
     from scalesynth.kernels.grid import sample_fields
 
     slot = mech.field_names.index(field)
@@ -133,7 +134,9 @@ def _save_atomic(fig, out: Path) -> None:
 @app.command("plot-task")
 @handles_errors
 def plot_task_cmd(
-    config: Annotated[Path, typer.Argument(help="run config (YAML) of a planar mechanism with a task section")],
+    config: Annotated[Path, typer.Argument(help="run config (YAML) of a planar mechanism with a task section, or a "
+                                           "results directory with --design")],
+    design_choice: DesignOpt = None,
     out: Annotated[Path | None, typer.Option("--out", help="directory to write task_lci.<format> into (default "
                                               "OUTDIR/plots); a name with a .png/.svg/.pdf suffix is the file")] = None,
     fmt: Annotated[str, typer.Option("--format", help="png | svg | pdf")] = "png",
@@ -145,11 +148,11 @@ def plot_task_cmd(
 ) -> None:
     """LCI (or another field, e.g. the deflection under the load) over the task box (unreachable cells blank) with
     the task path, as a PNG."""
-    from scalesynth.config import load_config
+    from scalesynth.selection import load_design
 
     if fmt not in ("png", "svg", "pdf"):
         raise ConfigError(f"--format: must be one of png, svg, pdf, got {fmt!r}")
-    cfg = load_config(config, list(sets or []))
+    cfg = load_design(config, design_choice, sets).cfg
     tm = task_map(cfg, resolution, field)
     unit = cfg.units.length
     design = ", ".join(f"{k}={v:g}" for k, v in cfg.resolved_design().items())

@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import JsonOpt, SetOpt, _mech_inputs, _print_json, app, handles_errors
+from scalesynth.cliapp import DesignOpt, JsonOpt, SetOpt, SourceArg, _design_inputs, _print_json, app, handles_errors
 from scalesynth.errors import InvalidParameter
 
 MAX_SAMPLES = 10_000  # each sample is a random feasible configuration and an SVD: 10 000 take about a minute
@@ -21,7 +21,8 @@ MAX_SAMPLES = 10_000  # each sample is a random feasible configuration and an SV
 @app.command("mobility")
 @handles_errors
 def mobility_cmd(
-    mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
+    mechanism: SourceArg,
+    design_choice: DesignOpt = None,
     sets: SetOpt = None,
     samples: Annotated[
         int, typer.Option("--samples", help="random feasible configurations for the screw-theory rank check")
@@ -34,7 +35,7 @@ def mobility_cmd(
 
     if not 1 <= samples <= MAX_SAMPLES:
         raise InvalidParameter(f"--samples: expected an integer in [1, {MAX_SAMPLES}], got {samples}")
-    mech, design, options = _mech_inputs(mechanism, sets)
+    mech, design, options = _design_inputs(mechanism, design_choice, sets)
     report = mobility_report(mech, design, options, samples=samples, seed=seed)
     out = report.to_dict()
     if as_json:

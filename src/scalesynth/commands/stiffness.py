@@ -1,4 +1,5 @@
-"""`scalesynth stiffness MECH --pose=... [--load=...] [--set k=v ...] [--json]`: stiffness at one pose."""
+"""`scalesynth stiffness MECH|CONFIG|RUN_DIR --pose=... [--design ...] [--load=...] [--set k=v ...]`: stiffness at
+one pose."""
 
 from __future__ import annotations
 
@@ -6,14 +7,25 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import JsonOpt, SetOpt, _mech_inputs, _parse_vector, _print_json, app, handles_errors
+from scalesynth.cliapp import (
+    DesignOpt,
+    JsonOpt,
+    SetOpt,
+    SourceArg,
+    _design_inputs,
+    _parse_vector,
+    _print_json,
+    app,
+    handles_errors,
+)
 
 
 @app.command("stiffness")
 @handles_errors
 def stiffness_cmd(
-    mechanism: Annotated[str, typer.Argument(help="mechanism name (see `scalesynth mechanisms`)")],
+    mechanism: SourceArg,
     pose: Annotated[str, typer.Option("--pose", help="task coordinates, comma-separated")],
+    design_choice: DesignOpt = None,
     load: Annotated[str | None, typer.Option("--load", help="force on the platform, N: Fx,Fy(,Fz)")] = None,
     joints: Annotated[str, typer.Option("--joints", help="ideal (moment-free passive joints) or bonded (welded)")]
     = "ideal",
@@ -24,7 +36,7 @@ def stiffness_cmd(
     frame model solved (links, joints, actuators, platform, load) with every unit."""
     from scalesynth.stiffness.report import pose_stiffness
 
-    mech, design, options = _mech_inputs(mechanism, sets)
+    mech, design, options = _design_inputs(mechanism, design_choice, sets)
     p = _parse_vector("--pose", pose, len(mech.task_axes))
     if load is not None:
         n = len(options["load"]) if "load" in options else 3

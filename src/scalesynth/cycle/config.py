@@ -27,6 +27,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from scalesynth.cycle.trajectory import LAWS
+from scalesynth.names import hint
 
 PRESETS = ("adept",)
 G0 = 9.80665  # standard gravity, m/s^2
@@ -76,7 +77,7 @@ class CycleConfig(BaseModel):
     @classmethod
     def _preset_ok(cls, v):
         if v is not None and v not in PRESETS:
-            raise ValueError(f"unknown preset {v!r} (known: {', '.join(PRESETS)})")
+            raise ValueError(f"unknown preset {v!r} " + hint(str(v), PRESETS))
         return v
 
     @field_validator("law")
@@ -84,7 +85,7 @@ class CycleConfig(BaseModel):
     def _law_ok(cls, v):
         for law in [v] if isinstance(v, str) else v:
             if law not in LAWS:
-                raise ValueError(f"unknown motion law {law!r} (known: {', '.join(LAWS)})")
+                raise ValueError(f"unknown motion law {law!r} " + hint(str(law), LAWS))
         if not isinstance(v, str) and "constant" in v and len(set(v)) > 1:
             raise ValueError("'constant' applies to the whole loop, not to single segments")
         return v

@@ -10,6 +10,7 @@ from __future__ import annotations
 from importlib import resources
 
 from scalesynth.errors import ConfigError
+from scalesynth.names import hint
 
 
 def _files() -> dict[str, resources.abc.Traversable]:
@@ -26,7 +27,7 @@ def text(name: str) -> str:
     """The YAML text of example ``name``; an unknown name raises ConfigError naming the available ones."""
     files = _files()
     if name not in files:
-        raise ConfigError(f"example: unknown example {name!r} (available: {', '.join(sorted(files))})")
+        raise ConfigError(f"example: unknown example {name!r} " + hint(name, sorted(files), "available"))
     return files[name].read_text(encoding="utf-8")
 
 

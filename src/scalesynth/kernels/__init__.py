@@ -8,7 +8,9 @@ from scalesynth import environment as _environment
 
 _environment.check()  # NUMBA_* variables, before Numba is imported
 
+from scalesynth import compile_notice as _compile_notice  # noqa: E402
 from scalesynth.kernels import cache_lock as _cache_lock  # noqa: E402
 
 _cache_lock.install()
 _environment.tolerate_missing_cache()  # no writable cache location: compile in memory, one warning
+_compile_notice.attach()  # a CLI process that compiles says so once (a no-op unless the CLI enabled it)

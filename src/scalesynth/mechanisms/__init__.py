@@ -68,6 +68,7 @@ def get(name: str) -> Mechanism:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise UnknownMechanism(
-            f"mechanism: unknown mechanism {name!r} (available: {', '.join(sorted(_REGISTRY))})"
-        ) from None
+        from scalesynth.names import hint
+
+        raise UnknownMechanism(f"mechanism: unknown mechanism {str(name)[:60]!r} "
+                               + hint(str(name), sorted(_REGISTRY), "available")) from None

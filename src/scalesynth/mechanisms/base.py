@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.names import hint
 
 
 @dataclass(frozen=True)
@@ -172,9 +173,7 @@ class Mechanism(ABC):
         design = self.default_design()
         for key, value in (values or {}).items():
             if key not in design:
-                raise InvalidParameter(
-                    f"design.{key}: unknown parameter of {self.name} (known: {', '.join(design)})"
-                )
+                raise InvalidParameter(f"design.{key}: unknown parameter of {self.name} " + hint(str(key), design))
             design[key] = _finite_float(f"design.{key}", value)
         for p in self.parameters:
             if p.positive and design[p.name] <= 0:
@@ -185,8 +184,8 @@ class Mechanism(ABC):
         options = self.default_options()
         for key, value in (values or {}).items():
             if key not in options:
-                known = ", ".join(options) or "none"
-                raise InvalidParameter(f"options.{key}: unknown option of {self.name} (known: {known})")
+                raise InvalidParameter(f"options.{key}: unknown option of {self.name} "
+                                       + hint(str(key), options, also=self.parameter_names))
             options[key] = value
         self.check_options(options)
         for key, value in options.items():

@@ -22,6 +22,7 @@ import numpy as np
 
 from scalesynth.errors import InvalidParameter
 from scalesynth.mechanisms.base import Field
+from scalesynth.names import hint
 
 # the per-voxel field of the mechanisms whose field kernels compute their capsules' clearance
 CLEARANCE_FIELD = Field(
@@ -107,7 +108,7 @@ def check_radius_option(options: dict[str, Any], bodies: Iterable[str]) -> None:
     for body, r in items:
         where = "options.link_radius" + ("" if body is None else f".{body}")
         if body is not None and body not in known:
-            raise InvalidParameter(f"{where}: unknown body (known: {', '.join(known)})")
+            raise InvalidParameter(f"{where}: unknown body " + hint(str(body), known))
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not math.isfinite(r) or r < 0:
             raise InvalidParameter(f"{where}: expected a length >= 0, got {r!r}")
 

@@ -15,6 +15,7 @@ from typing import Any
 
 from scalesynth.errors import InvalidParameter
 from scalesynth.mechanisms.base import Option
+from scalesynth.names import hint
 
 # Every positive stiffness input (Young's modulus, tube diameter and wall, actuator stiffness) lies in
 # [SMALLEST, MAX_MAGNITUDE]: the kernels divide by the rigidities (L / EA, L^3 / 3 EI, 1 / k) and multiply the
@@ -104,7 +105,7 @@ def check_stiffness_options(options: dict[str, Any], dim: int, groups: tuple[str
         raise InvalidParameter(f"options.sections: expected a mapping {{group: [diameter, wall]}}, got {sections!r}")
     for key in sections:
         if key not in groups:
-            raise InvalidParameter(f"options.sections.{key}: unknown link group (known: {', '.join(groups)})")
+            raise InvalidParameter(f"options.sections.{key}: unknown link group " + hint(str(key), groups))
     options["sections"] = {k: _tube(f"sections.{k}", v) for k, v in sections.items()}
     options["actuator_stiffness"] = _positive("actuator_stiffness", options["actuator_stiffness"])
     load = options["load"]
