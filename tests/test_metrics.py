@@ -206,8 +206,8 @@ def test_report_wall_time_is_this_runs_manifest(tmp_path):
     cfg = load_config(_small(tmp_path, algorithm=dict(SMALL["algorithm"], n_gen=2)))
     out = tmp_path / "run"
     out.mkdir()
-    (out / "manifest.json").write_text(json.dumps({"status": "finished", "wall_seconds": 9999.0,
-                                                   "machine": {"cores": 1}}))
+    (out / "manifest.json").write_text(json.dumps({"status": "finished", "config": cfg.model_dump(mode="json"),
+                                                   "wall_seconds": 9999.0, "machine": {"cores": 1}}))
     result = run(cfg, out)
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest == result.manifest and manifest["wall_seconds"] != 9999.0

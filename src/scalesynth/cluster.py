@@ -105,6 +105,8 @@ def probe_scheduler(address: str, seconds: float) -> None:
 
     from distributed.comm import connect
 
+    _refused_at_once(address, seconds)
+
     async def identity():
         comm = await connect(address, timeout=seconds)
         try:
@@ -134,6 +136,24 @@ def probe_scheduler(address: str, seconds: float) -> None:
         raise RunError(f"--scheduler {address}: cannot connect ({one_line(err)})")
     if not isinstance(outcome.get("reply"), dict):
         raise RunError(f"--scheduler {address}: the answer is not a dask scheduler's")
+
+
+def _refused_at_once(address: str, seconds: float) -> None:
+    """RunError 'cannot connect' when a tcp:// address refuses the connection: dask's connect retries a refused
+    port until its timeout, which would read as 'no answer'. Other outcomes are left to the identity probe."""
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(address)
+    if parts.scheme != "tcp" or parts.hostname is None or parts.port is None:
+        return
+    try:
+        socket.create_connection((parts.hostname, parts.port), timeout=seconds).close()
+    except ConnectionRefusedError:
+        raise RunError(f"--scheduler {address}: cannot connect (connection refused: is a dask scheduler listening "
+                       "there?)") from None
+    except OSError:
+        return
 
 
 @contextmanager
