@@ -67,13 +67,13 @@ def parse(source: float | int | str, parameters: Iterable[str]) -> Expression:
         tree = ast.parse(text, mode="eval").body
     except SyntaxError:
         raise ExpressionError(f"{text!r} is not an arithmetic expression") from None
-    known = set(parameters)
+    known = list(parameters)  # in the description's order, for the message's list
     names: set[str] = set()
     _check(tree, text, known, names)
     return Expression(text, frozenset(names), tree)
 
 
-def _check(node: ast.AST, text: str, known: set[str], names: set[str]) -> None:
+def _check(node: ast.AST, text: str, known: list[str], names: set[str]) -> None:
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise ExpressionError(f"{text!r}: only numbers may appear as constants")
@@ -81,7 +81,7 @@ def _check(node: ast.AST, text: str, known: set[str], names: set[str]) -> None:
         if node.id in CONSTANTS:
             return
         if node.id not in known:
-            raise ExpressionError(f"{text!r}: unknown parameter {node.id!r} " + hint(node.id, sorted(known)))
+            raise ExpressionError(f"{text!r}: unknown parameter {node.id!r} " + hint(node.id, known))
         names.add(node.id)
     elif isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
         _check(node.left, text, known, names)
