@@ -98,6 +98,8 @@ def _expected_lengths(name, mech, design, options):
     if name == "ups-sspr":
         (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.2, 0.15, 10.0))]
         return {"c (SR link A0B1)": design["c"], "l1 (SPR)": q[0], "l2": q[1], "l3": q[2]}
+    if name == "delta":  # each arm labelled with its joint, the three forearms alike
+        return {**{f"upper_arm, theta{i}": design["upper_arm"] for i in (1, 2, 3)}, "forearm": design["forearm"]}
     raise AssertionError(f"no expected lengths for {name}")
 
 

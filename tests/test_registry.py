@@ -30,7 +30,8 @@ MECHS = available()
 
 def test_registry_lists_every_seed_mechanism():
     assert {"2pauu-ppap", "planar-fivebar", "rps-upu", "ups-sspr", "pprs-rprs"} <= set(MECHS)
-    assert {get(m).seed for m in MECHS} == {"000", "001", "002", "003", "004"}
+    # described mechanisms (the Delta) come from no seed paper: their seed is ''
+    assert {get(m).seed for m in MECHS} - {""} == {"000", "001", "002", "003", "004"}
 
 
 @pytest.mark.parametrize("name", MECHS)

@@ -1,0 +1,342 @@
+"""DescribedMechanism: a registered Mechanism built from a Description, with no kinematics code of its own.
+
+Parameters, options, joints and fields come from the description; the field kernel is the template of kernel.py
+reading the packed legs; the NumPy kinematics (IK of every branch, FK, Jacobians, LCI, singularity) are generic
+over the legs of ``legs.py``. FK of a 3T mechanism of Pa legs is closed form: the platform centre lies on a sphere
+of radius l_i about each actuated point minus the platform offset, so FK intersects three spheres.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.mechanisms.base import (
+    DesignMetric,
+    Mechanism,
+    Option,
+    Parameter,
+    Solution,
+    base_fields,
+    check_magnitude,
+    enclosing_circle_radius,
+    parse_range,
+    singularity_label,
+    svd_lci,
+)
+from scalesynth.mechanisms.describe import expressions
+from scalesynth.mechanisms.describe import kernel as _k
+from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
+from scalesynth.mechanisms.describe.schema import Description, leg_frame
+
+
+def _turn(phi: float, v) -> np.ndarray:
+    """Vector v turned by phi (rad) about z."""
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]], dtype=float)
+
+
+@dataclass(frozen=True)
+class _LegPlan:
+    """A leg of the description with its expressions parsed and its turn about z fixed."""
+
+    type: str
+    joint: str
+    phi: float
+    base: tuple[expressions.Expression, ...]
+    platform: tuple[expressions.Expression, ...]
+    links: dict[str, expressions.Expression]
+    branch: str
+    limits: str | None
+    cone: str | None
+    frame: dict[str, tuple[float, float, float]]
+
+
+def _plans(desc: Description) -> tuple[_LegPlan, ...]:
+    names = list(desc.parameters)
+    out = []
+    for leg in desc.legs:
+        lt = LEG_TYPES[leg.type]
+        if leg.pattern:
+            phis = [math.radians(leg.pattern.start_deg + 360.0 * k / leg.pattern.count)
+                    for k in range(leg.pattern.count)]
+        else:
+            phis = [math.radians(leg.angle_deg)]
+        for phi in phis:
+            out.append(_LegPlan(
+                leg.type, leg.joint or lt.joint, phi,
+                tuple(expressions.parse(v, names) for v in leg.base),
+                tuple(expressions.parse(v, names) for v in leg.platform),
+                {k: expressions.parse(v, names) for k, v in leg.links.items()},
+                leg.branch or next(iter(lt.branches)), leg.limits, leg.cone, leg_frame(leg)))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class DescribedMechanism(Mechanism):
+    """A mechanism from a description (module docstring)."""
+
+    description: Description | None = field(default=None, compare=False, hash=False, repr=False)
+    plans: tuple = field(default=(), compare=False, hash=False, repr=False)
+
+    # ----- options and packing ------------------------------------------------------------------
+    def check_options(self, options: dict[str, Any]) -> None:
+        for name, spec in self.description.options.items():
+            value = options[name]
+            if spec.kind == "range":
+                options[name] = parse_range(name, value)
+            elif value is not None:
+                if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 < value <= math.pi / 2:
+                    raise InvalidParameter(f"options.{name}: expected null or a cone half-angle in (0, pi/2] rad, "
+                                           f"got {value!r}")
+                options[name] = float(value)
+        for plan in self.plans:
+            if plan.type == "P-Pa" and (plan.limits is None or options[plan.limits] is None):
+                raise InvalidParameter(f"options.{plan.limits or 'limits'}: a P-Pa leg needs a stroke range "
+                                       "[lo, hi] (its rail is otherwise endless)")
+
+    def legs(self, design: Mapping[str, float], options: Mapping[str, Any]) -> list[Leg]:
+        """The legs of a resolved design and options, in the mechanism frame."""
+        out = []
+        for i, plan in enumerate(self.plans):
+            lt = LEG_TYPES[plan.type]
+            try:
+                base = _turn(plan.phi, [e.value(design) for e in plan.base])
+                platform = _turn(plan.phi, [e.value(design) for e in plan.platform])
+                links = {k: e.value(design) for k, e in plan.links.items()}
+            except expressions.ExpressionError as err:
+                raise InvalidParameter(f"design: leg {i + 1}: {err}") from None
+            for k, v in links.items():
+                if not v > 0.0:
+                    raise InvalidParameter(f"design: leg {i + 1} {k} = {v:g}, must be > 0")
+                check_magnitude(f"design: leg {i + 1} {k}", v)
+            if lt.code == _k.R_PA:
+                u = _unit(_turn(plan.phi, plan.frame["arm_zero"]))
+                w = _unit(_turn(plan.phi, plan.frame["arm_positive"]))
+                normal = np.cross(u, w)
+            else:
+                u = _unit(_turn(plan.phi, plan.frame["rail"]))
+                w = np.zeros(3)
+                radial = _turn(plan.phi, (1.0, 0.0, 0.0))
+                normal = np.cross(u, radial)
+                if np.linalg.norm(normal) < 1e-9:  # a radial rail: the leg's plane is vertical
+                    normal = np.cross(u, (0.0, 0.0, 1.0))
+                normal = _unit(normal)
+            cone = options[plan.cone] if plan.cone else None
+            out.append(Leg(lt, base, platform, u, w, normal, links.get("upper_arm", 0.0), links["forearm"],
+                           lt.branches[plan.branch], options[plan.limits] if plan.limits else None,
+                           math.sin(cone) if cone is not None else None))
+        return out
+
+    def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        p = np.zeros(_k.N_PACKED)
+        p[0] = len(self.plans)
+        for i, leg in enumerate(self.legs(design, options)):
+            k = _k.HEAD + i * _k.STRIDE
+            p[k + _k.TYPE] = leg.type.code
+            p[k + _k.BASE : k + _k.BASE + 3] = leg.base
+            p[k + _k.PLAT : k + _k.PLAT + 3] = leg.platform
+            p[k + _k.U : k + _k.U + 3] = leg.u
+            p[k + _k.W : k + _k.W + 3] = leg.w
+            p[k + _k.AXIS : k + _k.AXIS + 3] = leg.normal
+            p[k + _k.ARM] = leg.arm
+            p[k + _k.FOREARM] = leg.forearm
+            p[k + _k.BRANCH] = leg.branch
+            if leg.limits is not None and not (leg.type.code == _k.R_PA and leg.limits[1] - leg.limits[0]
+                                               >= 2.0 * math.pi):
+                p[k + _k.HAS_LIMITS] = 1.0
+                p[k + _k.LO], p[k + _k.HI] = leg.limits
+            if leg.sin_cone is not None:
+                p[k + _k.HAS_CONE] = 1.0
+                p[k + _k.SIN_CONE] = leg.sin_cone
+        return p
+
+    @property
+    def field_kernel(self):
+        return _k.point_fields
+
+    @property
+    def reach_kernel(self):
+        return _k.point_reach
+
+    def kernel_branch(self, options) -> str:
+        return "/".join(plan.branch for plan in self.plans)
+
+    def bounding_box(self, design, options):
+        """Intersection over the legs of the box of the set each leg can reach: R-Pa, a ball of radius L + l about
+        B - r_p; P-Pa, the stroke segment of the rail swept by a ball of radius l (minus r_p). An empty
+        intersection gives a zero-size box at the origin (nothing reachable)."""
+        lo, hi = np.full(3, -math.inf), np.full(3, math.inf)
+        for leg in self.legs(design, options):
+            if leg.type.code == _k.R_PA:
+                c0 = c1 = leg.base - leg.platform
+                reach = leg.arm + leg.forearm
+            else:
+                c0 = leg.base + leg.limits[0] * leg.u - leg.platform
+                c1 = leg.base + leg.limits[1] * leg.u - leg.platform
+                reach = leg.forearm
+            lo = np.maximum(lo, np.minimum(c0, c1) - reach)
+            hi = np.minimum(hi, np.maximum(c0, c1) + reach)
+        if np.any(lo >= hi):
+            return np.zeros(3), np.zeros(3)
+        return lo, hi
+
+    # ----- NumPy kinematics ---------------------------------------------------------------------
+    def _labels(self) -> list[list[tuple[str, float]]]:
+        return [list(LEG_TYPES[plan.type].branches.items()) for plan in self.plans]
+
+    def inverse_kinematics(self, design, options, pose) -> list[Solution]:
+        """Every branch combination whose legs all reach the pose (limits not applied), labelled by the legs' branch
+        names joined by '/' (e.g. 'out/out/out', the kernel's for the rotary Delta)."""
+        p = self.check_vector("pose", pose, 3)
+        roots = [leg.roots(p) for leg in self.legs(design, options)]
+        if any(not r for r in roots):
+            return []
+        out = []
+        for combo in itertools.product(*self._labels()):
+            label = "/".join(name for name, _ in combo)
+            out.append(Solution(label, np.array([r[sign] for r, (_, sign) in zip(roots, combo, strict=True)])))
+        return out
+
+    def forward_kinematics(self, design, options, inputs) -> list[Solution]:
+        """Both intersections of the three spheres |P - (A_i - r_p,i)| = l_i (A_i the actuated point), labelled
+        'low' and 'high' by z (a Delta works 'low'); one 'double' when they touch; [] when they do not meet or when
+        two centres coincide (no isolated assembly)."""
+        q = self.check_vector("inputs", inputs, len(self.joints))
+        legs = self.legs(design, options)
+        centres = [leg.actuated_point(qi) - leg.platform for leg, qi in zip(legs, q, strict=True)]
+        radii = [leg.forearm for leg in legs]
+        return _three_spheres(centres, radii)
+
+    def jacobians(self, design, options, pose, q) -> dict[str, Any]:
+        """Jx (rows f_i, the forearm vectors Q_i - A_i), Jq = diag(f_i . dA_i/dq_i) and J = dx/dq = Jx^-1 Jq (None
+        where Jx is singular). Raises InvalidPose when q does not assemble at the pose (a forearm off its length by
+        more than 1e-6 relative)."""
+        p = self.check_vector("pose", pose, 3)
+        q = self.check_vector("inputs", q, len(self.joints))
+        jx, jq = np.zeros((3, 3)), np.zeros((3, 3))
+        for i, (leg, qi) in enumerate(zip(self.legs(design, options), q, strict=True)):
+            f = p + leg.platform - leg.actuated_point(qi)
+            if abs(float(np.linalg.norm(f)) - leg.forearm) > 1e-6 * max(leg.forearm, leg.arm):
+                raise InvalidPose(f"inputs: joint values do not assemble at the pose (forearm {i + 1} would be "
+                                  f"{float(np.linalg.norm(f)):g} long, not {leg.forearm:g})")
+            jx[i] = f
+            jq[i, i] = float(f @ leg.actuated_velocity(qi))
+        try:
+            j = np.linalg.solve(jx, jq)
+        except np.linalg.LinAlgError:
+            j = None
+        return {"Jx": jx, "Jq": jq, "J": j}
+
+    def lci(self, design, options, pose, q) -> float:
+        """sigma_min / sigma_max of J = dx/dq by NumPy's SVD; 0 at any singularity."""
+        jac = self.jacobians(design, options, pose, q)
+        if jac["J"] is None or self.singularity(design, options, pose, q, tol=0.0) != "none":
+            return 0.0
+        return svd_lci(jac["J"])
+
+    def singularity(self, design, options, pose, q, tol: float = 1e-7) -> str:
+        """'inverse' (some |f_i . dA_i/dq_i| <= tol |f_i| |dA_i/dq_i|: a forearm square to its actuated point's
+        motion), 'forward' (|det| of the unit forearm rows <= tol), 'both' or 'none'."""
+        jac = self.jacobians(design, options, pose, q)
+        legs = self.legs(design, options)
+        qv = self.check_vector("inputs", q, len(self.joints))
+        inverse = False
+        for i, (leg, qi) in enumerate(zip(legs, qv, strict=True)):
+            scale = float(np.linalg.norm(jac["Jx"][i]) * np.linalg.norm(leg.actuated_velocity(qi)))
+            inverse |= abs(jac["Jq"][i, i]) <= tol * scale
+        unit = jac["Jx"] / np.linalg.norm(jac["Jx"], axis=1)[:, None]
+        forward = abs(float(np.linalg.det(unit))) <= tol
+        return singularity_label(inverse, forward)
+
+    def velocity_map(self, design, options, pose, q) -> np.ndarray:
+        """A = Jq^-1 Jx: q_dot = A P_dot; rows at an inverse singularity (Jq_ii = 0) infinite."""
+        jac = self.jacobians(design, options, pose, q)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return jac["Jx"] / np.diag(jac["Jq"])[:, None]
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+def _three_spheres(centres, radii) -> list[Solution]:
+    c1, c2, c3 = (np.asarray(c, dtype=float) for c in centres)
+    r1, r2, r3 = radii
+    scale = max(r1, r2, r3, float(np.abs(np.array(centres)).max()))
+    ex = c2 - c1
+    d = float(np.linalg.norm(ex))
+    if d <= 1e-12 * scale:
+        return []
+    ex /= d
+    t = c3 - c1
+    i = float(ex @ t)
+    ey = t - i * ex
+    j = float(np.linalg.norm(ey))
+    if j <= 1e-12 * scale:
+        return []
+    ey /= j
+    ez = np.cross(ex, ey)
+    x = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
+    y = (r1 * r1 - r3 * r3 + i * i + j * j) / (2.0 * j) - i * x / j
+    h2 = r1 * r1 - x * x - y * y
+    if h2 < -1e-12 * scale * scale:
+        return []
+    mid = c1 + x * ex + y * ey
+    if h2 <= 1e-12 * scale * scale:
+        return [Solution("double", mid)]
+    h = math.sqrt(h2)
+    a, b = mid + h * ez, mid - h * ez
+    low, high = (a, b) if a[2] <= b[2] else (b, a)
+    return [Solution("low", low), Solution("high", high)]
+
+
+def _link_length_sum(plans, d: Mapping[str, float]) -> float:
+    return float(sum(e.value(d) for plan in plans for e in plan.links.values()))
+
+
+def _footprint(desc_mech_plans, d: Mapping[str, float]) -> float:
+    pts = [_turn(plan.phi, [e.value(d) for e in plan.base])[:2] for plan in desc_mech_plans]
+    return enclosing_circle_radius(pts)
+
+
+def from_description(desc: Description) -> DescribedMechanism:
+    """The registered mechanism of a validated description."""
+    plans = _plans(desc)
+    lt0 = LEG_TYPES[plans[0].type]
+    rotary = lt0.joint_unit == "angle"
+    joints = tuple(f"{plan.joint}{i + 1}" for i, plan in enumerate(plans))
+    options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items())
+    sigma_unit = "{length}/rad" if rotary else "1"
+    jac = "J = dx/dq (platform motion per rad of arm rotation)" if rotary else \
+        "J = dx/dq (platform motion per unit carriage motion)"
+    return DescribedMechanism(
+        name=desc.name,
+        title=desc.title,
+        seed="",
+        motion=desc.motion,
+        task_axes=("x", "y", "z"),
+        task_units=("length", "length", "length"),
+        joints=joints,
+        joint_units=tuple(LEG_TYPES[plan.type].joint_unit for plan in plans),
+        parameters=tuple(Parameter(name, spec.default, spec.doc, spec.unit, spec.positive)
+                         for name, spec in desc.parameters.items()),
+        options=options,
+        default_length_unit=desc.length_unit,
+        fields=base_fields(sigma_unit, jac),
+        design_metrics=(
+            DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (a parallelogram "
+                         "counted once)", lambda d, o, _p=plans: _link_length_sum(_p, d)),
+            DesignMetric("footprint_radius", "{length}", "radius of the smallest circle in the xy plane holding the "
+                         "legs' base attachment points", lambda d, o, _p=plans: _footprint(_p, d)),
+        ),
+        description=desc,
+        plans=plans,
+    )

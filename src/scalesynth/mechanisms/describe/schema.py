@@ -1,0 +1,206 @@
+"""The mechanism description: pydantic models, loading from YAML or a mapping, and the checks across fields.
+
+A description names its design parameters (units, defaults), its options (actuator ranges, cone limits), its motion
+type and its legs, each of a type from the leg library (``legs.LEG_TYPES``) with attachment points and link lengths
+given as expressions of the parameters (``expressions``). ``pattern: {count: n}`` repeats a leg n times at equal
+angles about z (leg k turned by start_deg + 360 k / n degrees); coordinates are given in the leg's own frame, i.e.
+before that turn. Every problem is one ConfigError line naming the leg and the field (docs/describing.md).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from scalesynth.errors import ConfigError
+from scalesynth.mechanisms.describe import expressions
+from scalesynth.mechanisms.describe.legs import LEG_TYPES
+from scalesynth.names import hint
+
+Expr = float | str
+MOTIONS = ("3T",)  # motion types the kernel template handles so far
+LENGTH_UNITS = ("m", "mm", "cm", "dm")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class ParameterSpec(_Strict):
+    """A design parameter: default value, unit ('length', 'angle' rad, or '1'), what it is."""
+
+    default: float
+    doc: str
+    unit: Literal["length", "angle", "1"] = "length"
+    positive: bool = True
+
+
+class OptionSpec(_Strict):
+    """A setting that is not a design parameter. kind 'range': null or [lo, hi] (an actuator range: rad for a
+    revolute, length for a prismatic joint); 'angle': null or a half-angle in rad in (0, pi/2] (a ball-joint cone)."""
+
+    kind: Literal["range", "angle"]
+    doc: str
+    default: Any = None
+
+
+class PatternSpec(_Strict):
+    """n legs at equal angles about z: leg k turned by start_deg + 360 k / count degrees."""
+
+    count: int = Field(ge=1, le=12)
+    start_deg: float = 0.0
+
+
+class LegSpec(_Strict):
+    """One leg (or, with ``pattern``, n copies of it at equal angles)."""
+
+    type: str
+    name: str = "leg"
+    joint: str | None = None  # joint name prefix; default from the leg type (theta, s)
+    pattern: PatternSpec | None = None
+    angle_deg: float = 0.0  # a single leg's turn about z (with pattern: use pattern.start_deg)
+    base: tuple[Expr, Expr, Expr]
+    platform: tuple[Expr, Expr, Expr]
+    links: dict[str, Expr]
+    branch: str | None = None
+    limits: str | None = None  # name of a 'range' option
+    cone: str | None = None  # name of an 'angle' option
+    arm_zero: tuple[float, float, float] | None = None
+    arm_positive: tuple[float, float, float] | None = None
+    rail: tuple[float, float, float] | None = None
+
+
+class Description(_Strict):
+    """A whole mechanism."""
+
+    name: str = Field(pattern=r"^[a-z][a-z0-9-]{0,39}$")
+    title: str
+    motion: str
+    length_unit: str = "m"
+    parameters: dict[str, ParameterSpec]
+    options: dict[str, OptionSpec] = {}
+    legs: list[LegSpec] = Field(min_length=1)
+
+
+def _one_line(text: str, limit: int = 200) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _format(err: ValidationError) -> str:
+    first = err.errors()[0]
+    loc = ""
+    for part in first["loc"]:
+        loc += f"[{part}]" if isinstance(part, int) else (f".{part}" if loc else str(part))
+    msg = "unknown key" if first["type"] == "extra_forbidden" else first["msg"].removeprefix("Value error, ")
+    return f"{loc}: {msg}" if loc else msg
+
+
+def parse_description(data: Any, where: str = "description") -> Description:
+    """Validate a mapping into a Description; ConfigError ``where: field: problem`` (one line) if anything is wrong:
+    the schema, an unknown leg type, motion or unit, a leg field its type does not have or lacks, an expression
+    naming an unknown parameter, a limit naming an option of the wrong kind, or legs that do not make the motion."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: expected a mapping (name, title, motion, parameters, options, legs)")
+    try:
+        desc = Description.model_validate(data)
+    except ValidationError as err:
+        raise ConfigError(_one_line(f"{where}: {_format(err)}")) from None
+    try:
+        _check(desc)
+    except ConfigError as err:
+        raise ConfigError(_one_line(f"{where}: {err}")) from None
+    return desc
+
+
+def load_description(path: str | Path) -> Description:
+    """Read a description file (YAML, the config's safe loader) and validate it."""
+    from scalesynth.config import MAX_YAML_BYTES, read_limited, safe_yaml
+
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such description file")
+    return parse_description(safe_yaml(read_limited(path, MAX_YAML_BYTES), str(path)), path.name)
+
+
+def _check(desc: Description) -> None:
+    if desc.motion not in MOTIONS:
+        raise ConfigError(f"motion: {desc.motion!r} is not handled yet " + hint(desc.motion, MOTIONS, "handled"))
+    if desc.length_unit not in LENGTH_UNITS:
+        raise ConfigError(f"length_unit: {desc.length_unit!r} " + hint(desc.length_unit, LENGTH_UNITS))
+    names = list(desc.parameters)
+    for name in names:
+        if not re.fullmatch(r"[A-Za-z_]\w{0,39}", name) or name in expressions.CONSTANTS:
+            raise ConfigError(f"parameters.{name[:40]}: a parameter name is a word of letters, digits and _ "
+                              "(not 'pi')")
+        if not math.isfinite(desc.parameters[name].default):
+            raise ConfigError(f"parameters.{name}.default: must be finite")
+    clash = set(names) & set(desc.options)
+    if clash:
+        raise ConfigError(f"options.{sorted(clash)[0]}: also a parameter name")
+    count = 0
+    kinds = set()
+    for i, leg in enumerate(desc.legs):
+        where = f"legs[{i}] ({leg.name})"
+        lt = LEG_TYPES.get(leg.type)
+        if lt is None:
+            raise ConfigError(f"{where}.type: unknown leg type {leg.type!r} " + hint(leg.type, LEG_TYPES, "library"))
+        kinds.add(lt.joint_unit)
+        for field, values in (("base", leg.base), ("platform", leg.platform)):
+            for axis, value in zip("xyz", values, strict=True):
+                _expression(f"{where}.{field}.{axis}", value, names)
+        missing = [k for k in lt.links if k not in leg.links]
+        if missing:
+            raise ConfigError(f"{where}.links: {lt.name} needs {', '.join(lt.links)} (missing {missing[0]})")
+        for key, value in leg.links.items():
+            if key not in lt.links:
+                raise ConfigError(f"{where}.links.{key}: not a link of {lt.name} " + hint(key, lt.links, "links"))
+            _expression(f"{where}.links.{key}", value, names)
+        if leg.branch is not None and leg.branch not in lt.branches:
+            raise ConfigError(f"{where}.branch: {leg.branch!r} is not a branch of {lt.name} "
+                              + hint(leg.branch, lt.branches, "branches"))
+        for field in ("arm_zero", "arm_positive", "rail"):
+            value = getattr(leg, field)
+            if value is not None and field not in lt.frame:
+                raise ConfigError(f"{where}.{field}: {lt.name} has no {field} " + hint(field, lt.frame, "frame"))
+        frame = leg_frame(leg)
+        for field, vec in frame.items():
+            if not 0.5 < math.sqrt(sum(v * v for v in vec)) < 2.0:
+                raise ConfigError(f"{where}.{field}: expected a unit vector, got {list(vec)}")
+        if lt.name == "R-Pa":
+            u, w = frame["arm_zero"], frame["arm_positive"]
+            if abs(sum(a * b for a, b in zip(u, w, strict=True))) > 1e-9:
+                raise ConfigError(f"{where}.arm_positive: must be perpendicular to arm_zero")
+        for field, kind in (("limits", "range"), ("cone", "angle")):
+            option = getattr(leg, field)
+            if option is None:
+                continue
+            if option not in desc.options:
+                raise ConfigError(f"{where}.{field}: unknown option {option!r} " + hint(option, desc.options))
+            if desc.options[option].kind != kind:
+                raise ConfigError(f"{where}.{field}: option {option!r} is a {desc.options[option].kind}, "
+                                  f"{field} needs a {kind}")
+        count += leg.pattern.count if leg.pattern else 1
+    if desc.motion == "3T" and count != 3:
+        raise ConfigError(f"legs: motion 3T needs 3 actuated legs (a square Jacobian), these give {count}")
+    if len(kinds) > 1:
+        raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
+                          "yet): use legs of one actuation kind")
+
+
+def _expression(where: str, value: Any, names: list[str]) -> expressions.Expression:
+    try:
+        return expressions.parse(value, names)
+    except expressions.ExpressionError as err:
+        raise ConfigError(f"{where}: {err}") from None
+
+
+def leg_frame(leg: LegSpec) -> dict[str, tuple[float, float, float]]:
+    """The leg's frame directions (leg frame, before the pattern's turn): the leg type's defaults overlaid by the
+    description's."""
+    lt = LEG_TYPES[leg.type]
+    return {k: tuple(getattr(leg, k) or v) for k, v in lt.frame.items()}

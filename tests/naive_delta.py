@@ -1,0 +1,65 @@
+"""Slow NumPy twin of the rotary Delta, written from its textbook kinematics in the Delta's own conventions (z up,
+base plane z = 0, leg i at phi_i = 0, 120, 240 deg, theta 0 horizontal outward and positive downward, elbows
+out), independently of scalesynth's description machinery: per leg, in its own frame (x' = x cos phi + y sin phi,
+y' = -x sin phi + y cos phi, a = R - r), A cos theta + B sin theta = K with A = 2 L (a - x'), B = 2 L z,
+K = l^2 - L^2 - (a - x')^2 - y'^2 - z^2; theta = atan2(B, A) +- acos(K / hypot(A, B)), the root with the larger
+cos theta; then J = Jx^-1 Jq with rows of Jx the forearm vectors s_i = Q_i - E_i and Jq = diag(s_i . dE_i/dtheta_i),
+its singular values by np.linalg.svd."""
+
+import numpy as np
+
+PHIS = np.radians([0.0, 120.0, 240.0])
+
+
+def delta_thetas(design, x, y, z):
+    """Elbows-out arm angles (3, *shape) and the reach mask (*shape) at platform centres (x, y, z)."""
+    R, r, L, l = (design[k] for k in ("base_radius", "platform_radius", "upper_arm", "forearm"))
+    a = R - r
+    x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
+    ok = np.ones(x.shape, dtype=bool)
+    thetas = []
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for phi in PHIS:
+            xp = x * np.cos(phi) + y * np.sin(phi)
+            yp = -x * np.sin(phi) + y * np.cos(phi)
+            A = 2 * L * (a - xp)
+            B = 2 * L * z
+            K = l**2 - L**2 - (a - xp) ** 2 - yp**2 - z**2
+            n = np.hypot(A, B)
+            ok &= (n > 0) & (np.abs(K) <= n)
+            g = np.arccos(np.clip(K / n, -1, 1))
+            t1, t2 = np.arctan2(B, A) + g, np.arctan2(B, A) - g
+            thetas.append(np.where(np.cos(t1) >= np.cos(t2), t1, t2))
+    return np.array(thetas), ok
+
+
+def delta_jacobian(design, p, thetas):
+    """(Jx, Jq, J) at one pose p with arm angles thetas."""
+    R, r, L = design["base_radius"], design["platform_radius"], design["upper_arm"]
+    jx, jq = np.zeros((3, 3)), np.zeros((3, 3))
+    for i, (phi, th) in enumerate(zip(PHIS, thetas, strict=True)):
+        u = np.array([np.cos(phi), np.sin(phi), 0.0])
+        e = (R + L * np.cos(th)) * u + np.array([0.0, 0.0, -L * np.sin(th)])
+        s = np.asarray(p, dtype=float) + r * u - e
+        de = np.array([-L * np.sin(th) * u[0], -L * np.sin(th) * u[1], -L * np.cos(th)])
+        jx[i] = s
+        jq[i, i] = s @ de
+    return jx, jq, np.linalg.solve(jx, jq)
+
+
+def delta_fields(design, options, x, y, z):
+    """(LCI, sigma_min, sigma_max) of J = dx/dq at arrays of points, shape x.shape + (3,); LCI -1 (and 0, 0) where
+    a leg does not reach or theta_limits (modulo 2 pi) exclude the elbows-out angle."""
+    x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
+    thetas, ok = delta_thetas(design, x, y, z)
+    lim = options.get("theta_limits")
+    if lim is not None:
+        for th in thetas:
+            ok &= np.mod(th - lim[0], 2 * np.pi) <= lim[1] - lim[0]
+    out = np.zeros(x.shape + (3,))
+    out[..., 0] = -1.0
+    for idx in zip(*np.nonzero(ok), strict=True):
+        _, _, j = delta_jacobian(design, (x[idx], y[idx], z[idx]), thetas[(slice(None), *idx)])
+        sv = np.linalg.svd(j, compute_uv=False)
+        out[idx] = (sv[-1] / sv[0], sv[-1], sv[0])
+    return out
