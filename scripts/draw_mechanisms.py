@@ -145,7 +145,24 @@ def _ups(mech, design, options):
                    [f"pose (alpha, beta, Y) = ({alpha}, {beta}, {yy}) (rad, rad, mm)"])
 
 
+def _described(mech, design, options):
+    """A described mechanism (mechanisms/describe) at a pose below the base centre: each leg's arm from its base
+    point to its elbow (or carriage) and the forearm on to its platform joint, from the description's legs."""
+    pose = (0.0, 0.0, -1.0)
+    q = _solution(mech, design, options, pose)  # the kernel's branch (elbows out)
+    p = np.array(pose)
+    legs = mech.legs(design, options)
+    bases = np.array([leg.base for leg in legs])
+    joints = np.array([p + leg.platform for leg in legs])
+    links = []
+    for i, (leg, qi) in enumerate(zip(legs, q, strict=True), 1):
+        elbow = leg.actuated_point(qi)
+        links += [(leg.base, elbow, f"upper_arm, theta{i}"), (elbow, p + leg.platform, "forearm")]
+    return Linkage([bases], joints, links, (p, "P"), [f"pose P = {pose} m, elbows out"])
+
+
 LINKAGES = {
+    "delta": _described,
     "2pauu-ppap": _pauu,
     "planar-fivebar": _fivebar,
     "pprs-rprs": _pprs,
@@ -218,7 +235,8 @@ def draw(name: str, path: Path) -> Path:
         ax.set_box_aspect((1, 1, 1))
         ax.view_init(elev=22, azim=-60)
     dims = ", ".join(f"{k} = {v:g}" for k, v in design.items())
-    ax.set_title(f"{name} (seed {mech.seed}, {mech.motion}): {dims} {unit}\n" + "; ".join(lk.notes), fontsize=9)
+    origin = f"seed {mech.seed}" if mech.seed else "described"
+    ax.set_title(f"{name} ({origin}, {mech.motion}): {dims} {unit}\n" + "; ".join(lk.notes), fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)

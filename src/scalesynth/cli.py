@@ -59,7 +59,8 @@ def mechanisms_cmd(as_json: JsonOpt = False) -> None:
         _print_json(rows)
         return
     for r in rows:
-        typer.echo(f"{r['name']:<16} seed {r['seed']}  {r['motion']:<5} {r['title']}")
+        origin = f"seed {r['seed']}" if r["seed"] else "described"
+        typer.echo(f"{r['name']:<16} {origin:<9}  {r['motion']:<5} {r['title']}")
         typer.echo("    parameters: " + ", ".join(f"{k}={v['default']:g}" for k, v in r["parameters"].items()))
         if r["options"]:
             typer.echo("    options:    " + ", ".join(f"{k}={v['default']!r}" for k, v in r["options"].items()))
