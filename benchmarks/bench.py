@@ -40,6 +40,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import adaptive as adaptive_bench  # noqa: E402  (benchmarks/adaptive.py: issue-15 parts)
 import compile_once  # noqa: E402  (benchmarks/compile_once.py: issue 15, compile once per command)
+import cpu_target  # noqa: E402  (benchmarks/cpu_target.py: issue 27, what reproducible bits cost)
 import show_speed  # noqa: E402  (benchmarks/show_speed.py: issue 14, show of a 3-D design)
 import synthesis  # noqa: E402  (benchmarks/synthesis.py: issue 15, per-config paper-scale table and memory)
 import task_accuracy  # noqa: E402  (benchmarks/task_accuracy.py: issue 15, the uniform task grids' accuracy)
@@ -384,7 +385,8 @@ PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": benc
          "compile": bench_compile, "fastpath": bench_fastpath, "stiffness": bench_stiffness,
          "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all,
          "compile_commands": compile_once.bench_compile_commands, "synthesis": synthesis.bench_synthesis,
-         "task_accuracy": task_accuracy.bench_task_accuracy, "show": show_speed.bench_show}
+         "task_accuracy": task_accuracy.bench_task_accuracy, "show": show_speed.bench_show,
+         "cpu_target": cpu_target.bench_cpu_target}
 
 
 def write_results_md() -> None:
@@ -409,7 +411,9 @@ def write_results_md() -> None:
             ("task_accuracy", "Issue 15: task boxes on their uniform grids: accuracy against a 3x finer grid",
              task_accuracy),
             ("show", "Issue 14: `scalesynth show` of a 3-D design at resolution 96 (target: within 10 s with a warm "
-             "cache)", show_speed)):
+             "cache)", show_speed),
+            ("cpu_target", "Issue 27: what reproducible bits cost (IEEE arithmetic, the pinned CPU target)",
+             cpu_target)):
         if part in data and "result" in data[part]:
             lines += _header(title, data[part]) + module.markdown(data[part])
     if "evaluator" in data:
@@ -830,6 +834,12 @@ def main(argv: list[str]) -> None:
         return
     if argv and argv[0] == "synthesis" and len(argv) > 1:  # synthesis CONFIG ...: rows merged into the stored part
         _merge_synthesis(synthesis.bench_synthesis([Path(a).name for a in argv[1:]]))
+        write_results_md()
+        return
+    if argv and argv[0] == "cpu_target" and len(argv) > 1:  # cpu_target --before TREE: that tree timed too
+        if argv[1:2] != ["--before"] or len(argv) != 3:
+            raise SystemExit("usage: bench.py cpu_target [--before TREE]")
+        _run_part("cpu_target", lambda: cpu_target.bench_cpu_target(3, argv[2]))
         write_results_md()
         return
     if argv and argv[0] == "adaptive_twin":  # the NumPy twin timing alone, merged into the stored adaptive rows

@@ -4,7 +4,8 @@ Each target runs in its own process with its own Numba cache (compiled once, the
 so the machine's load falls on every target alike. Timed: 2pauu-ppap's uniform evaluator (8 designs, N = 72,
 3 calls) and ups-sspr's adaptive evaluator (one design, 20 calls), CPU seconds, one Numba thread.
 
-    python benchmarks/cpu_target.py [ROUNDS] [--before TREE]
+    python benchmarks/bench.py cpu_target [--before TREE]   (stored, and in RESULTS.md)
+    python benchmarks/cpu_target.py [ROUNDS] [--before TREE]  (printed only)
 
 ``--before TREE`` adds another checkout's sources (e.g. a worktree of the commit before fast-math was turned off),
 compiled for the host CPU, as one more variant of the same run.
@@ -12,6 +13,7 @@ compiled for the host CPU, as one more variant of the same run.
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -55,11 +57,14 @@ def _host() -> dict[str, str]:
     return {"NUMBA_CPU_NAME": ll.get_host_cpu_name(), "NUMBA_CPU_FEATURES": ll.get_host_cpu_features().flatten()}
 
 
-def main(rounds: int, before: str | None = None) -> None:
+def bench_cpu_target(rounds: int = 3, before: str | None = None) -> dict:
+    """Rows {variant, round, target, <timed>: CPU s} for every target (and ``before``), rounds alternating."""
     targets = {"host": _host(), "x86-64": {"NUMBA_CPU_NAME": "x86-64", "NUMBA_CPU_FEATURES": ""},
                "x86-64-v3 (pinned)": {"NUMBA_CPU_NAME": "x86-64-v3", "NUMBA_CPU_FEATURES": ""}}
     if before:
-        targets["before, host"] = {**_host(), "PYTHONPATH": os.path.join(os.path.abspath(before), "src")}
+        targets["before: fast-math, host"] = {**_host(), "PYTHONPATH": os.path.join(os.path.abspath(before), "src")}
+    rows = []
+    load = [os.getloadavg()[0]]
     with tempfile.TemporaryDirectory() as tmp:
         for rnd in range(rounds + 1):  # round 0 compiles
             for label, extra in targets.items():
@@ -67,7 +72,31 @@ def main(rounds: int, before: str | None = None) -> None:
                 out = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True,
                                      timeout=1800, check=True)
                 if rnd:
-                    print(label, out.stdout.strip().splitlines()[-1], flush=True)
+                    row = {"variant": label, "round": rnd, **json.loads(out.stdout.strip().splitlines()[-1])}
+                    rows.append(row)
+                    print(row, flush=True)
+    load.append(os.getloadavg()[0])
+    return {"rounds": rounds, "before": before, "rows": rows, "load_average_1min": load}
+
+
+def markdown(entry: dict) -> list[str]:
+    """The median CPU seconds per variant and timed kernel, and each one's ratio to the pinned target."""
+    import statistics
+
+    rows = entry["result"]["rows"]
+    timed = [k for k in rows[0] if k.endswith("(CPU s)")]
+    variants = list(dict.fromkeys(r["variant"] for r in rows))
+    med = {(v, k): statistics.median(r[k] for r in rows if r["variant"] == v) for v in variants for k in timed}
+    pinned = "x86-64-v3 (pinned)"
+    out = ["The same kernels compiled for the host CPU, plain x86-64, the pinned x86-64-v3 level, and (where given) "
+           "the tree before fast-math was turned off (`--before`), each in its own process and Numba cache, "
+           f"rounds alternating ({entry['result']['rounds']} rounds, median; load average "
+           f"{entry['result']['load_average_1min']}). Ratios to the pinned target; CPU seconds, one Numba thread.", "",
+           "| variant | " + " | ".join(timed) + " |", "|---|" + "---|" * len(timed)]
+    for v in variants:
+        cells = [f"{med[(v, k)]:.4g} ({med[(v, k)] / med[(pinned, k)]:.2f}x)" for k in timed]
+        out.append(f"| {v} | " + " | ".join(cells) + " |")
+    return out + [""]
 
 
 if __name__ == "__main__":
@@ -77,4 +106,4 @@ if __name__ == "__main__":
         k = args.index("--before")
         tree = args[k + 1]
         del args[k : k + 2]
-    main(int(args[0]) if args else 2, tree)
+    bench_cpu_target(int(args[0]) if args else 2, tree)
