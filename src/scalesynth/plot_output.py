@@ -113,7 +113,7 @@ def _update_run_manifest(fig: Figures) -> None:
     run, already owns plots/ whole: left as it is)."""
     manifest = rundir.RUN.manifest_of(fig.target)
     files = (manifest or {}).get("files")
-    if not isinstance(files, list):
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
         return
     added = rundir.listing(fig.root)
     manifest["files"] = [*sorted({*files, *added} - {RUN_MANIFEST}), RUN_MANIFEST]
