@@ -577,7 +577,7 @@ def test_drives_command(tmp_path):
         assert summary["ranges"][name] == pytest.approx([table[:, 4 + k].min(), table[:, 4 + k].max()], rel=1e-9)
     png = (tmp_path / "drives.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["drives.csv", "drives.png"]  # no temp files left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["drives.csv", "drives.json", "drives.png"]  # no temp files
 
 
 def test_drives_command_bad_input(tmp_path):

@@ -285,12 +285,13 @@ def _write_checkpoint(out_dir: Path, blob: bytes) -> None:
     rio.write_atomic(path, lambda fh: fh.write(blob), mode="wb")
 
 
-def _write_results(out_dir: Path, files: dict[str, bytes]) -> None:
+def _write_results(out_dir: Path, files: dict[str, bytes], force: bool = False) -> None:
     """The results files a finished chunk returned, into the task's staging directory (manifest.json last: it
-    marks a finished run), without the checkpoint, then swapped in whole (``rundir``: locked, atomic)."""
+    marks a finished run), without the checkpoint, then swapped in whole (``rundir``: locked, atomic); with
+    ``force`` into a directory that is not a run's, moved in file by file."""
     from scalesynth import rundir
 
-    with rundir.claim(out_dir) as claimed:
+    with rundir.claim(out_dir, force=force) as claimed:
         work = rio.ensure_dir(claimed.work)
         (work / rio.CHECKPOINT).unlink(missing_ok=True)
         (out_dir / rio.CHECKPOINT).unlink(missing_ok=True)  # a legacy checkpoint inside the target
@@ -339,7 +340,20 @@ class LostChunks:
         return out
 
 
-def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | None = None) -> list[TaskRecord]:
+def check_targets(tasks: Sequence[BatchTask], out: Path, force: bool = False) -> None:
+    """OUT and every task's directory checked before any task runs: an OUT that cannot be a directory, and unless
+    ``force`` a task directory that is not empty and neither a run's nor an unfinished task's, are refused
+    (ConfigError naming --out: exit 2) instead of failing that task after its run. A task directory that cannot
+    be made (a file in the way) still fails that task alone."""
+    from scalesynth import outpath, rundir
+
+    outpath.check_dir(out, "--out")
+    for task in tasks:
+        rundir.check_own(task.out_dir, rundir.RUN, force, "--out", resuming=True)
+
+
+def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | None = None,
+              force: bool = False) -> list[TaskRecord]:
     """Drive every task's chain of chunks on the cluster, writing checkpoints and results into the tasks'
     directories on the client; returns the records in task order.
 
@@ -457,7 +471,7 @@ def run_tasks(tasks: Sequence[BatchTask], client, echo: Callable[[str], None] | 
                 pending.appendleft(run)
                 progress()
                 return None
-            _write_results(run.task.out_dir, chunk["files"])
+            _write_results(run.task.out_dir, chunk["files"], force)
             for k, v in _results_outcome(run.task.out_dir).items():
                 setattr(rec, k, v)
         except (ScalesynthError, OSError, KeyError, ValueError) as err:
@@ -596,22 +610,24 @@ def run_batch(
     seeds: int = 1,
     scheduler: str | None = None,
     echo: Callable[[str], None] | None = None,
+    force: bool = False,
 ) -> BatchSummary:
     """Run every (config, seed) task on dask, then write the combined fronts, plots and ``OUT/batch.json``.
 
     ``out`` is a path on this machine (the client), relative to its working directory; workers never see it.
-    Raises ConfigError for bad input (configs, seeds, a malformed scheduler address) and RunError when the
-    scheduler cannot be reached or a worker's scalesynth or result-relevant packages differ from the client's;
-    both before anything is written."""
+    Raises ConfigError for bad input (configs, seeds, a malformed scheduler address, a task directory that is not
+    a run's unless ``force``: :func:`check_targets`) and RunError when the scheduler cannot be reached or a
+    worker's scalesynth or result-relevant packages differ from the client's; all before anything is written."""
     t0 = time.perf_counter()
     out = Path(out).absolute()  # the client's directory: a relative --out is the client's
     tasks = plan(configs, seeds, out)  # bad input fails here, before anything is written
+    check_targets(tasks, out, force)  # before connecting: a refused directory costs no cluster
     with dask_client(scheduler, len(tasks)) as client:
         workers = check_workers(client)  # a worker without scalesynth, or another version: nothing is written
         if not workers and echo is not None:
             echo(f"no workers on the scheduler yet: the tasks wait for workers to join ({scheduler})")
         rio.ensure_dir(out)  # after connecting: an unreachable scheduler leaves nothing behind
-        records = run_tasks(tasks, client, echo)
+        records = run_tasks(tasks, client, echo, force)
         workers.update({r.worker: {"name": r.worker_name, "nthreads": r.worker_nthreads}
                         for r in records if r.worker and r.worker not in workers})
     combined = {}

@@ -167,10 +167,12 @@ def write_csv(path: Path, frame) -> None:
 FIGURE_FORMATS = ("png", "svg", "pdf")
 
 
-def save_figure(fig, path: Path, dpi: int = 130) -> None:
-    """Write a matplotlib figure atomically in the format of the file's suffix (png, svg or pdf)."""
+def save_figure(fig, path: Path, dpi: int = 130, metadata: dict[str, str] | None = None) -> None:
+    """Write a matplotlib figure atomically in the format of the file's suffix (png, svg or pdf); ``metadata``:
+    matplotlib's savefig metadata (the keys that format knows)."""
     fmt = Path(path).suffix.lstrip(".").lower() or "png"
-    write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight"), mode="wb")
+    write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, dpi=dpi, bbox_inches="tight", metadata=metadata),
+                 mode="wb")
 
 
 # ----- reading a results directory that may have been damaged: one-line ConfigError, never a traceback ----------

@@ -7,7 +7,7 @@ same figures; the ``plot-*`` commands pass ``results.load(run_dir)``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -55,8 +55,7 @@ def dominated_by_front(F_front: np.ndarray, f: np.ndarray) -> bool:
 
 
 def _plots_dir(result: RunResult, out: Path | None, fmt: str) -> Path:
-    if fmt not in rio.FIGURE_FORMATS:
-        raise ConfigError(f"--format: must be one of {', '.join(rio.FIGURE_FORMATS)}, got {fmt!r}")
+    _check_format(fmt)
     return rio.ensure_dir(Path(out) if out is not None else result.out_dir / PLOTS)
 
 
@@ -149,14 +148,47 @@ def band_sections(front: Front) -> BandSections:
     return BandSections(featured, panels, front.X, front.F)
 
 
-def plot_bands_run(run_dir: Path, out: Path | None = None, fmt: str = "png") -> dict[str, Any]:
-    """:func:`plot_bands` of a results directory, its sections evaluated first, from config.yaml and pareto.csv
-    read without pandas (issue 15: a fresh process reaches its first evaluation before the pandas and matplotlib
-    imports and the drawing). Where that read fails, or --format is invalid, plot_bands after results.load
-    reports what is wrong, as before."""
+def plot_front_run(run_dir: Path, out: Path | None = None, fmt: str = "png", force: bool = False) -> list[Path]:
+    """``plot-front``: :func:`plot_front` of a results directory into ``out`` (default RUN_DIR/plots), staged and
+    swapped in whole (``scalesynth.plot_output``; ``--out`` claimed before anything is evaluated); returns the
+    files written, where they are after the swap."""
+    from scalesynth.plot_output import figures
+
+    _check_format(fmt)
+    result = load(run_dir, require_finished=False)
+    with figures(_figures_dir(run_dir, out), "plot-front", force, str(run_dir)) as fig:
+        info = plot_front(replace(result, out_dir=fig.root), fig.dir, fmt)
+    return [fig.final(f) for f in info["files"]]
+
+
+def plot_bands_run(run_dir: Path, out: Path | None = None, fmt: str = "png",
+                   force: bool = False) -> dict[str, Any]:
+    """``plot-bands``: :func:`plot_bands` of a results directory, staged and swapped in like
+    :func:`plot_front_run`, its sections evaluated first, from config.yaml and pareto.csv read without pandas
+    (issue 15: a fresh process reaches its first evaluation before the pandas and matplotlib imports and the
+    drawing). Where that read fails, or --format is invalid, results.load reports what is wrong, as before.
+    ``files`` and ``band_files`` are where the files are after the swap."""
+    from scalesynth.plot_output import figures
+
     front = read_front(run_dir) if fmt in rio.FIGURE_FORMATS else None
-    sections = None if front is None else band_sections(front)
-    return plot_bands(load(run_dir, require_finished=False), out, fmt, sections)
+    if front is None:
+        load(run_dir, require_finished=False)  # says what is wrong with the directory
+        _check_format(fmt)
+    with figures(_figures_dir(run_dir, out), "plot-bands", force, str(run_dir)) as fig:
+        sections = None if front is None else band_sections(front)
+        result = replace(load(run_dir, require_finished=False), out_dir=fig.root)
+        info = plot_bands(result, None if fig.into_run else fig.dir, fmt, sections)
+    return {**info, "files": [fig.final(f) for f in info["files"]],
+            "band_files": [fig.final(f) for f in info["band_files"]]}
+
+
+def _figures_dir(run_dir: Path, out: Path | None) -> Path:
+    return Path(out) if out is not None else Path(run_dir) / PLOTS
+
+
+def _check_format(fmt: str) -> None:
+    if fmt not in rio.FIGURE_FORMATS:
+        raise ConfigError(f"--format: must be one of {', '.join(rio.FIGURE_FORMATS)}, got {fmt!r}")
 
 
 def plot_bands(result: RunResult, out: Path | None = None, fmt: str = "png",

@@ -16,7 +16,8 @@ A results directory is always either the previous finished run, untouched, or th
 The lock, staging and old directories are hidden (leading dot) and sit in the target's parent, on the same file
 system, so the swap is a rename and ``results/*/`` globs never see them.
 
-Every command that writes a directory (a run, ``cycle``, ``show``, ``compare``) uses this module, with an
+Every command that writes a directory (a run, ``batch``, ``cycle``, ``show``, ``compare``, ``drives``, the figure
+commands through ``scalesynth.plot_output``) uses this module, with an
 ``Output`` saying which file marks a directory as its own (its manifest) and which entries its output owns. A
 command writes only into a directory that is new, empty or its own (``claim`` checks the path with
 ``scalesynth.outpath`` and refuses anything else with exit code 2 before any work); with ``force`` it also writes
@@ -237,8 +238,7 @@ def claim(target: Path, output: Output = RUN, force: bool = False, option: str =
     rd.created = created
     try:
         _repair(target)
-        unfinished = resuming and any(p.is_file() for p in (rd.work / rio.CHECKPOINT, target / rio.CHECKPOINT))
-        rd.merge = not (_is_own(target, output) or (unfinished and not _would_drop(target, output)))
+        rd.merge = not _own(target, output, resuming)
         if rd.merge and not force:
             raise _refusal(given, output, option)
     except BaseException:
@@ -247,13 +247,38 @@ def claim(target: Path, output: Output = RUN, force: bool = False, option: str =
     return rd
 
 
-def check(target: Path, output: Output = RUN, force: bool = False, option: str = "--out") -> Path:
+def check(target: Path, output: Output = RUN, force: bool = False, option: str = "--out",
+          resuming: bool = False) -> Path:
     """``claim``'s checks of ``target`` without taking or creating anything (for a command that reads its inputs
     before claiming); returns the resolved path."""
     real = outpath.check_dir(target, option)
-    if not force and not _is_own(real, output):
+    if not force and not _own(real, output, resuming):
         raise _refusal(target, output, option)
     return real
+
+
+def check_own(target: Path, output: Output = RUN, force: bool = False, option: str = "--out",
+              resuming: bool = False) -> None:
+    """Only the ownership part of :func:`check`: an existing, non-empty ``target`` that is not ``output``'s own is
+    refused (ConfigError naming ``option``) unless ``force``; a path that cannot be a directory is left to the
+    caller (``batch`` fails that task alone when it cannot make the directory)."""
+    if not force and not _own(Path(target), output, resuming):
+        raise _refusal(target, output, option)
+
+
+def is_temp(name: str) -> bool:
+    """Whether a file name is one of a killed writer's temp files (``io.write_atomic``)."""
+    return bool(_TEMP.match(name))
+
+
+def _own(target: Path, output: Output, resuming: bool) -> bool:
+    """New, empty or ``output``'s own; ``resuming``: also a target whose unfinished run (a checkpoint staged beside
+    it, or inside it from scalesynth < 0.2) would lose nothing of it but temp files and that checkpoint."""
+    if _is_own(target, output):
+        return True
+    unfinished = resuming and any(p.is_file() for p in (staging_path(target) / rio.CHECKPOINT,
+                                                         target / rio.CHECKPOINT))
+    return unfinished and not _would_drop(target, output)
 
 
 def _refusal(given, output: Output, option: str) -> ConfigError:
@@ -284,10 +309,14 @@ def _would_drop(target: Path, output: Output) -> bool:
 
 
 @contextmanager
-def staged(target: Path, output: Output, force: bool = False, option: str = "--out") -> Iterator[RunDir]:
+def staged(target: Path, output: Output, force: bool = False, option: str = "--out",
+           stage: str = "staging") -> Iterator[RunDir]:
     """Claim ``target`` and yield it with an empty staging directory (``.work``) to write into: swapped in when the
-    block ends normally, discarded (the target untouched) when the block raises, an interrupt included."""
+    block ends normally, discarded (the target untouched) when the block raises, an interrupt included.
+    ``stage``: the staging directory's suffix, ``.<name>.<stage>`` (another than a run's ``staging`` where
+    ``target`` is a run directory whose unfinished successor may wait there for ``--resume``)."""
     with claim(target, output, force, option) as rd:
+        rd.work = rd.target.parent / f".{rd.target.name}.{stage}"
         rd.fresh()
         try:
             yield rd

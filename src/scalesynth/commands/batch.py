@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from scalesynth.cliapp import SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import ForceOpt, SetOpt, _print_json, app, handles_errors
 
 
 @app.command("batch")
@@ -31,10 +31,12 @@ def batch_cmd(
     as_json: Annotated[
         bool, typer.Option("--json", help="print the summary (batch.json) instead of the table")
     ] = False,
+    force: ForceOpt = False,
 ) -> None:
     """Run every (config, seed) pair as one dask task into OUT/<name>/seed<k>/ (finished tasks are skipped,
     unfinished ones resumed); write OUT/batch.json and, per config, the combined front and a hypervolume plot.
-    The client writes every file: workers need no access to OUT. Exit code 1 if any task failed."""
+    The client writes every file: workers need no access to OUT. A task directory that is neither new, empty nor
+    a run's is refused before any task runs (exit 2) unless --force. Exit code 1 if any task failed."""
     from scalesynth.batch import format_table, run_batch
     from scalesynth.cluster import address_from_file, check_address, check_protocol
     from scalesynth.config import load_config
@@ -46,7 +48,8 @@ def batch_cmd(
     if scheduler:
         check_protocol(scheduler)  # one this installation cannot speak: refused before anything is loaded
     loaded = [(str(path), load_config(path, sets)) for path in configs]  # all validated before any task starts
-    summary = run_batch(loaded, out, seeds=seeds, scheduler=scheduler, echo=lambda line: typer.echo(line, err=True))
+    summary = run_batch(loaded, out, seeds=seeds, scheduler=scheduler, echo=lambda line: typer.echo(line, err=True),
+                        force=force)
     if as_json:
         _print_json(summary.to_dict())
     else:

@@ -5,8 +5,11 @@ displacements over time. ``drives CONFIG`` is ``cycle`` on the square E-F-G-H-E 
 ``constant`` (the loop at constant speed, period 1 s, so t is the fraction of the loop) for a pprs-rprs config:
 the same analysis (``scalesynth.cycle.analysis``), written in the old format, each file atomically:
 ``drives.csv`` (t, x, y, z, w1, w2, beta, s1, s2, s3; mm, beta in rad) and ``drives.png`` (one subplot per
-actuator). For velocities, accelerations, forces, clearance and rest-to-rest laws use ``scalesynth cycle`` with a
-``cycle:`` section.
+actuator), with ``drives.json`` (the summary ``--json`` prints, and the files) marking the directory as drives'
+own. The directory (default RUN_DIR/drives, or OUTDIR/drives of a config) is staged and swapped in whole
+(``scalesynth.rundir``): it must be new, empty or a drives directory, anything else is refused before the
+analysis unless ``--force``. For velocities, accelerations, forces, clearance and rest-to-rest laws use
+``scalesynth cycle`` with a ``cycle:`` section.
 """
 
 from __future__ import annotations
@@ -17,11 +20,15 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cliapp import DesignOpt, SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import DesignOpt, ForceOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError, InvalidPose
-from scalesynth.io import ensure_dir, save_figure, write_text
+from scalesynth.io import save_figure, write_json, write_text
+from scalesynth.rundir import Output
 
 CSV_COLUMNS = ("t", "x", "y", "z", "w1", "w2", "beta", "s1", "s2", "s3")
+FILES = ("drives.csv", "drives.png")
+MANIFEST = "drives.json"
+OUTPUT = Output("drives", MANIFEST, ("corners", "files"), owned=lambda name: name in (*FILES, MANIFEST))
 # At z = 200 mm the cross-section of the primary workspace is a diagonal band: the largest axis-parallel square
 # that fits is about 30.9 mm, centred near (-41, -25); a 20 mm square there keeps about 5 mm of margin.
 DEFAULT_CENTER = "-40,-25"
@@ -84,16 +91,20 @@ def drives_cmd(
     side: Annotated[float, typer.Option("--side", help="side of the square (mm)")] = 20.0,
     center: Annotated[str, typer.Option("--center", help="centre x,y of the square (mm)")] = DEFAULT_CENTER,
     samples: Annotated[int, typer.Option("--samples", help="samples along the closed path (>= 9)")] = 400,
-    out: Annotated[Path | None, typer.Option("--out", help="output directory (default: <run dir>/drives)")] = None,
+    out: Annotated[Path | None, typer.Option("--out", help="output directory (default: RUN_DIR/drives, or "
+                                              "OUTDIR/drives of a config)")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
+    force: ForceOpt = False,
 ) -> None:
     """Drive-displacement curves of a pprs-rprs design along a closed square E-F-G-H-E: drives.csv, drives.png."""
+    from scalesynth import rundir
     from scalesynth.cycle import analysis
     from scalesynth.cycle.config import CycleConfig
     from scalesynth.mechanisms.pprs_rprs import MECHANISM
     from scalesynth.selection import load_design
 
-    cfg = load_design(config, design_choice, sets).cfg
+    chosen = load_design(config, design_choice, sets)
+    cfg = chosen.cfg
     if cfg.mechanism != MECHANISM.name:
         raise ConfigError(f"mechanism: drives needs {MECHANISM.name}, got {cfg.mechanism!r}")
     if not (np.isfinite(side) and side > 0):
@@ -104,23 +115,27 @@ def drives_cmd(
         raise InvalidPose(f"--samples: need 9 to 100001 samples, got {samples}")
     corners = square_path(_parse_center(center), side, z)
     cycle = CycleConfig(path=corners.tolist(), law="constant", period=1.0, samples=samples - 1)
-    curves = analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cycle, cfg.units.length)
-    out_dir = ensure_dir(out if out is not None else cfg.output_dir() / "drives")
-    csv_path, png_path = out_dir / "drives.csv", out_dir / "drives.png"
-    write_csv(csv_path, curves)
-    marks = [(name, k / 4) for k, name in enumerate("EFGHE")]
-    write_plot(png_path, curves, marks)
-    summary = {
-        "csv": str(csv_path),
-        "png": str(png_path),
-        "corners": {name: [float(v) for v in c] for name, c in zip("EFGH", corners, strict=True)},
-        "samples": int(curves.traj.t.size),
-        "ranges": {
-            name: [float(curves.q[:, k].min()), float(curves.q[:, k].max())]
-            for k, name in enumerate(MECHANISM.joints)
-        },
-        "min_lci": float(curves.lci.min()),
-    }
+    if out is None:
+        out = (chosen.result.out_dir if chosen.result is not None else cfg.output_dir()) / "drives"
+    with rundir.staged(out, OUTPUT, force) as staged:  # --out checked and locked before the analysis
+        curves = analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cycle, cfg.units.length)
+        write_csv(staged.work / FILES[0], curves)
+        marks = [(name, k / 4) for k, name in enumerate("EFGHE")]
+        write_plot(staged.work / FILES[1], curves, marks)
+        summary = {
+            "csv": str(staged.target / FILES[0]),
+            "png": str(staged.target / FILES[1]),
+            "corners": {name: [float(v) for v in c] for name, c in zip("EFGH", corners, strict=True)},
+            "samples": int(curves.traj.t.size),
+            "ranges": {
+                name: [float(curves.q[:, k].min()), float(curves.q[:, k].max())]
+                for k, name in enumerate(MECHANISM.joints)
+            },
+            "min_lci": float(curves.lci.min()),
+        }
+        write_json(staged.work / MANIFEST, {"source": str(config), "design": cfg.resolved_design(), **summary,
+                                            "files": [*FILES, MANIFEST]})
+    csv_path, png_path = summary["csv"], summary["png"]
     if as_json:
         _print_json(summary)
         return

@@ -14,7 +14,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from scalesynth.cliapp import DesignOpt, SetOpt, _print_json, app, handles_errors
+from scalesynth.cliapp import DesignOpt, ForceOpt, SetOpt, _print_json, app, handles_errors
 from scalesynth.errors import ConfigError
 from scalesynth.names import hint
 
@@ -53,16 +53,7 @@ def task_map(cfg, resolution: int | None = None, field: str = "lci") -> TaskMap:
     from scalesynth.kernels.grid import sample_grid
 
     mech = cfg.mech
-    if not mech.planar:
-        raise ConfigError(f"mechanism: plot-task needs a planar mechanism, {mech.name} has {len(mech.task_axes)} axes")
-    if cfg.task is None:
-        raise ConfigError("task: plot-task needs a task section (task.box, optional task.path)")
-    res = resolution or cfg.task.resolution or cfg.grid.resolution
-    if res < 2:
-        raise ConfigError(f"--resolution: need at least 2 cells per axis, got {res}")
-    from scalesynth import memory
-
-    memory.check(memory.task_map_estimate(res, "--resolution" if resolution else "task.resolution"))
+    res = check_task_map(cfg, resolution, field)
     lo, step = np.zeros(3), np.ones(3)
     for a, name in enumerate(mech.task_axes):  # config validation guarantees both axes are in the box
         lo[a], hi = cfg.task.box[name]
@@ -75,8 +66,6 @@ def task_map(cfg, resolution: int | None = None, field: str = "lci") -> TaskMap:
     path = None if cfg.task.path is None else np.asarray(cfg.task.path, dtype=float)
     if field == "lci":
         return TaskMap(xs=xs, ys=ys, lci=lci, path=path)
-    if field not in mech.field_names:
-        raise ConfigError(f"--field: unknown field {field!r} of {mech.name} " + hint(field, mech.field_names, "fields"))
     from scalesynth.kernels.grid import sample_fields
 
     slot = mech.field_names.index(field)
@@ -85,6 +74,25 @@ def task_map(cfg, resolution: int | None = None, field: str = "lci") -> TaskMap:
     vals = np.where(lci >= 0, vals, -1.0)
     label = f"{field} ({spec.unit.replace('{length}', cfg.units.length)})"
     return TaskMap(xs=xs, ys=ys, lci=lci, path=path, field=field, values=vals, label=label)
+
+
+def check_task_map(cfg, resolution: int | None = None, field: str = "lci") -> int:
+    """:func:`task_map`'s checks, before any sampling: a planar mechanism, a task section, at least 2 cells per
+    axis within the memory limit, a known field (ConfigError naming each); returns the cells per axis."""
+    mech = cfg.mech
+    if not mech.planar:
+        raise ConfigError(f"mechanism: plot-task needs a planar mechanism, {mech.name} has {len(mech.task_axes)} axes")
+    if cfg.task is None:
+        raise ConfigError("task: plot-task needs a task section (task.box, optional task.path)")
+    res = resolution or cfg.task.resolution or cfg.grid.resolution
+    if res < 2:
+        raise ConfigError(f"--resolution: need at least 2 cells per axis, got {res}")
+    from scalesynth import memory
+
+    memory.check(memory.task_map_estimate(res, "--resolution" if resolution else "task.resolution"))
+    if field != "lci" and field not in mech.field_names:
+        raise ConfigError(f"--field: unknown field {field!r} of {mech.name} " + hint(field, mech.field_names, "fields"))
+    return res
 
 
 def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
@@ -122,37 +130,55 @@ def task_figure(tm: TaskMap, axes: tuple[str, str], unit: str, title: str):
     return fig
 
 
-def _save_atomic(fig, out: Path) -> None:
-    """Write the figure atomically (io.save_figure, format from the suffix): a reader never sees half a file, and
-    an error names ``out``."""
-    from scalesynth import io as rio
-
-    rio.ensure_dir(out.parent)
-    rio.save_figure(fig, out)
-
-
 @app.command("plot-task")
 @handles_errors
 def plot_task_cmd(
     config: Annotated[Path, typer.Argument(help="run config (YAML) of a planar mechanism with a task section, or a "
                                            "results directory with --design")],
     design_choice: DesignOpt = None,
-    out: Annotated[Path | None, typer.Option("--out", help="directory to write task_lci.<format> into (default "
-                                              "OUTDIR/plots); a name with a .png/.svg/.pdf suffix is the file")] = None,
+    out: Annotated[Path | None, typer.Option("--out", help="directory to write task_<field>.<format> into (default "
+                                              "RUN_DIR/plots, or OUTDIR/plots of a config); a name with a "
+                                              ".png/.svg/.pdf suffix is the file")] = None,
     fmt: Annotated[str, typer.Option("--format", help="png | svg | pdf")] = "png",
     sets: SetOpt = None,
     resolution: Annotated[int | None, typer.Option(help="cells per axis (default task/grid resolution)")] = None,
     field: Annotated[str, typer.Option("--field", help="field to map: lci or any of the mechanism's fields, e.g. "
                                        "deflection or stiffness_min (see `scalesynth metrics MECH`)")] = "lci",
     as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout")] = False,
+    force: ForceOpt = False,
 ) -> None:
     """LCI (or another field, e.g. the deflection under the load) over the task box (unreachable cells blank) with
     the task path, as a PNG."""
+    from scalesynth import plot_output
     from scalesynth.selection import load_design
 
     if fmt not in ("png", "svg", "pdf"):
         raise ConfigError(f"--format: must be one of png, svg, pdf, got {fmt!r}")
-    cfg = load_design(config, design_choice, sets).cfg
+    chosen = load_design(config, design_choice, sets)
+    cfg = chosen.cfg
+    res = check_task_map(cfg, resolution, field)
+    if out is not None and out.suffix.lower() in (".png", ".svg", ".pdf"):
+        target = plot_output.check_file(out, "plot-task", force)  # before the map: nothing computed for nothing
+        _draw(cfg, resolution, field, target)
+    else:
+        default = (chosen.result.out_dir if chosen.result is not None else cfg.output_dir()) / "plots"
+        name = f"task_{field}.{fmt}"
+        with plot_output.figures(out or default, "plot-task", force, str(config)) as figs:
+            _draw(cfg, resolution, field, figs.dir / name)
+        target = figs.final(figs.dir.relative_to(figs.root) / name)
+    shown = task_metrics_at(cfg, res)
+    if as_json:
+        _print_json({"out": str(target), **shown})
+    else:
+        typer.echo(f"wrote {target} (" + ", ".join(f"{k} {v:.4f}" for k, v in shown.items()) + ")")
+
+
+def _draw(cfg, resolution: int | None, field: str, target: Path) -> None:
+    """The task map and its figure, written atomically to ``target`` (format from its suffix), marked as
+    plot-task's (``plot_output.metadata``)."""
+    from scalesynth import io as rio
+    from scalesynth import plot_output
+
     tm = task_map(cfg, resolution, field)
     unit = cfg.units.length
     design = ", ".join(f"{k}={v:g}" for k, v in cfg.resolved_design().items())
@@ -167,19 +193,11 @@ def plot_task_cmd(
     import matplotlib.pyplot as plt  # after the map: the evaluation does not wait for matplotlib's import
 
     fig = task_figure(tm, cfg.mech.task_axes[:2], unit, title)
-    if out is not None and out.suffix.lower() in (".png", ".svg", ".pdf"):
-        target = out
-    else:
-        target = (out or cfg.output_dir() / "plots") / f"task_{field}.{fmt}"
     try:
-        _save_atomic(fig, target)
+        rio.ensure_dir(target.parent)  # the file form's new directories: made once the map is drawn
+        rio.save_figure(fig, target, metadata=plot_output.metadata(target, "plot-task"))
     finally:
         plt.close(fig)
-    shown = task_metrics_at(cfg, tm.lci.shape[0])
-    if as_json:
-        _print_json({"out": str(target), **shown})
-    else:
-        typer.echo(f"wrote {target} (" + ", ".join(f"{k} {v:.4f}" for k, v in shown.items()) + ")")
 
 
 def task_metrics_at(cfg, resolution: int) -> dict[str, float]:

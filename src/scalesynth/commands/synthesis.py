@@ -52,32 +52,31 @@ PlotOut = Annotated[Path | None, typer.Option("--out", help="directory for the f
 PlotFormat = Annotated[str, typer.Option("--format", help="png | svg | pdf")]
 
 
-def _echo_files(run_dir: Path, files) -> None:
+def _echo_files(files) -> None:
     for f in files:
-        typer.echo(str(f if Path(f).is_absolute() else Path(run_dir) / f))
+        typer.echo(str(f))
 
 
 @app.command("plot-front")
 @handles_errors
 def plot_front_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
-                   out: PlotOut = None, fmt: PlotFormat = "png") -> None:
+                   out: PlotOut = None, fmt: PlotFormat = "png", force: ForceOpt = False) -> None:
     """Pareto front with the config's reference designs re-evaluated, and hypervolume per generation."""
-    from scalesynth.report import plot_front
-    from scalesynth.results import load
+    from scalesynth.report import plot_front_run
 
-    _echo_files(run_dir, plot_front(load(run_dir, require_finished=False), out, fmt)["files"])
+    _echo_files(plot_front_run(run_dir, out, fmt, force))
 
 
 @app.command("plot-bands")
 @handles_errors
 def plot_bands_cmd(run_dir: Annotated[Path, typer.Argument(help="results directory of a finished run")],
-                   out: PlotOut = None, fmt: PlotFormat = "png") -> None:
+                   out: PlotOut = None, fmt: PlotFormat = "png", force: ForceOpt = False) -> None:
     """Front coloured by each dexterity band's share; band shares and LCI sections of knee and extreme designs;
     per-band Pareto sets (bands/pareto_band<k>.csv and their plots)."""
     from scalesynth.report import plot_bands_run
 
-    info = plot_bands_run(run_dir, out, fmt)
-    _echo_files(run_dir, info["files"] + info["band_files"])
+    info = plot_bands_run(run_dir, out, fmt, force)
+    _echo_files(info["files"] + info["band_files"])
 
 
 @app.command("select")
