@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from scalesynth.cli import main
+from cli_main import run_main as _run_main
 from scalesynth.config import config_from_dict
 from scalesynth.optimize import run
 from scalesynth.rundir import staging_path
@@ -29,14 +29,6 @@ def _snapshot(directory: Path) -> dict[str, bytes]:
     return {str(p.relative_to(directory)): (p.read_bytes() if p.is_file() else b"<dir>")
             for p in sorted(directory.rglob("*"))}
 
-
-def _run_main(argv, capsys) -> tuple[int, str, str]:
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exc:
-        main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else 1), out, err
 
 
 def _assert_refused(argv, code, needle, workdir, capsys, monkeypatch):

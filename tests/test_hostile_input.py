@@ -19,7 +19,7 @@ import pytest
 import yaml
 
 import scalesynth as ss
-from scalesynth.cli import main
+from cli_main import run_main as _run_main
 from scalesynth.config import MAX_YAML_BYTES, config_from_dict, load_config
 from scalesynth.errors import ConfigError, InvalidParameter, RunError
 
@@ -32,14 +32,6 @@ FIVEBAR = yaml.safe_load((ROOT / "configs" / "fivebar_packing.yaml").read_text()
 CYCLE = yaml.safe_load((ROOT / "configs" / "fivebar_pnp_cycle.yaml").read_text())
 DENORMAL = 5e-324  # the smallest positive float
 
-
-def _run_main(argv, capsys) -> tuple[int, str, str]:
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exc:
-        main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else 1), out, err
 
 
 def _one_error_line(err: str, needle: str) -> str:

@@ -13,9 +13,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from scalesynth.cli import main
+from cli_main import run_main as _main
 from scalesynth.compare import conversion
-from scalesynth.config import config_from_dict, load_config
+from scalesynth.config import load_config
 from scalesynth.optimize import run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -24,30 +24,17 @@ QUICK = ROOT / "configs" / "quick.yaml"
 FIVEBAR = ROOT / "configs" / "fivebar_packing.yaml"
 POSE = "--pose=0,-700"  # mm: inside every five-bar workspace of these runs (the packing rectangle's middle)
 
-# the same five-bar in metres (fivebar_pnp_cycle's design and bounds / 1000), no task or cycle
-FIVEBAR_M = {"name": "fivebar_m", "mechanism": "planar-fivebar", "units": {"length": "m"},
-             "design": {"r": 0.2, "l1": 0.475, "l2": 0.875}, "options": {"mode": "+-"},
-             "bounds": {"r": [0.05, 0.4], "l1": [0.25, 0.8], "l2": [0.5, 1.4]}, "grid": {"resolution": 16},
-             "objectives": [{"metric": "link_length_sum", "sense": "min"}, {"metric": "gci", "sense": "max"}],
-             "algorithm": {"pop_size": 8, "n_gen": 2, "seed": 1}}
 
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """A tiny five-bar synthesis in mm with a pick-and-place cycle (its front has cycle metrics), and one in m."""
+    """A tiny five-bar synthesis in mm with a pick-and-place cycle (its front has cycle metrics), and a tiny
+    2pauu-ppap one (quick.yaml), whose lengths are in m (each mechanism computes in its own length unit)."""
     base = tmp_path_factory.mktemp("one_command_line")
     run(load_config(PNP, ["algorithm.pop_size=8", "algorithm.n_gen=2"]), base / "mm", plots=False)
-    run(config_from_dict(FIVEBAR_M), base / "m", plots=False)
+    run(load_config(QUICK, ["algorithm.pop_size=8", "algorithm.n_gen=2"]), base / "m", plots=False)
     return base
 
-
-def _main(argv, capsys) -> tuple[int, str, str]:
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exc:
-        main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else 1), out, err
 
 
 def _ok_json(argv, capsys) -> dict:
@@ -137,7 +124,8 @@ def test_every_per_design_command_takes_a_run_directory(runs, tmp_path, argv, ca
     (["evaluate", "{run}", "--design", "kne"], "(did you mean 'knee'?)"),
     (["evaluate", "{run}", "--design", "best-task_gc"], "did you mean 'task_gci'"),
     (["evaluate", "{run}", "--design", "99"], "--design: row 99 is not in pareto.csv"),
-    (["evaluate", "{m}", "--design", "best-cycle_max_actuator_force"], "is not a column of this run's pareto.csv"),
+    (["evaluate", "{m}", "--design", "best-cycle_max_actuator_force_revolute"],
+     "is not a column of this run's pareto.csv"),
 ])
 def test_selector_errors_are_one_line(runs, argv, needle, capsys):
     argv = [str(a).format(run=runs / "mm", m=runs / "m") for a in argv]
@@ -147,21 +135,23 @@ def test_selector_errors_are_one_line(runs, argv, needle, capsys):
 
 # ----- compare across length units ---------------------------------------------------------------------------
 def test_compare_matches_metrics_by_catalogue_name_across_units(runs, tmp_path, capsys):
-    """A run in mm and one in m share link_length_sum (link_length_sum_mm / link_length_sum_m): the table and the
-    figure use the first run's mm, the m run's values times 1000, and stderr says which values were converted."""
+    """A run in mm (five-bar) and one in m (2pauu-ppap) share link_length_sum (link_length_sum_mm /
+    link_length_sum_m): the table and the figure use the first run's mm, the m run's values times 1000, and stderr
+    says which values were converted. An area (mm2) and a volume (m3) differ by more than the length unit: not
+    shared."""
     for x in ("link_length_sum", "link_length_sum_m"):  # the catalogue name, or either run's column
         code, out, err = _main(["compare", runs / "mm", runs / "m", "--x", x, "--y", "gci", "--out",
                                 tmp_path / "cmp", "--json"], capsys)
         assert code == 0, err
         info = json.loads(out)
         assert info["axes"] == ["link_length_sum_mm", "gci"]
-        assert "note: fivebar_m: converted to the first run's units: link_length_sum m -> mm" in err
+        assert "note: quick: converted to the first run's units: link_length_sum m -> mm" in err
         converted = {c["metric"]: c for c in info["converted"]}
         assert converted["link_length_sum"]["factor"] == pytest.approx(1000.0, rel=1e-15)
-        assert converted["volume"]["from"] == "m2" and converted["volume"]["to"] == "mm2"
+        assert "volume" not in converted and "volume" not in info["shared_metrics"]
         assert "gci" not in converted  # dimensionless: nothing to convert
     metres = pd.read_csv(runs / "m" / "pareto.csv")
-    rows = [r for r in info["rows"] if r["run"] == "fivebar_m"]
+    rows = [r for r in info["rows"] if r["run"] == "quick"]
     assert rows
     for r in rows:
         assert r["link_length_sum_mm"] == pytest.approx(1000.0 * metres["link_length_sum_m"].iloc[r["pareto_row"]],

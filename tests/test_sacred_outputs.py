@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from cli_main import run_main as _main
 from scalesynth import rundir
-from scalesynth.cli import main
 from scalesynth.config import config_from_dict
 from scalesynth.optimize import run
 
@@ -38,14 +38,6 @@ def _snapshot(directory: Path) -> dict[str, bytes]:
             out[key] = p.read_bytes() if p.is_file() else b"<dir>"
     return out
 
-
-def _main(argv, capsys) -> tuple[int, str, str]:
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exc:
-        main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
 
 
 def _refused(argv, needle, workdir, capsys, monkeypatch, code=2) -> str:

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
+from cli_main import run_main as _main
 from scalesynth import rundir
-from scalesynth.cli import main
 from scalesynth.config import load_config
 from scalesynth.optimize import run
 
@@ -42,13 +42,6 @@ def _snapshot(directory: Path) -> dict[str, bytes]:
     return out
 
 
-def _main(argv, capsys) -> tuple[int, str, str]:
-    capsys.readouterr()
-    with pytest.raises(SystemExit) as exc:
-        main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
 
 
 def _ok(argv, capsys) -> str:
