@@ -76,7 +76,11 @@ def bench_cpu_target(rounds: int = 3, before: str | None = None) -> dict:
                     rows.append(row)
                     print(row, flush=True)
     load.append(os.getloadavg()[0])
-    return {"rounds": rounds, "before": before, "rows": rows, "load_average_1min": load}
+    commit = None
+    if before:
+        commit = subprocess.run(["git", "-C", before, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                text=True, timeout=60).stdout.strip() or None
+    return {"rounds": rounds, "before": before, "before_commit": commit, "rows": rows, "load_average_1min": load}
 
 
 def markdown(entry: dict) -> list[str]:
@@ -91,7 +95,10 @@ def markdown(entry: dict) -> list[str]:
     out = ["The same kernels compiled for the host CPU, plain x86-64, the pinned x86-64-v3 level, and (where given) "
            "the tree before fast-math was turned off (`--before`), each in its own process and Numba cache, "
            f"rounds alternating ({entry['result']['rounds']} rounds, median; load average "
-           f"{entry['result']['load_average_1min']}). Ratios to the pinned target; CPU seconds, one Numba thread.", "",
+           f"{[round(x, 1) for x in entry['result']['load_average_1min']]}). Ratios to the pinned target; CPU seconds, one "
+           "Numba thread."
+           + (f" `before`: commit {entry['result']['before_commit']} (fast-math flags nsz, arcp, contract, afn)."
+              if entry["result"].get("before_commit") else ""), "",
            "| variant | " + " | ".join(timed) + " |", "|---|" + "---|" * len(timed)]
     for v in variants:
         cells = [f"{med[(v, k)]:.4g} ({med[(v, k)] / med[(pinned, k)]:.2f}x)" for k in timed]
