@@ -119,7 +119,7 @@ def parse_description(data: Any, where: str = "description") -> Description:
 
 def load_description(path: str | Path) -> Description:
     """Read a description file (YAML, the config's safe loader) and validate it."""
-    from scalesynth.config import MAX_YAML_BYTES, read_limited, safe_yaml
+    from scalesynth.yamlfile import MAX_YAML_BYTES, read_limited, safe_yaml
 
     path = Path(path)
     if not path.is_file():
