@@ -117,14 +117,16 @@ def parse_description(data: Any, where: str = "description") -> Description:
     return desc
 
 
-def load_description(path: str | Path) -> Description:
-    """Read a description file (YAML, the config's safe loader) and validate it."""
+def load_description(path: str | Path, where: str | None = None) -> Description:
+    """Read a description file (YAML, the config's safe loader) and validate it; ``where`` starts error lines
+    (default the file's name)."""
     from scalesynth.config import MAX_YAML_BYTES, read_limited, safe_yaml
 
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: no such description file")
-    return parse_description(safe_yaml(read_limited(path, MAX_YAML_BYTES), str(path)), path.name)
+    where = where or path.name
+    return parse_description(safe_yaml(read_limited(path, MAX_YAML_BYTES), where), where)
 
 
 def _check(desc: Description) -> None:
