@@ -184,8 +184,8 @@ def _check(desc: Description) -> None:
             if option not in desc.options:
                 raise ConfigError(f"{where}.{field}: unknown option {option!r} " + hint(option, desc.options))
             if desc.options[option].kind != kind:
-                raise ConfigError(f"{where}.{field}: option {option!r} is a {desc.options[option].kind}, "
-                                  f"{field} needs a {kind}")
+                raise ConfigError(f"{where}.{field}: option {option!r} is of kind {desc.options[option].kind}, "
+                                  f"{field} needs one of kind {kind}")
         count += leg.pattern.count if leg.pattern else 1
     if desc.motion == "3T" and count != 3:
         raise ConfigError(f"legs: motion 3T needs 3 actuated legs (a square Jacobian), these give {count}")
