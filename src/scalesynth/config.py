@@ -233,14 +233,19 @@ class RunConfig(_Strict):
     constraints: list[ConstraintConfig] = Field(default_factory=list)
     algorithm: AlgorithmConfig = Field(default_factory=AlgorithmConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
-    _mech: Any = PrivateAttr(None)
-    _described: bool = PrivateAttr(False)  # a user's description: dumped inline, so a dump reloads the same mechanism
+    _mech: Any = PrivateAttr(None)  # cfg.mech, found again after unpickling (mechanisms hold unpicklable lambdas)
+    _description: Any = PrivateAttr(None)  # a user's description: dumped inline, so a dump reloads it
 
     @field_serializer("mechanism")
     def _mechanism_out(self, value):
-        if self._described:
-            return {"description": self._mech.description.model_dump(mode="json", exclude_defaults=True)}
+        if self._description is not None:
+            return {"description": self._description.model_dump(mode="json", exclude_defaults=True)}
         return value
+
+    def __getstate__(self):
+        state = super().__getstate__()
+        state["__pydantic_private__"] = {**(state.get("__pydantic_private__") or {}), "_mech": None}
+        return state
 
     @field_validator("design", "bounds", "references", mode="before")
     @classmethod
@@ -284,8 +289,8 @@ class RunConfig(_Strict):
         base_dir = (info.context or {}).get("base_dir")
         mech = mechanism_of(self.mechanism, base_dir)
         self._mech = mech
-        self._described = isinstance(self.mechanism, dict) and mech.description is not None \
-            and not _is_registered(mech)
+        if isinstance(self.mechanism, dict) and not _is_registered(mech):
+            self._description = mech.description
         self.mechanism = mech.name
         self.units.length = mech.length_unit(self.units.length)
         mech.resolve_design(self.design)
@@ -352,11 +357,10 @@ class RunConfig(_Strict):
     # convenient views
     @property
     def mech(self):
-        if self._mech is not None:
-            return self._mech
-        from scalesynth.mechanisms import get
-
-        return get(self.mechanism)
+        if self._mech is None:
+            self._mech = mechanism_of(self.mechanism) if self._description is None else \
+                describe_user_mechanism(self._description)
+        return self._mech
 
     def resolved_design(self) -> dict[str, float]:
         return self.mech.resolve_design(self.design)
@@ -378,6 +382,12 @@ def mechanism_of(value: Any, base_dir: Path | None = None):
     from scalesynth.mechanisms import get
 
     return get(value)
+
+
+def describe_user_mechanism(description):
+    from scalesynth.mechanisms.describe import user_mechanism
+
+    return user_mechanism(description)
 
 
 def _is_registered(mech) -> bool:
