@@ -215,7 +215,9 @@ def test_the_linear_delta_leg_and_its_jacobian():
     design, options = mech.resolve_design({}), mech.resolve_options({})
     legs, packed = mech.legs(design, options), mech.pack(design, options)
     lo, hi = mech.bounding_box(design, options)
-    assert hi[2] == pytest.approx(1.0 + 0.5)  # the top of the stroke plus the rod
+    # 'far' on a rail pointing up: the platform joint lies below its carriage, from the top of the stroke down to
+    # its bottom minus the rod
+    assert (lo[2], hi[2]) == pytest.approx((0.0 - 0.5, 1.0))
     out, vals = np.zeros(3), np.zeros((3, 6))
     h = 1e-6
     for p in ([0.0, 0.0, 0.2], [0.05, -0.03, 0.4], [-0.08, 0.02, 0.1]):
