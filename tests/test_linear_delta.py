@@ -1,13 +1,15 @@
 """The linear Delta (mechanisms/linear-delta.yaml, 3 x P-Pa on vertical rails): its conventions, leg IK and the
-Jacobian against finite differences of the forward kinematics, the kernel against a NumPy twin written here from
-the textbook geometry, conditioning on the central axis against its closed form, and the workspace volume against
-its closed form (a double integral for any design; pi l^2 S when the rails' circle equals the platform's)."""
+Jacobian against finite differences of the forward kinematics, the kernel against a NumPy twin written from the
+geometry (tests/naive_delta.py), conditioning on the central axis against its closed form, and the workspace
+volume against its closed form (a double integral for any design; pi l^2 S when the rails' circle equals the
+platform's)."""
 
 import math
 
 import numpy as np
 import pytest
 
+from naive_delta import linear_delta_fields
 from scalesynth.config import load_config
 from scalesynth.evaluate import evaluate_config
 from scalesynth.kernels import grid as kgrid
@@ -24,38 +26,6 @@ RNG_SEED = 20261
 def _random_designs(rng, k):
     return [LIN.resolve_design({"base_radius": rng.uniform(0.15, 0.6), "platform_radius": rng.uniform(0.02, 0.1),
                                 "forearm": rng.uniform(0.3, 1.0)}) for _ in range(k)]
-
-
-def twin_fields(design, stroke, pts):
-    """NumPy twin, independent of the description machinery: leg i's rail is the vertical line through
-    a (cos phi_i, sin phi_i) (a = R - r, the platform offset taken off); at platform centre P its carriage is
-    h_i = sqrt(l^2 - d_i^2) above P (d_i the horizontal distance from P to that line), at depth s_i = -z - h_i,
-    which must lie in the stroke. The forearm f_i = P - C_i, J = Jx^-1 Jq with Jx rows f_i and
-    Jq = diag(f_i . (0, 0, -1)); LCI, sigma_min, sigma_max by np.linalg.svd; -1, 0, 0 where unreachable."""
-    a, l = design["base_radius"] - design["platform_radius"], design["forearm"]
-    out = np.zeros((len(pts), 3))
-    for n, p in enumerate(pts):
-        rows, ok = [], True
-        for phi in PHIS:
-            c = a * np.array([math.cos(phi), math.sin(phi)])
-            d2 = float(((p[:2] - c) ** 2).sum())
-            if d2 > l * l:
-                ok = False
-                break
-            h = math.sqrt(l * l - d2)
-            s = -p[2] - h
-            if not stroke[0] <= s <= stroke[1]:
-                ok = False
-                break
-            rows.append([p[0] - c[0], p[1] - c[1], h])  # P + r_p - C: up from the carriage's level is -h
-        if not ok:
-            out[n] = (-1.0, 0.0, 0.0)
-            continue
-        jx = np.array(rows) * np.array([1.0, 1.0, -1.0])
-        jq = np.diag(jx @ np.array([0.0, 0.0, -1.0]))
-        sv = np.linalg.svd(np.linalg.solve(jx, jq), compute_uv=False)
-        out[n] = (sv[-1] / sv[0], sv[-1], sv[0])
-    return out
 
 
 def _reachable_points(design, options, rng, k):
@@ -127,7 +97,7 @@ def test_kernel_fields_equal_the_numpy_twin_on_random_designs_and_points():
         pts = rng.uniform(lo, hi, size=(400, 3))
         fields = kgrid.population_points_fields(LIN.field_kernel, LIN.n_fields,
                                                 LIN.pack(design, options)[None, :], pts)[0]
-        twin = twin_fields(design, stroke, pts)
+        twin = linear_delta_fields(design, options, pts[:, 0], pts[:, 1], pts[:, 2])
         ok = fields[:, 0] >= 0
         assert np.array_equal(ok, twin[:, 0] >= 0) and 20 <= ok.sum() < 400
         np.testing.assert_allclose(fields[ok], twin[ok], rtol=1e-7, atol=1e-12)

@@ -92,4 +92,5 @@ def get(name: str) -> Mechanism:
         from scalesynth.names import hint
 
         raise UnknownMechanism(f"mechanism: unknown mechanism {str(name)[:60]!r} "
-                               + hint(str(name), sorted(_REGISTRY), "available")) from None
+                               + hint(str(name), sorted(_REGISTRY), "available",
+                                      more="`scalesynth mechanisms` lists them")) from None
