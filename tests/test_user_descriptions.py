@@ -4,6 +4,9 @@ a wrong description is one line naming the leg and the field, exit 2; a config d
 (results/config.yaml) reloads the same mechanism. Cheap: uniform 16^3 grids of the Delta."""
 
 import json
+import os
+import subprocess
+import sys
 
 import pytest
 import yaml
@@ -143,3 +146,17 @@ def test_description_of_what_has_none_is_refused(args, message):
 def test_mechanisms_name_lists_one():
     res = CliRunner().invoke(app, ["mechanisms", "delta", "--json"])
     assert res.exit_code == 0 and [r["name"] for r in json.loads(res.stdout)] == ["delta"]
+
+
+def test_a_users_description_loads_no_other_mechanism(tmp_path):
+    """Checking the user's name against the built-ins reads only what that name suggests (no module imported for
+    'my-delta'): a config of one's own costs no other mechanism's import."""
+    cfg = _project(tmp_path, DELTA_TEXT)
+    code = ("import json, sys\nfrom scalesynth.config import load_config\ncfg = load_config(sys.argv[1])\n"
+            "print(json.dumps([cfg.mechanism, sorted(m for m in sys.modules if m.startswith('scalesynth.mechanisms.')"
+            " and not m.startswith('scalesynth.mechanisms.describe'))]))")
+    proc = subprocess.run([sys.executable, "-c", code, str(cfg)], capture_output=True, text=True, timeout=600,
+                          env=dict(os.environ, NUMBA_NUM_THREADS="1"))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    name, modules = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert name == "my-delta" and set(modules) <= {"scalesynth.mechanisms.base", "scalesynth.mechanisms.links"}

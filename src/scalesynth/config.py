@@ -391,12 +391,9 @@ def describe_user_mechanism(description):
 
 
 def _is_registered(mech) -> bool:
-    from scalesynth.mechanisms import get
+    from scalesynth.mechanisms import find
 
-    try:
-        return get(mech.name) is mech
-    except ScalesynthError:
-        return False
+    return find(mech.name) is mech
 
 
 def _format_validation_error(err: ValidationError) -> str:

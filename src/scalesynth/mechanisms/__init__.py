@@ -81,6 +81,14 @@ def _load_one(name: str) -> None:
         register(mech)
 
 
+def find(name: str) -> Mechanism | None:
+    """The registered mechanism ``name``, or None, loading at most the module or description file the name suggests
+    (every mechanism lives there: tests/test_lazy_imports.py), so asking about a user's name loads nothing else."""
+    if name not in _REGISTRY and not _LOADED:
+        _load_one(name)
+    return _REGISTRY.get(name)
+
+
 def get(name: str) -> Mechanism:
     if name not in _REGISTRY and not _LOADED:
         _load_one(name)

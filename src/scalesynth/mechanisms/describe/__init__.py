@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from scalesynth.errors import ConfigError, UnknownMechanism
+from scalesynth.errors import ConfigError
 from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, from_description
 from scalesynth.mechanisms.describe.schema import Description, load_description, parse_description
 
@@ -38,12 +38,9 @@ def user_mechanism(desc: Description, where: str = "mechanism.description") -> D
     """The mechanism of a user's description. One object per description content (so caches keyed by the
     mechanism hold across configs); a description equal to a built-in one gives the registered built-in; one that
     takes a registered mechanism's name but differs from it is refused (results and plans go by name)."""
-    from scalesynth.mechanisms import get
+    from scalesynth.mechanisms import find
 
-    try:
-        registered = get(desc.name)
-    except UnknownMechanism:
-        registered = None
+    registered = find(desc.name)
     if registered is not None:
         if isinstance(registered, DescribedMechanism) and registered.description == desc:
             return registered
