@@ -156,13 +156,16 @@ def _described(mech, design, options):
     joints = np.array([p + leg.platform for leg in legs])
     links = []
     for i, (leg, qi) in enumerate(zip(legs, q, strict=True), 1):
-        elbow = leg.actuated_point(qi)
-        links += [(leg.base, elbow, f"upper_arm, theta{i}"), (elbow, p + leg.platform, "forearm")]
-    return Linkage([bases], joints, links, (p, "P"), [f"pose P = {pose} m, elbows out"])
+        elbow = leg.actuated_point(qi)  # R-Pa: the elbow; P-Pa: the carriage, |elbow - base| = its joint value
+        arm = "upper_arm" if leg.type.joint_unit == "angle" else "carriage"
+        links += [(leg.base, elbow, f"{arm}, {mech.joints[i - 1]}"), (elbow, p + leg.platform, "forearm")]
+    mode = "elbows out" if legs[0].type.joint_unit == "angle" else "platform below the carriages"
+    return Linkage([bases], joints, links, (p, "P"), [f"pose P = {pose} m, {mode}"])
 
 
 LINKAGES = {
     "delta": _described,
+    "linear-delta": _described,
     "2pauu-ppap": _pauu,
     "planar-fivebar": _fivebar,
     "pprs-rprs": _pprs,

@@ -63,3 +63,35 @@ def delta_fields(design, options, x, y, z):
         sv = np.linalg.svd(j, compute_uv=False)
         out[idx] = (sv[-1] / sv[0], sv[-1], sv[0])
     return out
+
+
+def linear_delta_fields(design, options, x, y, z):
+    """The linear Delta's (LCI, sigma_min, sigma_max) of J = dx/dq at arrays of points, shape x.shape + (3,), LCI -1
+    (and 0, 0) where unreachable. Independent of the description machinery: leg i's rail is the vertical line through
+    a (cos phi_i, sin phi_i) (a = R - r, the platform offset taken off); at platform centre P its carriage is
+    h_i = sqrt(l^2 - d_i^2) above P (d_i the horizontal distance from P to that line), at depth s_i = -z - h_i below
+    the base plane, which must lie in options['stroke']. The forearm f_i = P - C_i = (P_xy - c_i, -h_i),
+    J = Jx^-1 Jq with Jx rows f_i and Jq = diag(f_i . (0, 0, -1)) = diag(h_i); singular values by np.linalg.svd."""
+    a, l = design["base_radius"] - design["platform_radius"], design["forearm"]
+    lo, hi = options["stroke"]
+    x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
+    out = np.zeros(x.shape + (3,))
+    out[..., 0] = -1.0
+    for idx in np.ndindex(x.shape):
+        rows = []
+        for phi in PHIS:
+            dx, dy = x[idx] - a * np.cos(phi), y[idx] - a * np.sin(phi)
+            d2 = dx * dx + dy * dy
+            if d2 > l * l:
+                break
+            h = np.sqrt(l * l - d2)
+            if not lo <= -z[idx] - h <= hi:
+                break
+            rows.append([dx, dy, -h])
+        if len(rows) < 3:
+            continue
+        jx = np.array(rows)
+        jq = np.diag(-jx[:, 2])
+        sv = np.linalg.svd(np.linalg.solve(jx, jq), compute_uv=False)
+        out[idx] = (sv[-1] / sv[0], sv[-1], sv[0])
+    return out

@@ -215,7 +215,9 @@ def test_the_linear_delta_leg_and_its_jacobian():
     design, options = mech.resolve_design({}), mech.resolve_options({})
     legs, packed = mech.legs(design, options), mech.pack(design, options)
     lo, hi = mech.bounding_box(design, options)
-    assert hi[2] == pytest.approx(1.0 + 0.5)  # the top of the stroke plus the rod
+    # 'far' on a rail pointing up: the platform joint lies below its carriage, from the top of the stroke down to
+    # its bottom minus the rod
+    assert (lo[2], hi[2]) == pytest.approx((0.0 - 0.5, 1.0))
     out, vals = np.zeros(3), np.zeros((3, 6))
     h = 1e-6
     for p in ([0.0, 0.0, 0.2], [0.05, -0.03, 0.4], [-0.08, 0.02, 0.1]):
@@ -257,7 +259,7 @@ def _bad(**changes):
     (_bad(leg_type="P-Pb"),
      "d: legs[0] (leg).type: unknown leg type 'P-Pb' (did you mean 'P-Pa'?; library: R-Pa, P-Pa)"),
     (_bad(leg_base=["rail_radus", 0, 0]),
-     "d: legs[0] (leg).base.x: 'rail_radus': unknown parameter 'rail_radus' (did you mean 'rail_radius'?; known: "
+     "d: legs[0] (leg).base.x: unknown parameter 'rail_radus' (did you mean 'rail_radius'?; known: "
      "rail_radius, platform_radius, forearm)"),
     (_bad(leg_links={}), "d: legs[0] (leg).links: P-Pa needs forearm (missing forearm)"),
     (_bad(leg_links={"forearm": "forearm", "upper_arm": 0.3}),
@@ -290,5 +292,5 @@ def test_the_builtin_description_file_is_the_registered_delta(tmp_path):
     assert DELTA.option_names == ("theta_limits", "cone_limit")
     bad = tmp_path / "my_delta.yaml"
     bad.write_text((BUILTIN_DIR / "delta.yaml").read_text().replace("base: [base_radius", "base: [base_radiu"))
-    with pytest.raises(ConfigError, match=r"^my_delta.yaml: legs\[0\] \(arm\).base.x: 'base_radiu': unknown param"):
+    with pytest.raises(ConfigError, match=r"^my_delta.yaml: legs\[0\] \(arm\).base.x: unknown param"):
         load_description(bad)

@@ -100,6 +100,10 @@ def _expected_lengths(name, mech, design, options):
         return {"c (SR link A0B1)": design["c"], "l1 (SPR)": q[0], "l2": q[1], "l3": q[2]}
     if name == "delta":  # each arm labelled with its joint, the three forearms alike
         return {**{f"upper_arm, theta{i}": design["upper_arm"] for i in (1, 2, 3)}, "forearm": design["forearm"]}
+    if name == "linear-delta":  # each rail from the base plane to its carriage: the carriage depth s_i by the IK
+        (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, -1.0))
+                if s.label == "near/near/near"]
+        return {**{f"carriage, s{i}": q[i - 1] for i in (1, 2, 3)}, "forearm": design["forearm"]}
     raise AssertionError(f"no expected lengths for {name}")
 
 

@@ -32,17 +32,28 @@ from scalesynth.cliapp import (  # noqa: F401 - re-exported: app and the shared 
     error_line,
     handles_errors,
 )
+from scalesynth.errors import ConfigError  # noqa: E402
 
 
 @app.command("mechanisms")
 @handles_errors
-def mechanisms_cmd(as_json: JsonOpt = False) -> None:
-    """List registered mechanisms and their parameters."""
+def mechanisms_cmd(
+    name: Annotated[str | None, typer.Argument(help="only this mechanism")] = None,
+    description: Annotated[bool, typer.Option(
+        "--description", help="print the mechanism's description (YAML) to start your own from")] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """List registered mechanisms and their parameters; with NAME --description, print NAME's description."""
     from scalesynth.mechanisms import available, get
 
+    if description:
+        if name is None:
+            raise ConfigError("--description: name the mechanism (scalesynth mechanisms NAME --description)")
+        _print_description(get(name))
+        return
     rows = []
-    for name in available():
-        m = get(name)
+    for key in ([get(name).name] if name is not None else available()):
+        m = get(key)
         rows.append(
             {
                 "name": m.name,
@@ -64,6 +75,17 @@ def mechanisms_cmd(as_json: JsonOpt = False) -> None:
         typer.echo("    parameters: " + ", ".join(f"{k}={v['default']:g}" for k, v in r["parameters"].items()))
         if r["options"]:
             typer.echo("    options:    " + ", ".join(f"{k}={v['default']!r}" for k, v in r["options"].items()))
+
+
+def _print_description(mech) -> None:
+    """The description file of a described built-in mechanism, as shipped (comments included)."""
+    from scalesynth.mechanisms.describe import builtin_path
+
+    path = builtin_path(mech.name)
+    if getattr(mech, "description", None) is None or not path.is_file():
+        raise ConfigError(f"--description: {mech.name} is a hand-written mechanism (seed {mech.seed}), not a "
+                          "described one: start from a described one (scalesynth mechanisms lists them)")
+    typer.echo(path.read_text(encoding="utf-8"), nl=False)
 
 
 @app.command("evaluate")

@@ -13,7 +13,18 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_serializer, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    field_serializer,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from scalesynth.cycle import config as cycle_config
 from scalesynth.errors import ConfigError, ScalesynthError
@@ -202,7 +213,9 @@ class UnitsConfig(_Strict):
 class RunConfig(_Strict):
     # used as a directory name (results/<name>, batch OUT/<name>): no separators, no leading dot ('.', '..')
     name: str = Field(..., min_length=1, max_length=128, pattern=r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
-    mechanism: str
+    # a registered mechanism's name, or {description: FILE or MAPPING}: a user's described mechanism (FILE relative
+    # to the config file); after validation the name, with the mechanism in _mech (cfg.mech)
+    mechanism: str | dict[str, Any]
     units: UnitsConfig = Field(default_factory=UnitsConfig)
     design: dict[str, float] = Field(default_factory=dict, description="design evaluated by `evaluate`")
     options: dict[str, Any] = Field(default_factory=dict)
@@ -220,6 +233,19 @@ class RunConfig(_Strict):
     constraints: list[ConstraintConfig] = Field(default_factory=list)
     algorithm: AlgorithmConfig = Field(default_factory=AlgorithmConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
+    _mech: Any = PrivateAttr(None)  # cfg.mech, found again after unpickling (mechanisms hold unpicklable lambdas)
+    _description: Any = PrivateAttr(None)  # a user's description: dumped inline, so a dump reloads it
+
+    @field_serializer("mechanism")
+    def _mechanism_out(self, value):
+        if self._description is not None:
+            return {"description": self._description.model_dump(mode="json", exclude_defaults=True)}
+        return value
+
+    def __getstate__(self):
+        state = super().__getstate__()
+        state["__pydantic_private__"] = {**(state.get("__pydantic_private__") or {}), "_mech": None}
+        return state
 
     @field_validator("design", "bounds", "references", mode="before")
     @classmethod
@@ -259,10 +285,13 @@ class RunConfig(_Strict):
         return v
 
     @model_validator(mode="after")
-    def _against_mechanism(self):
-        from scalesynth.mechanisms import get
-
-        mech = get(self.mechanism)
+    def _against_mechanism(self, info: ValidationInfo):
+        base_dir = (info.context or {}).get("base_dir")
+        mech = mechanism_of(self.mechanism, base_dir)
+        self._mech = mech
+        if isinstance(self.mechanism, dict) and not _is_registered(mech):
+            self._description = mech.description
+        self.mechanism = mech.name
         self.units.length = mech.length_unit(self.units.length)
         mech.resolve_design(self.design)
         mech.resolve_options(self.options)
@@ -328,9 +357,10 @@ class RunConfig(_Strict):
     # convenient views
     @property
     def mech(self):
-        from scalesynth.mechanisms import get
-
-        return get(self.mechanism)
+        if self._mech is None:
+            self._mech = mechanism_of(self.mechanism) if self._description is None else \
+                describe_user_mechanism(self._description)
+        return self._mech
 
     def resolved_design(self) -> dict[str, float]:
         return self.mech.resolve_design(self.design)
@@ -340,6 +370,30 @@ class RunConfig(_Strict):
 
     def output_dir(self) -> Path:
         return Path(self.output.dir) if self.output.dir else Path("results") / self.name
+
+
+def mechanism_of(value: Any, base_dir: Path | None = None):
+    """The mechanism a config's ``mechanism`` names: a registered name, or ``{description: FILE or MAPPING}`` (a
+    relative FILE read from ``base_dir``); ConfigError / UnknownMechanism, one line, otherwise."""
+    if isinstance(value, dict):
+        from scalesynth.mechanisms.describe import resolve_source
+
+        return resolve_source(value, base_dir)
+    from scalesynth.mechanisms import get
+
+    return get(value)
+
+
+def describe_user_mechanism(description):
+    from scalesynth.mechanisms.describe import user_mechanism
+
+    return user_mechanism(description)
+
+
+def _is_registered(mech) -> bool:
+    from scalesynth.mechanisms import find
+
+    return find(mech.name) is mech
 
 
 def _format_validation_error(err: ValidationError) -> str:
@@ -395,21 +449,23 @@ def apply_overrides(data: dict, overrides: list[str] | None, design_keys: set[st
     return data
 
 
-def config_from_dict(data: Any, overrides: list[str] | None = None) -> RunConfig:
+def config_from_dict(data: Any, overrides: list[str] | None = None, base_dir: str | Path | None = None) -> RunConfig:
+    """Validate a config mapping; ``base_dir`` is where a relative ``mechanism: {description: FILE}`` is read from
+    (load_config: the config file's directory; None: the working directory)."""
     if not isinstance(data, dict):
         raise ConfigError("config: top level must be a mapping")
     data = dict(data)
+    base = Path(base_dir) if base_dir is not None else None
     if overrides:
         design_keys = None
         try:
-            from scalesynth.mechanisms import get
-
-            design_keys = set(get(str(data.get("mechanism"))).parameter_names)
+            raw = data.get("mechanism")
+            design_keys = set(mechanism_of(raw if isinstance(raw, dict) else str(raw), base).parameter_names)
         except ScalesynthError:
             pass
         data = apply_overrides(data, overrides, design_keys)
     try:
-        return RunConfig.model_validate(data)
+        return RunConfig.model_validate(data, context={"base_dir": base})
     except ValidationError as err:
         raise ConfigError(_one_line(_format_validation_error(err))) from None
     except ScalesynthError as err:
@@ -441,7 +497,7 @@ def load_config(path: str | Path, overrides: list[str] | None = None) -> RunConf
     if not is_file:
         raise ConfigError(f"{path}: no such config file")
     text = read_limited(path, MAX_YAML_BYTES)
-    return config_from_dict(safe_yaml(text, str(path)), overrides)
+    return config_from_dict(safe_yaml(text, str(path)), overrides, path.parent)
 
 
 def dump_config(cfg: RunConfig) -> str:

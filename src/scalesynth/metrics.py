@@ -265,15 +265,17 @@ def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
     ]
 
 
-_CACHE: dict[tuple[str, str], dict[str, Metric]] = {}
+# (name, unit) -> (the mechanism, its catalogue): two users' descriptions may share a name, so the entry is checked
+# to be this very mechanism's
+_CACHE: dict[tuple[str, str], tuple[Mechanism, dict[str, Metric]]] = {}
 
 
 def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metric]:
     """Every metric of ``mech`` with columns in ``length_unit`` (default the mechanism's), in result-column order."""
     unit = mech.length_unit(length_unit, "length_unit")
     key = (mech.name, unit)
-    if key in _CACHE:
-        return _CACHE[key]
+    if key in _CACHE and _CACHE[key][0] is mech:
+        return _CACHE[key][1]
     mkey = mech.measure_key(unit)
     munit = mech.measure_unit(unit)
     mname = mech.measure_name()
@@ -325,7 +327,7 @@ def catalogue(mech: Mechanism, length_unit: str | None = None) -> dict[str, Metr
         if m.name in out:
             raise ValueError(f"metric {m.name!r} defined twice for {mech.name}")
         out[m.name] = m
-    _CACHE[key] = out
+    _CACHE[key] = (mech, out)
     return out
 
 

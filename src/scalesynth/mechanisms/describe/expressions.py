@@ -81,7 +81,8 @@ def _check(node: ast.AST, text: str, known: list[str], names: set[str]) -> None:
         if node.id in CONSTANTS:
             return
         if node.id not in known:
-            raise ExpressionError(f"{text!r}: unknown parameter {node.id!r} " + hint(node.id, known))
+            inside = "" if text == node.id else f"{text!r}: "  # the whole expression is the name: say it once
+            raise ExpressionError(f"{inside}unknown parameter {node.id!r} " + hint(node.id, known))
         names.add(node.id)
     elif isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
         _check(node.left, text, known, names)

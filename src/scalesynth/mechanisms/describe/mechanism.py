@@ -170,19 +170,25 @@ class DescribedMechanism(Mechanism):
 
     def bounding_box(self, design, options):
         """Intersection over the legs of the box of the set each leg can reach: R-Pa, a ball of radius L + l about
-        B - r_p; P-Pa, the stroke segment of the rail swept by a ball of radius l (minus r_p). An empty
-        intersection gives a zero-size box at the origin (nothing reachable)."""
+        B - r_p; P-Pa, the stroke segment of the rail swept by the half ball of radius l on its branch's side
+        (f . e >= 0 for 'near', <= 0 for 'far', f the forearm: the platform joint lies beyond the carriage along
+        the rail, or before it), minus r_p. An empty intersection gives a zero-size box at the origin."""
         lo, hi = np.full(3, -math.inf), np.full(3, math.inf)
         for leg in self.legs(design, options):
             if leg.type.code == _k.R_PA:
                 c0 = c1 = leg.base - leg.platform
-                reach = leg.arm + leg.forearm
+                down = up = np.full(3, leg.arm + leg.forearm)
             else:
                 c0 = leg.base + leg.limits[0] * leg.u - leg.platform
                 c1 = leg.base + leg.limits[1] * leg.u - leg.platform
-                reach = leg.forearm
-            lo = np.maximum(lo, np.minimum(c0, c1) - reach)
-            hi = np.minimum(hi, np.maximum(c0, c1) + reach)
+                # extent of the half ball {|f| <= l, f . n >= 0}, n = -branch e, along each axis: l where the axis
+                # points into the half (or along its face), else l sqrt(1 - n_k^2), its rim's
+                n = -leg.branch * leg.u
+                rim = leg.forearm * np.sqrt(np.maximum(0.0, 1.0 - n * n))
+                up = np.where(n >= 0.0, leg.forearm, rim)
+                down = np.where(n <= 0.0, leg.forearm, rim)
+            lo = np.maximum(lo, np.minimum(c0, c1) - down)
+            hi = np.minimum(hi, np.maximum(c0, c1) + up)
         if np.any(lo >= hi):
             return np.zeros(3), np.zeros(3)
         return lo, hi

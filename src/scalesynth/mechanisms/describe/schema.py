@@ -117,14 +117,16 @@ def parse_description(data: Any, where: str = "description") -> Description:
     return desc
 
 
-def load_description(path: str | Path) -> Description:
-    """Read a description file (YAML, the config's safe loader) and validate it."""
+def load_description(path: str | Path, where: str | None = None) -> Description:
+    """Read a description file (YAML, the config's safe loader) and validate it; ``where`` starts error lines
+    (default the file's name)."""
     from scalesynth.yamlfile import MAX_YAML_BYTES, read_limited, safe_yaml
 
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: no such description file")
-    return parse_description(safe_yaml(read_limited(path, MAX_YAML_BYTES), str(path)), path.name)
+    where = where or path.name
+    return parse_description(safe_yaml(read_limited(path, MAX_YAML_BYTES), where), where)
 
 
 def _check(desc: Description) -> None:
@@ -182,8 +184,8 @@ def _check(desc: Description) -> None:
             if option not in desc.options:
                 raise ConfigError(f"{where}.{field}: unknown option {option!r} " + hint(option, desc.options))
             if desc.options[option].kind != kind:
-                raise ConfigError(f"{where}.{field}: option {option!r} is a {desc.options[option].kind}, "
-                                  f"{field} needs a {kind}")
+                raise ConfigError(f"{where}.{field}: option {option!r} is of kind {desc.options[option].kind}, "
+                                  f"{field} needs one of kind {kind}")
         count += leg.pattern.count if leg.pattern else 1
     if desc.motion == "3T" and count != 3:
         raise ConfigError(f"legs: motion 3T needs 3 actuated legs (a square Jacobian), these give {count}")
