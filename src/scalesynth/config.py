@@ -376,7 +376,7 @@ def mechanism_of(value: Any, base_dir: Path | None = None):
     """The mechanism a config's ``mechanism`` names: a registered name, or ``{description: FILE or MAPPING}`` (a
     relative FILE read from ``base_dir``); ConfigError / UnknownMechanism, one line, otherwise."""
     if isinstance(value, dict):
-        from scalesynth.mechanisms.describe import resolve_source
+        from scalesynth.user_mechanisms import resolve_source
 
         return resolve_source(value, base_dir)
     from scalesynth.mechanisms import get
@@ -385,7 +385,7 @@ def mechanism_of(value: Any, base_dir: Path | None = None):
 
 
 def describe_user_mechanism(description):
-    from scalesynth.mechanisms.describe import user_mechanism
+    from scalesynth.user_mechanisms import user_mechanism
 
     return user_mechanism(description)
 

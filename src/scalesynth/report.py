@@ -164,8 +164,9 @@ def plot_front_run(run_dir: Path, out: Path | None = None, fmt: str = "png", for
 def plot_bands_run(run_dir: Path, out: Path | None = None, fmt: str = "png",
                    force: bool = False) -> dict[str, Any]:
     """``plot-bands``: :func:`plot_bands` of a results directory, staged and swapped in like
-    :func:`plot_front_run`, its sections evaluated from config.yaml and pareto.csv read without pandas, once
-    results.load has checked the whole directory (it reports what is wrong, and an invalid --format).
+    :func:`plot_front_run`, its sections evaluated first, from config.yaml and pareto.csv read without pandas
+    (issue 15: a fresh process reaches its first evaluation before the pandas and matplotlib imports and the
+    drawing). Where that read fails, or --format is invalid, results.load reports what is wrong, as before.
     ``files`` and ``band_files`` are where the files are after the swap."""
     from scalesynth.plot_output import figures
 
@@ -174,10 +175,8 @@ def plot_bands_run(run_dir: Path, out: Path | None = None, fmt: str = "png",
         load(run_dir, require_finished=False)  # says what is wrong with the directory
         _check_format(fmt)
     with figures(_figures_dir(run_dir, out), "plot-bands", force, str(run_dir)) as fig:
-        # the whole directory is checked before any kernel runs: a damaged one is refused in one line, with no
-        # compile notice before it
-        result = replace(load(run_dir, require_finished=False), out_dir=fig.root)
         sections = None if front is None else band_sections(front)
+        result = replace(load(run_dir, require_finished=False), out_dir=fig.root)
         info = plot_bands(result, None if fig.into_run else fig.dir, fmt, sections)
     return {**info, "files": [fig.final(f) for f in info["files"]],
             "band_files": [fig.final(f) for f in info["band_files"]]}
