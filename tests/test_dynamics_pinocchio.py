@@ -240,7 +240,9 @@ def _config(name: str) -> dict:
 def test_delta_cycle_forces_match_pinocchio(tmp_path):
     """configs/delta.yaml's design on a pick-and-place loop with dynamics.masses {upper_arm 1.2, forearm 0.6,
     platform 0.5} kg and a 1 kg payload: every sample's force<i> (N m) equals the Pinocchio closed chain's arm
-    torque at the sample's (p, pd, pdd) to 1e-6 relative (to each actuator's peak)."""
+    torque at the sample's (p, pd, pdd) to 1e-6 relative (to each actuator's peak); Pinocchio's arm rates equal
+    cycle.csv's q, qd, qdd. Needs the dynamics section (issue 29) and the Delta's link geometry (cycles refuse a
+    mechanism without it)."""
     data = _config("delta.yaml")
     masses = {"upper_arm": 1.2, "forearm": 0.6, "platform": 0.5}
     data["dynamics"] = {"masses": masses}
@@ -256,6 +258,8 @@ def test_delta_cycle_forces_match_pinocchio(tmp_path):
         t_k, info = pdyn.delta_torques_pinocchio(design, m, p, pd, pdd)
         assert info["gap"] < 1e-12 and info["residual"] < 1e-10
         np.testing.assert_allclose([cols[f"q{i}"][k] for i in (1, 2, 3)], pdyn.delta_ik(design, p), atol=1e-9)
+        np.testing.assert_allclose(info["theta_d"], [cols[f"qd{i}"][k] for i in (1, 2, 3)], rtol=1e-7, atol=1e-9)
+        np.testing.assert_allclose(info["theta_dd"], [cols[f"qdd{i}"][k] for i in (1, 2, 3)], rtol=1e-6, atol=1e-7)
         tau.append(t_k)
     tau = np.array(tau)
     for i in range(3):
