@@ -72,6 +72,7 @@ class LegSpec(_Strict):
     arm_zero: tuple[float, float, float] | None = None
     arm_positive: tuple[float, float, float] | None = None
     rail: tuple[float, float, float] | None = None
+    width: Expr = 0.0  # parallelogram width along its short sides (bodies.py): 0 = one bar on the centre line
 
 
 class Description(_Strict):
@@ -144,6 +145,12 @@ def _check(desc: Description) -> None:
     clash = set(names) & set(desc.options)
     if clash:
         raise ConfigError(f"options.{sorted(clash)[0]}: also a parameter name")
+    from scalesynth.mechanisms.describe.bodies import RESERVED_OPTIONS
+
+    taken = (set(names) | set(desc.options)) & set(RESERVED_OPTIONS)
+    if taken:
+        raise ConfigError(f"options.{sorted(taken)[0]}: every described mechanism has this option (bodies, "
+                          "stiffness): choose another name")
     count = 0
     kinds = set()
     for i, leg in enumerate(desc.legs):
@@ -155,6 +162,7 @@ def _check(desc: Description) -> None:
         for field, values in (("base", leg.base), ("platform", leg.platform)):
             for axis, value in zip("xyz", values, strict=True):
                 _expression(f"{where}.{field}.{axis}", value, names)
+        _expression(f"{where}.width", leg.width, names)
         missing = [k for k in lt.links if k not in leg.links]
         if missing:
             raise ConfigError(f"{where}.links: {lt.name} needs {', '.join(lt.links)} (missing {missing[0]})")
