@@ -30,10 +30,11 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     svd_lci,
 )
-from scalesynth.mechanisms.describe import bodies, expressions
+from scalesynth.mechanisms.describe import bodies, expressions, frame
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
+from scalesynth.stiffness.sections import check_stiffness_options
 
 
 def _turn(phi: float, v) -> np.ndarray:
@@ -91,6 +92,7 @@ class DescribedMechanism(Mechanism):
     # ----- options and packing ------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
         bodies.check_link_radius(options, self._codes())
+        check_stiffness_options(options, 3, frame.link_groups(self._codes()[0] == _k.R_PA))
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":
@@ -208,6 +210,12 @@ class DescribedMechanism(Mechanism):
         qv = self.check_vector("inputs", q, len(self.joints))
         rad = bodies.radii(options, self._codes(), self.default_length_unit)
         return bodies.link_geometry(self.legs(design, options), bodies.widths(self.plans, design), rad, p, qv)
+
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """The stiffness frame (scalesynth.stiffness.FrameModel) at platform centre ``pose`` in the kernel's
+        branch: arms or carriages on actuator springs, each parallelogram as two bars on universal joints, a rigid
+        platform (frame.py); ``joints`` 'bonded' welds the passive universal joints."""
+        return frame.stiffness_model(self, design, options, pose, joints)
 
     # ----- NumPy kinematics ---------------------------------------------------------------------
     def _labels(self) -> list[list[tuple[str, float]]]:
@@ -336,7 +344,8 @@ def from_description(desc: Description) -> DescribedMechanism:
     rotary = lt0.joint_unit == "angle"
     joints = tuple(f"{plan.joint}{i + 1}" for i, plan in enumerate(plans))
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items())
-    options += (Option("link_radius", None, bodies.LINK_RADIUS_DOC),)
+    options += (Option("link_radius", None, bodies.LINK_RADIUS_DOC),
+                *frame.options(desc.stiffness, desc.length_unit, rotary))
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = "J = dx/dq (platform motion per rad of arm rotation)" if rotary else \
         "J = dx/dq (platform motion per unit carriage motion)"

@@ -18,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from scalesynth.errors import ConfigError
 from scalesynth.mechanisms.describe import expressions
+from scalesynth.mechanisms.describe.frame import StiffnessSpec
 from scalesynth.mechanisms.describe.legs import LEG_TYPES
 from scalesynth.names import hint
 
@@ -85,6 +86,7 @@ class Description(_Strict):
     parameters: dict[str, ParameterSpec]
     options: dict[str, OptionSpec] = {}
     legs: list[LegSpec] = Field(min_length=1)
+    stiffness: StiffnessSpec | None = None  # defaults of the stiffness options (frame.py)
 
 
 def _one_line(text: str, limit: int = 200) -> str:
@@ -195,6 +197,9 @@ def _check(desc: Description) -> None:
                 raise ConfigError(f"{where}.{field}: option {option!r} is of kind {desc.options[option].kind}, "
                                   f"{field} needs one of kind {kind}")
         count += leg.pattern.count if leg.pattern else 1
+    from scalesynth.mechanisms.describe.frame import check_spec
+
+    check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].joint_unit == "angle")
     if desc.motion == "3T" and count != 3:
         raise ConfigError(f"legs: motion 3T needs 3 actuated legs (a square Jacobian), these give {count}")
     if len(kinds) > 1:
