@@ -205,6 +205,9 @@ def _check(desc: Description) -> None:
     if len(kinds) > 1:
         raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
                           "yet): use legs of one actuation kind")
+    from scalesynth.mechanisms.describe.mobility_check import check_mobility
+
+    check_mobility(desc)  # the legs make the motion type (a platform that cannot turn, held by its actuators)
 
 
 def _expression(where: str, value: Any, names: list[str]) -> expressions.Expression:
