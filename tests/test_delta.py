@@ -289,7 +289,10 @@ def test_the_builtin_description_file_is_the_registered_delta(tmp_path):
     desc = load_description(BUILTIN_DIR / "delta.yaml")
     assert list(desc.parameters) == list(DELTA.parameter_names) == ["base_radius", "platform_radius", "upper_arm",
                                                                     "forearm"]
-    assert DELTA.option_names == ("theta_limits", "cone_limit")
+    from scalesynth.mechanisms.describe.bodies import RESERVED_OPTIONS
+
+    # the description's options, then those every described mechanism has (bodies, stiffness)
+    assert DELTA.option_names == ("theta_limits", "cone_limit", *RESERVED_OPTIONS)
     bad = tmp_path / "my_delta.yaml"
     bad.write_text((BUILTIN_DIR / "delta.yaml").read_text().replace("base: [base_radius", "base: [base_radiu"))
     with pytest.raises(ConfigError, match=r"^my_delta.yaml: legs\[0\] \(arm\).base.x: unknown param"):

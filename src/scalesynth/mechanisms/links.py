@@ -36,7 +36,8 @@ class Segment:
     """One capsule: the segment a -> b (3 floats each, length unit) swept by a ball of ``radius``.
 
     ``name`` identifies the segment (e.g. 'arm1'), ``body`` the rigid body it belongs to (several segments of
-    one body, e.g. the sides of a platform triangle, share a body name). A zero-length segment is a ball.
+    one body, e.g. the sides of a platform triangle, share a body name), ``group`` the body's kind (the body name
+    without its number). A zero-length segment is a ball.
     """
 
     name: str
@@ -44,6 +45,12 @@ class Segment:
     a: np.ndarray
     b: np.ndarray
     radius: float
+
+    @property
+    def group(self) -> str:
+        """The body's group: its name without a trailing number ('forearm2' -> 'forearm', 'arm1' -> 'arm'), the
+        key a per-group property (mass, section) is given under."""
+        return self.body.rstrip("0123456789")
 
 
 @dataclass(frozen=True)

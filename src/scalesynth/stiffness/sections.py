@@ -24,8 +24,8 @@ from scalesynth.names import hint
 SMALLEST = 1e-12
 # a tube wall below this share of its diameter: d^4 - (d - 2 t)^4 loses all its digits (0 for t < ulp(d))
 MIN_WALL_SHARE = 1e-9
-GPA_TO_N_PER_LENGTH2 = {"mm": 1e3, "m": 1e9}  # 1 GPa = 1e3 N/mm^2 = 1e9 N/m^2
-MM_IN = {"mm": 1.0, "m": 1e-3}
+GPA_TO_N_PER_LENGTH2 = {"mm": 1e3, "cm": 1e5, "dm": 1e7, "m": 1e9}  # 1 GPa = 1e3 N/mm^2 = 1e9 N/m^2
+MM_IN = {"mm": 1.0, "cm": 0.1, "dm": 0.01, "m": 1e-3}
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,7 @@ class Section:
 
 def stiffness_options(length_unit: str, actuator_stiffness: float, actuator_doc: str, load: list[float],
                       load_doc: str) -> tuple[Option, ...]:
-    """The shared stiffness options of a mechanism whose lengths are in ``length_unit`` ('mm' or 'm')."""
+    """The shared stiffness options of a mechanism whose lengths are in ``length_unit`` ('mm', 'cm', 'dm' or 'm')."""
     mm = MM_IN[length_unit]
     return (
         Option("youngs_modulus", 70.0, "stiffness: Young's modulus of every link, GPa (aluminium)"),

@@ -30,10 +30,11 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     svd_lci,
 )
-from scalesynth.mechanisms.describe import expressions
+from scalesynth.mechanisms.describe import bodies, expressions, frame
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
+from scalesynth.stiffness.sections import check_stiffness_options
 
 
 def _turn(phi: float, v) -> np.ndarray:
@@ -56,12 +57,14 @@ class _LegPlan:
     limits: str | None
     cone: str | None
     frame: dict[str, tuple[float, float, float]]
+    width: expressions.Expression | None = None  # the parallelogram's width (bodies.py); None = 0
+    leg_index: int = 0  # index of the description's leg this one comes from (error lines name it)
 
 
 def _plans(desc: Description) -> tuple[_LegPlan, ...]:
     names = list(desc.parameters)
     out = []
-    for leg in desc.legs:
+    for index, leg in enumerate(desc.legs):
         lt = LEG_TYPES[leg.type]
         if leg.pattern:
             phis = [math.radians(leg.pattern.start_deg + 360.0 * k / leg.pattern.count)
@@ -74,7 +77,8 @@ def _plans(desc: Description) -> tuple[_LegPlan, ...]:
                 tuple(expressions.parse(v, names) for v in leg.base),
                 tuple(expressions.parse(v, names) for v in leg.platform),
                 {k: expressions.parse(v, names) for k, v in leg.links.items()},
-                leg.branch or next(iter(lt.branches)), leg.limits, leg.cone, leg_frame(leg)))
+                leg.branch or next(iter(lt.branches)), leg.limits, leg.cone, leg_frame(leg),
+                expressions.parse(leg.width, names), index))
     return tuple(out)
 
 
@@ -87,6 +91,8 @@ class DescribedMechanism(Mechanism):
 
     # ----- options and packing ------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
+        bodies.check_link_radius(options, self._codes())
+        check_stiffness_options(options, 3, frame.link_groups(self._codes()[0] == _k.R_PA))
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":
@@ -192,6 +198,24 @@ class DescribedMechanism(Mechanism):
         if np.any(lo >= hi):
             return np.zeros(3), np.zeros(3)
         return lo, hi
+
+    # ----- bodies (bodies.py) -------------------------------------------------------------------
+    def _codes(self) -> list[float]:
+        return [LEG_TYPES[plan.type].code for plan in self.plans]
+
+    def link_geometry(self, design, options, pose, q):
+        """Capsules of every body at platform centre ``pose`` with joint values ``q`` (bodies.py: upper_arm<i>,
+        rail<i>, carriage<i>, forearm<i> as its parallelogram's bars, base, platform); radii from link_radius."""
+        p = self.check_vector("pose", pose, 3)
+        qv = self.check_vector("inputs", q, len(self.joints))
+        rad = bodies.radii(options, self._codes(), self.default_length_unit)
+        return bodies.link_geometry(self.legs(design, options), bodies.widths(self.plans, design), rad, p, qv)
+
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """The stiffness frame (scalesynth.stiffness.FrameModel) at platform centre ``pose`` in the kernel's
+        branch: arms or carriages on actuator springs, each parallelogram as two bars on universal joints, a rigid
+        platform (frame.py); ``joints`` 'bonded' welds the passive universal joints."""
+        return frame.stiffness_model(self, design, options, pose, joints)
 
     # ----- NumPy kinematics ---------------------------------------------------------------------
     def _labels(self) -> list[list[tuple[str, float]]]:
@@ -320,6 +344,8 @@ def from_description(desc: Description) -> DescribedMechanism:
     rotary = lt0.joint_unit == "angle"
     joints = tuple(f"{plan.joint}{i + 1}" for i, plan in enumerate(plans))
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items())
+    options += (Option("link_radius", None, bodies.LINK_RADIUS_DOC),
+                *frame.options(desc.stiffness, desc.length_unit, rotary))
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = "J = dx/dq (platform motion per rad of arm rotation)" if rotary else \
         "J = dx/dq (platform motion per unit carriage motion)"

@@ -18,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from scalesynth.errors import ConfigError
 from scalesynth.mechanisms.describe import expressions
+from scalesynth.mechanisms.describe.frame import StiffnessSpec
 from scalesynth.mechanisms.describe.legs import LEG_TYPES
 from scalesynth.names import hint
 
@@ -72,6 +73,7 @@ class LegSpec(_Strict):
     arm_zero: tuple[float, float, float] | None = None
     arm_positive: tuple[float, float, float] | None = None
     rail: tuple[float, float, float] | None = None
+    width: Expr = 0.0  # parallelogram width along its short sides (bodies.py): 0 = one bar on the centre line
 
 
 class Description(_Strict):
@@ -84,6 +86,7 @@ class Description(_Strict):
     parameters: dict[str, ParameterSpec]
     options: dict[str, OptionSpec] = {}
     legs: list[LegSpec] = Field(min_length=1)
+    stiffness: StiffnessSpec | None = None  # defaults of the stiffness options (frame.py)
 
 
 def _one_line(text: str, limit: int = 200) -> str:
@@ -144,6 +147,12 @@ def _check(desc: Description) -> None:
     clash = set(names) & set(desc.options)
     if clash:
         raise ConfigError(f"options.{sorted(clash)[0]}: also a parameter name")
+    from scalesynth.mechanisms.describe.bodies import RESERVED_OPTIONS
+
+    taken = (set(names) | set(desc.options)) & set(RESERVED_OPTIONS)
+    if taken:
+        raise ConfigError(f"options.{sorted(taken)[0]}: every described mechanism has this option (bodies, "
+                          "stiffness): choose another name")
     count = 0
     kinds = set()
     for i, leg in enumerate(desc.legs):
@@ -155,6 +164,7 @@ def _check(desc: Description) -> None:
         for field, values in (("base", leg.base), ("platform", leg.platform)):
             for axis, value in zip("xyz", values, strict=True):
                 _expression(f"{where}.{field}.{axis}", value, names)
+        _expression(f"{where}.width", leg.width, names)
         missing = [k for k in lt.links if k not in leg.links]
         if missing:
             raise ConfigError(f"{where}.links: {lt.name} needs {', '.join(lt.links)} (missing {missing[0]})")
@@ -187,11 +197,17 @@ def _check(desc: Description) -> None:
                 raise ConfigError(f"{where}.{field}: option {option!r} is of kind {desc.options[option].kind}, "
                                   f"{field} needs one of kind {kind}")
         count += leg.pattern.count if leg.pattern else 1
+    from scalesynth.mechanisms.describe.frame import check_spec
+
+    check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].joint_unit == "angle")
     if desc.motion == "3T" and count != 3:
         raise ConfigError(f"legs: motion 3T needs 3 actuated legs (a square Jacobian), these give {count}")
     if len(kinds) > 1:
         raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
                           "yet): use legs of one actuation kind")
+    from scalesynth.mechanisms.describe.mobility_check import check_mobility
+
+    check_mobility(desc)  # the legs make the motion type (a platform that cannot turn, held by its actuators)
 
 
 def _expression(where: str, value: Any, names: list[str]) -> expressions.Expression:

@@ -1,0 +1,156 @@
+"""The bodies of a described mechanism, derived from its description alone: link capsules (clearance, the robot
+drawing, cycles) and the names the dynamics and the stiffness frame share (docs/describing.md, "Bodies").
+
+Per leg i (1-based, in the order of the expanded legs), with E the elbow (R-Pa) or carriage point (P-Pa) at the
+joint value, Q = P + r_p the platform joint, n the normal of the leg's plane (R-Pa: the actuated axis u x w; P-Pa:
+the carriage's cross direction) and h half the leg's parallelogram ``width``:
+
+* ``upper_arm<i>`` (R-Pa): the arm B -> E, and with a width the elbow's short side E - h n -> E + h n;
+* ``rail<i>`` (P-Pa): the rail B + lo e -> B + hi e over the stroke; ``carriage<i>``: its short side
+  E - h n -> E + h n (a ball at E without a width);
+* ``forearm<i>``: the parallelogram's two long bars E +- h n -> Q +- h n (one bar E -> Q on the centre line
+  when the width is 0), one body: the bars of one parallelogram are never checked against each other;
+* ``base``: the closed polygon through the legs' base points B_i; ``platform``: the closed polygon through the
+  platform joints Q_i +- h n_i, in angular order about P.
+
+A body's *group* is its name without the leg number (``Segment.group``): upper_arm, forearm, carriage, rail,
+base, platform. Adjacent (sharing a joint): base-upper_arm, upper_arm-forearm, base-rail, rail-carriage,
+carriage-forearm, forearm-platform, and rail-forearm of one leg: the model puts the carriage's joint on the
+rail's line, so that pair would always touch.
+
+Capsule radii: option ``link_radius`` (a number, or a mapping of groups or bodies to radii, a body's entry
+winning over its group's), defaults DEFAULT_RADII_M in metres, converted to the description's length unit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from scalesynth.errors import InvalidParameter
+from scalesynth.mechanisms import links
+from scalesynth.mechanisms.describe import kernel as _k
+
+# capsule radii (m) when link_radius does not give them: illustrative, a mid-size Delta's
+DEFAULT_RADII_M = {"base": 0.04, "upper_arm": 0.025, "forearm": 0.01, "platform": 0.02, "rail": 0.02,
+                   "carriage": 0.03}
+UNITS_PER_M = {"m": 1.0, "dm": 10.0, "cm": 100.0, "mm": 1000.0}
+LINK_RADIUS_DOC = ("capsule radius of every body, or {group or body: radius} (groups upper_arm, forearm, carriage, "
+                   "rail, base, platform); null = defaults (docs/describing.md)")
+# options every described mechanism has, whatever its description declares (schema refuses them as names)
+RESERVED_OPTIONS = ("link_radius", "youngs_modulus", "poisson_ratio", "tube", "sections", "actuator_stiffness", "load")
+
+
+def leg_bodies(code: float, i: int) -> tuple[str, ...]:
+    """The moving bodies of leg i (1-based) of leg type ``code`` (kernel codes), base side first."""
+    if code == _k.R_PA:
+        return (f"upper_arm{i}", f"forearm{i}")
+    return (f"rail{i}", f"carriage{i}", f"forearm{i}")
+
+
+def body_names(codes: Sequence[float]) -> tuple[str, ...]:
+    """Every body of a mechanism whose legs have these type codes, in link_geometry's order."""
+    out = ["base"]
+    for i, code in enumerate(codes, 1):
+        out += leg_bodies(code, i)
+    return tuple(out) + ("platform",)
+
+
+def group_of(body: str) -> str:
+    """The group of a body name: the name without its trailing leg number ('forearm2' -> 'forearm')."""
+    return body.rstrip("0123456789")
+
+
+def check_link_radius(options: dict[str, Any], codes: Sequence[float]) -> None:
+    """Validate options['link_radius'] against the bodies and their groups; InvalidParameter naming the entry."""
+    bodies = body_names(codes)
+    links.check_radius_option(options, tuple(dict.fromkeys(tuple(map(group_of, bodies)) + bodies)))
+
+
+def radii(options: Mapping[str, Any], codes: Sequence[float], length_unit: str) -> dict[str, float]:
+    """Capsule radius per body (length unit): the defaults, then link_radius's groups, then its bodies."""
+    scale = UNITS_PER_M[length_unit]
+    bodies = body_names(codes)
+    value = options.get("link_radius")
+    out = {b: DEFAULT_RADII_M[group_of(b)] * scale for b in bodies}
+    if value is None:
+        return out
+    if not isinstance(value, Mapping):
+        return {b: float(value) for b in bodies}
+    for b in bodies:
+        if group_of(b) in value:
+            out[b] = float(value[group_of(b)])
+    for b in bodies:
+        if b in value:
+            out[b] = float(value[b])
+    return out
+
+
+def link_geometry(legs, widths: Sequence[float], rad: Mapping[str, float], pose, q) -> links.LinkGeometry:
+    """Capsules and adjacency at platform centre ``pose`` with joint values ``q`` (module docstring). ``legs``:
+    the resolved legs (legs.Leg), ``widths``: each leg's parallelogram width, ``rad``: radius per body."""
+    p = np.asarray(pose, dtype=float)
+    segs: list[links.Segment] = []
+    pairs: list[tuple[str, str]] = []
+    base_pts, plat_pts = [], []
+
+    def seg(name, body, a, b):
+        segs.append(links.Segment(name, body, np.asarray(a, dtype=float), np.asarray(b, dtype=float), rad[body]))
+
+    for i, (leg, w, qi) in enumerate(zip(legs, widths, q, strict=True), 1):
+        h = 0.5 * float(w)
+        e = leg.actuated_point(float(qi))
+        j = p + leg.platform
+        side = h * leg.normal
+        base_pts.append(leg.base)
+        plat_pts += [j - side, j + side] if h > 0.0 else [j]
+        if leg.type.code == _k.R_PA:
+            seg(f"upper_arm{i}", f"upper_arm{i}", leg.base, e)
+            if h > 0.0:
+                seg(f"elbow{i}", f"upper_arm{i}", e - side, e + side)
+            pairs += [("base", f"upper_arm{i}"), (f"upper_arm{i}", f"forearm{i}")]
+        else:
+            lo, hi = leg.limits
+            seg(f"rail{i}", f"rail{i}", leg.base + lo * leg.u, leg.base + hi * leg.u)
+            seg(f"carriage{i}", f"carriage{i}", e - side, e + side)
+            pairs += [("base", f"rail{i}"), (f"rail{i}", f"carriage{i}"), (f"carriage{i}", f"forearm{i}"),
+                      (f"rail{i}", f"forearm{i}")]
+        if h > 0.0:
+            seg(f"forearm{i}a", f"forearm{i}", e + side, j + side)
+            seg(f"forearm{i}b", f"forearm{i}", e - side, j - side)
+        else:
+            seg(f"forearm{i}", f"forearm{i}", e, j)
+        pairs.append((f"forearm{i}", "platform"))
+    for k, (a, b) in enumerate(_ring(base_pts, np.mean(base_pts, axis=0)), 1):
+        seg(f"base{k}", "base", a, b)
+    for k, (a, b) in enumerate(_ring(plat_pts, p), 1):
+        seg(f"platform{k}", "platform", a, b)
+    order = {b: n for n, b in enumerate(body_names([leg.type.code for leg in legs]))}
+    segs.sort(key=lambda s: order[s.body])  # stable: a body's segments stay in the order written
+    return links.LinkGeometry(tuple(segs), links.adjacency(pairs))
+
+
+def _ring(points, centre) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Sides of the closed polygon through ``points`` in angular order about ``centre`` (xy-plane angle); one point
+    gives one ball, two points one side."""
+    pts = [np.asarray(v, dtype=float) for v in points]
+    if len(pts) == 1:
+        return [(pts[0], pts[0])]
+    pts.sort(key=lambda v: math.atan2(v[1] - centre[1], v[0] - centre[0]))
+    if len(pts) == 2:
+        return [(pts[0], pts[1])]
+    return [(pts[k], pts[(k + 1) % len(pts)]) for k in range(len(pts))]
+
+
+def widths(plans, design: Mapping[str, float]) -> list[float]:
+    """Each leg's parallelogram width (length unit) from its expression; InvalidParameter if negative."""
+    out = []
+    for i, plan in enumerate(plans, 1):
+        w = 0.0 if plan.width is None else float(plan.width.value(design))
+        if not (math.isfinite(w) and w >= 0.0):
+            raise InvalidParameter(f"design: leg {i} width = {w:g}, must be >= 0")
+        out.append(w)
+    return out
