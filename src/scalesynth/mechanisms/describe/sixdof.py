@@ -21,6 +21,7 @@ import numpy as np
 
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.mechanisms.base import (
+    MAX_MAGNITUDE,
     DesignMetric,
     Option,
     Parameter,
@@ -107,11 +108,12 @@ class Leg6:
     def roots(self, pose, rot: np.ndarray) -> dict[float, float]:
         """Every IK root {branch: q} at platform centre ``pose`` and orientation ``rot`` (limits not applied); {} out
         of reach. RUS: q = atan2(B, A) -+ acos(K / sqrt(A^2 + B^2)), branch +1 the one with the larger cos q; UPS:
-        q = |Q - B| (0 counts as out of reach: no direction)."""
+        q = |Q - B| (0 counts as out of reach: no direction; so does a leg longer than MAX_MAGNITUDE, which no
+        joint value may be)."""
         d = np.asarray(pose, dtype=float) + rot @ self.r - self.base
         if not self.rus:
             q = float(np.linalg.norm(d))
-            return {1.0: q} if q > 0.0 else {}
+            return {1.0: q} if 0.0 < q <= MAX_MAGNITUDE else {}
         a = 2.0 * self.arm * float(d @ self.u)
         b = 2.0 * self.arm * float(d @ self.w)
         k = float(d @ d) + self.arm ** 2 - self.rod ** 2
