@@ -163,9 +163,35 @@ def _described(mech, design, options):
     return Linkage([bases], joints, links, (p, "P"), [f"pose P = {pose} m, {mode}"])
 
 
+def _described_6dof(mech, design, options):
+    """A described 6-DOF mechanism (describe/sixdof.py) at its nominal pose, the platform level: a hexapod's legs
+    from base to platform joint (each labelled with its length q_i), a Hexa's arms to their elbows and rods on to
+    the platform joints."""
+    pose = (0.0, 0.0, 0.8) if mech.name == "hexapod" else (0.0, 0.0, -0.6)
+    q = _solution(mech, design, options, pose)
+    p = np.array(pose)
+    rot = mech.rotation(options)
+    legs = mech.legs(design, options)
+    bases = np.array([leg.base for leg in legs])
+    joints = np.array([p + rot @ leg.r for leg in legs])
+    links = []
+    for i, (leg, qi, joint) in enumerate(zip(legs, q, joints, strict=True)):
+        if leg.rus:
+            elbow = leg.actuated_point(qi)
+            links += [(leg.base, elbow, f"arm, {mech.joints[i]}"), (elbow, joint, "rod")]
+        else:
+            links.append((leg.base, joint, mech.joints[i]))
+    # the platform polygon in the order of the joints around it
+    order = np.argsort(np.arctan2(joints[:, 1] - p[1], joints[:, 0] - p[0]))
+    border = np.argsort(np.arctan2(bases[:, 1], bases[:, 0]))
+    return Linkage([bases[border]], joints[order], links, (p, "P"), [f"pose P = {pose} m, platform level"])
+
+
 LINKAGES = {
     "delta": _described,
     "linear-delta": _described,
+    "hexa": _described_6dof,
+    "hexapod": _described_6dof,
     "2pauu-ppap": _pauu,
     "planar-fivebar": _fivebar,
     "pprs-rprs": _pprs,

@@ -104,6 +104,11 @@ def _expected_lengths(name, mech, design, options):
         (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, -1.0))
                 if s.label == "near/near/near"]
         return {**{f"carriage, s{i}": q[i - 1] for i in (1, 2, 3)}, "forearm": design["forearm"]}
+    if name == "hexapod":  # each leg labelled with its joint: its length q_i by the IK at the drawn pose
+        (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, 0.8))]
+        return {f"q{i}": q[i - 1] for i in range(1, 7)}
+    if name == "hexa":  # each arm labelled with its joint, the six rods alike
+        return {**{f"arm, theta{i}": design["arm"] for i in range(1, 7)}, "rod": design["rod"]}
     raise AssertionError(f"no expected lengths for {name}")
 
 

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from naive_delta import delta_fields, linear_delta_fields
+from naive_sixdof import hexa_fields, hexapod_fields
 from scalesynth.config import load_config
 from scalesynth.evaluate import evaluate_config, make_grid
 from scalesynth.kernels import grid as kgrid
@@ -26,6 +27,8 @@ from naive import (
 TWINS = {
     "2pauu-ppap": pauu_fields,
     "delta": delta_fields,
+    "hexa": hexa_fields,
+    "hexapod": hexapod_fields,
     "linear-delta": linear_delta_fields,
     "planar-fivebar": lambda d, o, x, y, z: fivebar_fields(d, o, x, y),
     "pprs-rprs": pprs_fields,

@@ -56,8 +56,8 @@ def test_metrics_command_lists_every_metric_of_the_fivebar_as_json():
         assert name in by_name
     text = cli("metrics")
     assert text.returncode == 0 and "link_length_sum" in text.stdout and "stroke_d" in text.stdout
-    bad = cli("metrics", "hexapod")
-    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "unknown mechanism 'hexapod'" in bad.stderr
+    bad = cli("metrics", "no-such-robot")
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "unknown mechanism 'no-such-robot'" in bad.stderr
 
 
 def test_docs_metrics_md_is_generated_from_the_catalogue():

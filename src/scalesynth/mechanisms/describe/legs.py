@@ -8,6 +8,11 @@ mechanism frame, what ``DescribedMechanism.pack`` writes into the kernel's block
   universal joints keep the platform's orientation: the rotary Delta's leg (RUU / RSS). Joint: the arm angle (rad).
 * ``P-Pa``: a carriage on a straight rail carrying a parallelogram forearm: the linear Delta's leg (PUU / PSS).
   Joint: the carriage position along the rail (length).
+* ``RUS`` (alias ``R-SS``), motion 6DOF: a rotary actuated arm (``arm``) carrying one rod (``rod``) with a
+  spherical or universal joint at each end: the Hexa's leg. Joint: the arm angle (rad). Its NumPy twin and the rest
+  of the 6-DOF kinematics are in sixdof.py, its kernel in kernel6.py.
+* ``UPS`` (alias ``SPS``), motion 6DOF: a prismatic leg of variable length between a base joint and a platform
+  joint: the hexapod's (Gough-Stewart) leg. Joint: the leg length (length).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from scalesynth.mechanisms.describe import kernel as _k
+from scalesynth.mechanisms.describe import kernel6 as _k6
 
 
 @dataclass(frozen=True)
@@ -32,6 +38,7 @@ class LegType:
     links: tuple[str, ...]  # link lengths a leg of this type needs
     branches: dict[str, float]  # working-mode name -> the kernel's BRANCH value; the first is the default
     frame: dict[str, tuple[float, float, float]]  # direction fields a description may set, with their defaults
+    motion: str = "3T"  # the motion type whose kernel template handles the leg
 
 
 LEG_TYPES: dict[str, LegType] = {
@@ -45,6 +52,16 @@ LEG_TYPES: dict[str, LegType] = {
         ("forearm",), {"far": 1.0, "near": -1.0}, {"rail": (0.0, 0.0, 1.0)},
     ),
 }
+_RUS = dict(joint="theta", joint_unit="angle", links=("arm", "rod"), branches={"out": 1.0, "in": -1.0},
+            frame={"arm_zero": (1.0, 0.0, 0.0), "arm_positive": (0.0, 0.0, -1.0)}, motion="6DOF")
+_UPS = dict(joint="q", joint_unit="length", links=(), branches={"one": 1.0}, frame={"cone_axis": (0.0, 0.0, 1.0)},
+            motion="6DOF")
+for _name, _doc, _kw in (
+        ("RUS", "rotary arm + one rod with a spherical/universal joint at each end (Hexa leg)", _RUS),
+        ("R-SS", "RUS with a spherical joint at each end of the rod (same kinematics)", _RUS),
+        ("UPS", "prismatic leg of variable length between a base and a platform joint (hexapod leg)", _UPS),
+        ("SPS", "UPS with a spherical base joint (same kinematics)", _UPS)):
+    LEG_TYPES[_name] = LegType(_name, _k6.RUS if _kw is _RUS else _k6.UPS, _doc, **_kw)
 
 
 @dataclass(frozen=True)

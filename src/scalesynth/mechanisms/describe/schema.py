@@ -23,7 +23,8 @@ from scalesynth.mechanisms.describe.legs import LEG_TYPES
 from scalesynth.names import hint
 
 Expr = float | str
-MOTIONS = ("3T",)  # motion types the kernel template handles so far
+MOTIONS = ("3T", "6DOF")  # motion types a kernel template handles (kernel.py, kernel6.py)
+LEG_COUNT = {"3T": 3, "6DOF": 6}  # actuated legs each motion needs (a square Jacobian)
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
 
@@ -66,7 +67,7 @@ class LegSpec(_Strict):
     angle_deg: float = 0.0  # a single leg's turn about z (with pattern: use pattern.start_deg)
     base: tuple[Expr, Expr, Expr]
     platform: tuple[Expr, Expr, Expr]
-    links: dict[str, Expr]
+    links: dict[str, Expr] = {}  # a UPS leg has none
     branch: str | None = None
     limits: str | None = None  # name of a 'range' option
     cone: str | None = None  # name of an 'angle' option
@@ -74,6 +75,7 @@ class LegSpec(_Strict):
     arm_positive: tuple[float, float, float] | None = None
     rail: tuple[float, float, float] | None = None
     width: Expr = 0.0  # parallelogram width along its short sides (bodies.py): 0 = one bar on the centre line
+    cone_axis: tuple[float, float, float] | None = None  # UPS: the joints' cone axis (base frame; platform frame)
 
 
 class Description(_Strict):
@@ -160,6 +162,10 @@ def _check(desc: Description) -> None:
         lt = LEG_TYPES.get(leg.type)
         if lt is None:
             raise ConfigError(f"{where}.type: unknown leg type {leg.type!r} " + hint(leg.type, LEG_TYPES, "library"))
+        if lt.motion != desc.motion:
+            raise ConfigError(f"{where}.type: a {lt.name} leg makes motion {lt.motion}, not {desc.motion} "
+                              + hint(leg.type, [k for k, v in LEG_TYPES.items() if v.motion == desc.motion],
+                                     f"{desc.motion} legs"))
         kinds.add(lt.joint_unit)
         for field, values in (("base", leg.base), ("platform", leg.platform)):
             for axis, value in zip("xyz", values, strict=True):
@@ -175,7 +181,7 @@ def _check(desc: Description) -> None:
         if leg.branch is not None and leg.branch not in lt.branches:
             raise ConfigError(f"{where}.branch: {leg.branch!r} is not a branch of {lt.name} "
                               + hint(leg.branch, lt.branches, "branches"))
-        for field in ("arm_zero", "arm_positive", "rail"):
+        for field in ("arm_zero", "arm_positive", "rail", "cone_axis"):
             value = getattr(leg, field)
             if value is not None and field not in lt.frame:
                 raise ConfigError(f"{where}.{field}: {lt.name} has no {field} " + hint(field, lt.frame, "frame"))
@@ -183,7 +189,7 @@ def _check(desc: Description) -> None:
         for field, vec in frame.items():
             if not 0.5 < math.sqrt(sum(v * v for v in vec)) < 2.0:
                 raise ConfigError(f"{where}.{field}: expected a unit vector, got {list(vec)}")
-        if lt.name == "R-Pa":
+        if "arm_zero" in frame:
             u, w = frame["arm_zero"], frame["arm_positive"]
             if abs(sum(a * b for a, b in zip(u, w, strict=True))) > 1e-9:
                 raise ConfigError(f"{where}.arm_positive: must be perpendicular to arm_zero")
@@ -200,8 +206,10 @@ def _check(desc: Description) -> None:
     from scalesynth.mechanisms.describe.frame import check_spec
 
     check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].joint_unit == "angle")
-    if desc.motion == "3T" and count != 3:
-        raise ConfigError(f"legs: motion 3T needs 3 actuated legs (a square Jacobian), these give {count}")
+    need = LEG_COUNT[desc.motion]
+    if count != need:
+        raise ConfigError(f"legs: motion {desc.motion} needs {need} actuated legs (a square Jacobian), these give "
+                          f"{count}")
     if len(kinds) > 1:
         raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
                           "yet): use legs of one actuation kind")
