@@ -40,6 +40,7 @@ import numpy as np
 from scalesynth.cycle import config as ccfg
 from scalesynth.cycle import trajectory
 from scalesynth.cycle.clearance import clearance
+from scalesynth.dynamics.inverse import link_forces
 from scalesynth.errors import InvalidPose, ScalesynthError
 from scalesynth.mechanisms.base import Mechanism, wrap_angle
 
@@ -244,6 +245,9 @@ def analyse(
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     vel, acc, jc = _payload_motion(mech, design, options, traj, size)
     force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
+    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, label, size,
+                                                   si_velocity_map(mech, A, length_unit), length_unit)
+    force, force_gravity, task_force = force + links, force_gravity + links_gravity, task_force + links_task
     gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)
     at = int(np.argmin(gaps))
     return CycleResult(

@@ -24,7 +24,7 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
 
 from scalesynth.cycle.trajectory import LAWS
 from scalesynth.names import hint
@@ -65,6 +65,10 @@ class CycleConfig(BaseModel):
     samples: int = Field(400, ge=8, le=100_000, description="time intervals over one cycle")
     speed_limits: float | list[float] | None = None
     force_limits: float | list[float] | None = None
+    dwell_s: float = Field(0.0, ge=0.0, le=3600.0, description="s at rest at pick and at place (motors' cycle time)")
+    # the run config's dynamics and motors sections (RunConfig attaches them; None: tube links, no motors)
+    _dynamics: Any = PrivateAttr(None)
+    _motors: Any = PrivateAttr(None)
 
     @field_validator("path")
     @classmethod
