@@ -321,6 +321,7 @@ class RunConfig(_Strict):
         if self.cycle is not None:  # the cycle analysis reads the mass model and motors from its cycle
             self.cycle._dynamics = self.dynamics
             self.cycle._motors = self.motors
+            self.cycle._base_dir = base_dir
         self._check_metrics(mech)
         axes = ", ".join(mech.task_axes)
         for axis in self.grid.region or {}:

@@ -69,6 +69,7 @@ class CycleConfig(BaseModel):
     # the run config's dynamics and motors sections (RunConfig attaches them; None: tube links, no motors)
     _dynamics: Any = PrivateAttr(None)
     _motors: Any = PrivateAttr(None)
+    _base_dir: Any = PrivateAttr(None)  # where a relative motors.catalogue is read from
 
     @field_validator("path")
     @classmethod
@@ -286,6 +287,11 @@ CYCLE_METRICS = (
     "cycle_min_clearance",
     "cycle_max_deflection",
     "max_cycles_per_minute",
+    "picks_per_minute",
+    "cycle_time_s",
+    "motor_peak_torque_ratio",
+    "motor_rms_torque_ratio",
+    "motor_speed_ratio",
 )
 
 

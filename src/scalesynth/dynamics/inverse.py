@@ -121,4 +121,9 @@ def link_forces(mech, design, options, cyc, traj, label: str, size: float, A_si:
         return np.zeros((n, nj)), np.zeros((n, nj)), np.zeros((n, k))
     _, jac, _, acc = endpoint_motion(mech, design, options, traj.p, traj.pd, traj.pdd, label, size)
     F, F_g = generalised_forces(mech, jac, acc, masses, frame_gravity(cyc, mech), length_unit)
+    if not np.all(np.isfinite(F)):
+        from scalesynth.errors import InvalidPose
+
+        raise InvalidPose("cycle: a sample lies on the boundary of the workspace (the links' motion is not defined "
+                          "around it)")
     return actuator_forces(mech, A_si, F), actuator_forces(mech, A_si, F_g), F

@@ -187,3 +187,48 @@ def rest_samples(traj, preset: str | None) -> tuple[int, ...]:
     place = 3 if preset == "adept" and len(verts) == 6 else int(np.argmax(np.linalg.norm(verts - verts[0], axis=1)))
     at = [int(np.argmin(np.abs(traj.t - traj.vertex_times[k]))) for k in (0, place)]
     return tuple(at)
+
+
+MOTOR_METRICS = ("picks_per_minute", "cycle_time_s", "motor_peak_torque_ratio", "motor_rms_torque_ratio",
+                 "motor_speed_ratio")
+CYCLE_TIME_PENALTY = 1e12  # s: the cycle time of a design whose motors cannot run the cycle
+
+
+def cycle_motor_metrics(motors: Motors, traj, cyc, joint_units, length_unit: str, qd, qdd, force, force_gravity):
+    """The motor metrics of D designs (arrays (D, n, nj): qd, qdd in joint units per s, s^2; force, force_gravity
+    SI) -> (name -> (D,), binding limit (D,)): picks_per_minute and cycle_time_s (the shortest period within every
+    limit, plus the dwell), and at the configured rate the peak motor torque / peak_torque, the RMS motor torque
+    (motion and dwell) / rated_torque and the peak motor speed / max_speed."""
+    js = joint_si(joint_units, length_unit)
+    speed, g, a = motor_side(motors, qd * js, qdd * js, force, force_gravity)
+    w = time_weights(traj.t)
+    rest = rest_samples(traj, cyc.preset)
+    period = traj.period
+    dwell = 2.0 * cyc.dwell_s
+    s, binding = rate_limits(motors, speed, g, a, w, period, dwell, rest)
+    with np.errstate(divide="ignore"):
+        cycle_time = np.where(s > 0, period / np.where(s > 0, s, 1.0) + dwell, CYCLE_TIME_PENALTY)
+    g_rest2 = np.mean(g[:, list(rest)] ** 2, axis=1)
+    rms = np.sqrt(_rms2(g, a, w, np.ones(len(s)), dwell / period, g_rest2))
+    out = {
+        "picks_per_minute": np.where(s > 0, 60.0 / cycle_time, 0.0),
+        "cycle_time_s": np.minimum(cycle_time, CYCLE_TIME_PENALTY),
+        "motor_peak_torque_ratio": np.max(np.abs(g + a) / motors.peak_torque, axis=(1, 2)),
+        "motor_rms_torque_ratio": np.max(rms / motors.rated_torque, axis=1),
+        "motor_speed_ratio": np.max(np.abs(speed) / motors.max_speed, axis=(1, 2)),
+    }
+    return out, binding
+
+
+def failed_motor_metrics() -> dict[str, float]:
+    """Motor metrics of a cycle that cannot be followed."""
+    return {"picks_per_minute": 0.0, "cycle_time_s": CYCLE_TIME_PENALTY, "motor_peak_torque_ratio": CYCLE_TIME_PENALTY,
+            "motor_rms_torque_ratio": CYCLE_TIME_PENALTY, "motor_speed_ratio": CYCLE_TIME_PENALTY}
+
+
+def of_cycle(cyc, n_joints: int) -> Motors | None:
+    """The resolved motors attached to a cycle config (None without a motors section)."""
+    cfg = getattr(cyc, "_motors", None)
+    if cfg is None:
+        return None
+    return resolve(cfg, n_joints, getattr(cyc, "_base_dir", None))
