@@ -17,6 +17,7 @@ from scalesynth.config import load_config
 from scalesynth.cycle import analysis, trajectory
 from scalesynth.cycle.clearance import clearance, segment_distance
 from scalesynth.cycle.config import METRES_PER_UNIT
+from scalesynth.dynamics.config import DynamicsConfig
 from scalesynth.mechanisms.base import wrap_angle
 
 from conftest import ROOT
@@ -32,9 +33,12 @@ CASES = {"planar-fivebar": FIVEBAR, "pprs-rprs": PPRS, "2pauu-ppap": SEED000, "r
 CYCLE_CONFIGS = sorted(p.name for p in (ROOT / "configs").glob("*.yaml") if "cycle" in yaml.safe_load(p.read_text()))
 
 
-def run(cfg, **changes):
-    """The config's cycle with changes (100 time intervals unless given: enough for every check, fast)."""
+def run(cfg, massless=False, **changes):
+    """The config's cycle with changes (100 time intervals unless given: enough for every check, fast);
+    ``massless``: links without mass (dynamics.masses: {}), the payload alone."""
     cyc = cfg.cycle.model_copy(update={"samples": 100, **changes})
+    if massless:
+        cyc._dynamics = DynamicsConfig(masses={})
     return analysis.analyse(cfg.mech, cfg.resolved_design(), cfg.resolved_options(), cyc, cfg.units.length)
 
 
@@ -118,7 +122,7 @@ def test_power_balance_at_every_sample(name):
     cfg = CASES[name]
     cartesian = all(u == "length" for u in cfg.mech.task_units)
     gravity = [1.0, -3.0, -9.0][-len(cfg.mech.task_axes):] if cartesian else [1.0, -3.0, -9.0]
-    res = run(cfg, payload=2.5, gravity=gravity)
+    res = run(cfg, massless=True, payload=2.5, gravity=gravity)  # links with mass: tests/test_dynamics.py
     m = METRES_PER_UNIT[cfg.units.length]
     joint_si = np.array([m if u == "length" else 1.0 for u in cfg.mech.joint_units])
     task_si = np.array([m if u == "length" else 1.0 for u in cfg.mech.task_units])
@@ -131,7 +135,8 @@ def test_power_balance_at_every_sample(name):
     if cartesian:  # F = m (a - g) exactly
         np.testing.assert_allclose(res.task_force, 2.5 * (res.traj.pdd * m - res.gravity), rtol=1e-12)
     # the gravity part of the forces: what the actuators exert holding the payload still at the same poses
-    still = run(cfg, payload=2.5, gravity=gravity, cycles_per_minute=1e-6 * cfg.cycle.cycles_per_minute)
+    still = run(cfg, massless=True, payload=2.5, gravity=gravity,
+                cycles_per_minute=1e-6 * cfg.cycle.cycles_per_minute)
     np.testing.assert_allclose(res.force_gravity, still.force, rtol=0, atol=1e-6 * np.abs(res.force).max())
 
 
@@ -147,7 +152,9 @@ def test_doubling_the_rate_doubles_speeds_and_quadruples_accelerations(name):
     # inertial forces quadruple, gravity's part stays: tau(2x) - tau_g = 4 (tau(1x) - tau_g)
     tau_g = slow.force_gravity
     if all(u == "length" for u in cfg.mech.task_units):
-        np.testing.assert_allclose(tau_g, np.einsum("nik,k->ni", slow.force_map, -slow.payload * slow.gravity))
+        bare = run(cfg, massless=True)  # the payload's weight alone (the links' own: tests/test_dynamics.py)
+        np.testing.assert_allclose(bare.force_gravity, np.einsum("nik,k->ni", bare.force_map,
+                                                                 -bare.payload * bare.gravity))
     np.testing.assert_allclose(fast.force - tau_g, 4 * (slow.force - tau_g), rtol=1e-6,
                                atol=1e-6 * np.abs(slow.force).max())
 
@@ -446,7 +453,7 @@ def test_rps_upu_cycle_in_mixed_task_axes(tmp_path):
     """rps-upu's task axes are (z, theta, psi); the payload sits at O' = (0, 0, z) in the P-model, so the generalised
     force is exactly (m (z_ddot - g_z), 0, 0): N along z, no torque about the angles (a point mass on the rotation
     axes). The command writes its cycle with mm and rad columns."""
-    res = run(RPS, samples=100)
+    res = run(RPS, massless=True, samples=100)  # the payload's force alone
     m = 1e-3
     np.testing.assert_allclose(res.task_force[:, 0], RPS.cycle.payload * (res.traj.pdd[:, 0] * m + 9.80665),
                                rtol=1e-9)
@@ -492,8 +499,9 @@ def test_cycle_runs_on_the_configs_with_a_cycle(tmp_path, config):
     assert json.loads(cli.stdout)["metrics"] == pytest.approx(m, rel=1e-12)
     lu = METRES_PER_UNIT[cfg.units.length]
     joint_si = np.array([lu if u == "length" else 1.0 for u in cfg.mech.joint_units])
-    payload = cfg.cycle.payload * (res.payload_accel * lu - res.gravity) * res.payload_velocity * lu
-    np.testing.assert_allclose(np.sum(res.force * res.qd * joint_si, axis=1), payload.sum(axis=1), atol=1e-9)
+    bare = run(cfg, massless=True, samples=60)  # the payload alone (with the links: tests/test_dynamics.py)
+    payload = cfg.cycle.payload * (bare.payload_accel * lu - bare.gravity) * bare.payload_velocity * lu
+    np.testing.assert_allclose(np.sum(bare.force * bare.qd * joint_si, axis=1), payload.sum(axis=1), atol=1e-9)
 
 
 def test_pprs_rail_input_follows_x_exactly():

@@ -27,6 +27,7 @@ from pydantic import (
 )
 
 from scalesynth.cycle import config as cycle_config
+from scalesynth.dynamics import config as dynamics_config
 from scalesynth.errors import ConfigError, ScalesynthError
 from scalesynth.names import hint
 from scalesynth.yamlfile import MAX_YAML_BYTES, _quote, read_limited, safe_yaml  # noqa: F401 (re-exported)
@@ -224,6 +225,8 @@ class RunConfig(_Strict):
     dexterity: DexterityConfig = Field(default_factory=DexterityConfig)
     task: TaskConfig | None = None
     cycle: cycle_config.CycleConfig | None = Field(None, description="pick-and-place cycle (scalesynth.cycle)")
+    dynamics: dynamics_config.DynamicsConfig | None = Field(None, description="mass model of the links (cycles)")
+    motors: dynamics_config.MotorsConfig | None = Field(None, description="motors and gears of the actuators")
     references: dict[str, dict[str, float]] = Field(
         default_factory=dict, description="labelled designs re-evaluated and drawn beside the front (e.g. a paper's)"
     )
@@ -235,6 +238,15 @@ class RunConfig(_Strict):
     output: OutputConfig = Field(default_factory=OutputConfig)
     _mech: Any = PrivateAttr(None)  # cfg.mech, found again after unpickling (mechanisms hold unpicklable lambdas)
     _description: Any = PrivateAttr(None)  # a user's description: dumped inline, so a dump reloads it
+
+    @model_serializer(mode="wrap")
+    def _dump_without_unset_sections(self, handler):
+        # dynamics and motors appear in a dump only when given (dumps of older configs stay as they were)
+        data = handler(self)
+        for key in ("dynamics", "motors"):
+            if data.get(key, 0) is None:
+                data.pop(key)
+        return data
 
     @field_serializer("mechanism")
     def _mechanism_out(self, value):
@@ -306,6 +318,10 @@ class RunConfig(_Strict):
                 raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} " + hint(str(key), params))
             if params[key].positive and lo <= 0:
                 raise ValueError(f"bounds.{key}: lower bound must be > 0 for a length, got {lo}")
+        if self.cycle is not None:  # the cycle analysis reads the mass model and motors from its cycle
+            self.cycle._dynamics = self.dynamics
+            self.cycle._motors = self.motors
+            self.cycle._base_dir = base_dir
         self._check_metrics(mech)
         axes = ", ".join(mech.task_axes)
         for axis in self.grid.region or {}:
@@ -322,6 +338,10 @@ class RunConfig(_Strict):
                 raise ValueError(f"task.path: points need {len(mech.task_axes)} coordinates for {mech.name}")
         if self.cycle is not None:
             cycle_config.check(self.cycle, mech)
+            self._check_dynamics(mech, base_dir)
+        elif self.dynamics is not None or self.motors is not None:
+            raise ValueError(f"{'dynamics' if self.dynamics is not None else 'motors'}: needs a cycle section "
+                             "(the masses and motors act along the cycle)")
         if len(self.objectives) < 1:
             raise ValueError("objectives: need at least one")
         seen: dict[tuple, int] = {}
@@ -332,6 +352,25 @@ class RunConfig(_Strict):
                                  + (f", band {obj.band}" if obj.band is not None else "") + ")")
             seen[key] = i
         return self
+
+    def _check_dynamics(self, mech, base_dir) -> None:
+        """Check dynamics.masses' groups and the motors against the mechanism (ValueError naming the field)."""
+        from scalesynth.dynamics import motors
+
+        if self.motors is not None:
+            try:
+                motors.resolve(self.motors, len(mech.joints), base_dir)
+            except ScalesynthError as err:
+                raise ValueError(str(err)) from None
+        if self.dynamics is not None and self.dynamics.masses:
+            from scalesynth.dynamics import bodies
+
+            geometry = bodies.reference_geometry(mech, self.design, self.options, self.cycle, self.units.length)
+            if geometry is not None:
+                try:
+                    bodies.check_groups(self.dynamics.masses, geometry, mech.name)
+                except ScalesynthError as err:
+                    raise ValueError(str(err)) from None
 
     def _check_metrics(self, mech) -> None:
         """Every objective and constraint names a catalogue metric this config can evaluate."""

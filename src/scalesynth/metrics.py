@@ -262,6 +262,18 @@ def _cycle_entries(mech: Mechanism, length_unit: str) -> list[Metric]:
         entry("max_cycles_per_minute", "1/min", (0.0, math.inf), "max", None, ("cycle", "cycle.limits"),
               "highest cycle rate within the actuator speed and force limits of the cycle section (cycles per "
               "minute; 0 if gravity alone exceeds a force limit or the cycle cannot be followed)", plain=True),
+        entry("picks_per_minute", "1/min", (0.0, math.inf), "max", None, ("cycle", "cycle.motors"),
+              "picks per minute within every motor limit (peak and rated torque, speed; links, payload, rotor "
+              "inertia and gravity): 60 / cycle_time_s; 0 if the motors cannot hold the payload or the cycle "
+              "cannot be followed", plain=True),
+        entry("cycle_time_s", "s", (0.0, CYCLE_PENALTY), "min", CYCLE_PENALTY, ("cycle", "cycle.motors"),
+              f"shortest period of the cycle's motion law within every motor limit plus 2 cycle.dwell_s (s){failed} "
+              "or the motors cannot hold the payload", plain=True),
+        *(entry(f"motor_{what}_ratio", "1", (0.0, math.inf), "min", CYCLE_PENALTY, ("cycle", "cycle.motors"),
+                f"largest {desc} over the actuators at the configured rate (1 = at the limit){failed}", plain=True)
+          for what, desc in (("peak_torque", "peak motor torque / peak_torque"),
+                             ("rms_torque", "RMS motor torque (motion and dwell) / rated_torque"),
+                             ("speed", "peak motor speed / max_speed"))),
     ]
 
 
@@ -365,6 +377,8 @@ def applicable(m: Metric, has_task: bool, has_path: bool, options: Mapping[str, 
             return "needs a cycle section"
         if need == "cycle.limits" and cycle is not None and cycle.speed_limits is None and cycle.force_limits is None:
             return "needs cycle.speed_limits or cycle.force_limits"
+        if need == "cycle.motors" and cycle is not None and getattr(cycle, "_motors", None) is None:
+            return "needs a motors section"
         if need == "task" and not has_task:
             return "needs a task section"
         if need == "path" and not has_path:

@@ -40,6 +40,7 @@ import numpy as np
 from scalesynth.cycle import config as ccfg
 from scalesynth.cycle import trajectory
 from scalesynth.cycle.clearance import clearance
+from scalesynth.dynamics.inverse import link_forces
 from scalesynth.errors import InvalidPose, ScalesynthError
 from scalesynth.mechanisms.base import Mechanism, wrap_angle
 
@@ -84,6 +85,8 @@ class CycleResult:
     payload_velocity: np.ndarray
     payload_accel: np.ndarray
     deflection: np.ndarray | None = None
+    motor_speed: np.ndarray | None = None  # (n, n_joints) rad/s at the motor shaft, with motors
+    motor_torque: np.ndarray | None = None  # (n, n_joints) N m at the motor shaft (rotor inertia included)
 
     def columns(self) -> dict[str, np.ndarray]:
         """cycle.csv's columns in order: t; p_a, pd_a, pdd_a per task axis; q, qd, qdd, force per actuator
@@ -102,6 +105,10 @@ class CycleResult:
         out["clearance"] = self.clearance
         if self.deflection is not None:
             out["deflection"] = self.deflection
+        if self.motor_torque is not None:
+            for i in range(len(self.joints)):
+                out[f"motor_speed{i + 1}"] = self.motor_speed[:, i]
+                out[f"motor_torque{i + 1}"] = self.motor_torque[:, i]
         return out
 
     def units(self) -> dict[str, str]:
@@ -118,6 +125,9 @@ class CycleResult:
         out.update({"lci": "1", "clearance": lu})
         if self.deflection is not None:
             out["deflection"] = lu
+        if self.motor_torque is not None:
+            for i in range(len(self.joints)):
+                out.update({f"motor_speed{i + 1}": "rad/s", f"motor_torque{i + 1}": "N m"})
         return out
 
 
@@ -244,6 +254,9 @@ def analyse(
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     vel, acc, jc = _payload_motion(mech, design, options, traj, size)
     force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
+    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, label, size,
+                                                   si_velocity_map(mech, A, length_unit), length_unit)
+    force, force_gravity, task_force = force + links, force_gravity + links_gravity, task_force + links_task
     gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)
     at = int(np.argmin(gaps))
     return CycleResult(
@@ -253,7 +266,20 @@ def analyse(
         joint_units=mech.joint_units, length_unit=length_unit, payload=cyc.payload, gravity=g,
         force_map=force_map, force_gravity=force_gravity, payload_velocity=vel, payload_accel=acc,
         deflection=deflection_along(mech, design, options, traj.p, cyc.payload * (g[None, :] - acc * m_per_unit)),
+        **_motor_columns(mech, cyc, qd, qdd, force, force_gravity, length_unit),
     )
+
+
+def _motor_columns(mech, cyc, qd, qdd, force, force_gravity, length_unit) -> dict[str, np.ndarray]:
+    """motor_speed and motor_torque (n, nj) with motors (dynamics.motors.motor_side), else {}."""
+    from scalesynth.dynamics import motors as dm
+
+    mot = dm.of_cycle(cyc, len(mech.joints))
+    if mot is None:
+        return {}
+    js = dm.joint_si(mech.joint_units, length_unit)
+    speed, g, a = dm.motor_side(mot, qd * js, qdd * js, force, force_gravity)
+    return {"motor_speed": speed, "motor_torque": g + a}
 
 
 def _clearance_along(mech: Mechanism, design, options, packed, poses: np.ndarray, q: np.ndarray,
@@ -476,6 +502,10 @@ def failed_metrics(mech: Mechanism, options, cyc: ccfg.CycleConfig) -> dict[str,
         bad["cycle_max_deflection"] = CYCLE_PENALTY
     if cyc.speed_limits is not None or cyc.force_limits is not None:
         bad["max_cycles_per_minute"] = 0.0
+    if getattr(cyc, "_motors", None) is not None:
+        from scalesynth.dynamics.motors import failed_motor_metrics
+
+        bad.update(failed_motor_metrics())
     return bad
 
 
@@ -497,4 +527,18 @@ def result_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> dict[str, float]:
         out["cycle_max_deflection"] = float(min(np.max(res.deflection), CYCLE_PENALTY))
     if speed is not None or force is not None:
         out["max_cycles_per_minute"] = 60.0 / cyc.cycle_time * scale
+    out.update(motor_metrics(res, cyc)[0])
     return out
+
+
+def motor_metrics(res: CycleResult, cyc: ccfg.CycleConfig) -> tuple[dict[str, float], str | None]:
+    """The motor metrics of an analysed cycle (``dynamics.motors``) and the limit that binds its rate; ({}, None)
+    without motors."""
+    from scalesynth.dynamics import motors as dm
+
+    mot = dm.of_cycle(cyc, len(res.joints))
+    if mot is None:
+        return {}, None
+    vals, binding = dm.cycle_motor_metrics(mot, res.traj, cyc, res.joint_units, res.length_unit, res.qd[None],
+                                           res.qdd[None], res.force[None], res.force_gravity[None])
+    return {k: float(v[0]) for k, v in vals.items()}, str(binding[0])

@@ -24,7 +24,7 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
 
 from scalesynth.cycle.trajectory import LAWS
 from scalesynth.names import hint
@@ -65,6 +65,11 @@ class CycleConfig(BaseModel):
     samples: int = Field(400, ge=8, le=100_000, description="time intervals over one cycle")
     speed_limits: float | list[float] | None = None
     force_limits: float | list[float] | None = None
+    dwell_s: float = Field(0.0, ge=0.0, le=3600.0, description="s at rest at pick and at place (motors' cycle time)")
+    # the run config's dynamics and motors sections (RunConfig attaches them; None: tube links, no motors)
+    _dynamics: Any = PrivateAttr(None)
+    _motors: Any = PrivateAttr(None)
+    _base_dir: Any = PrivateAttr(None)  # where a relative motors.catalogue is read from
 
     @field_validator("path")
     @classmethod
@@ -282,6 +287,11 @@ CYCLE_METRICS = (
     "cycle_min_clearance",
     "cycle_max_deflection",
     "max_cycles_per_minute",
+    "picks_per_minute",
+    "cycle_time_s",
+    "motor_peak_torque_ratio",
+    "motor_rms_torque_ratio",
+    "motor_speed_ratio",
 )
 
 

@@ -34,7 +34,7 @@ def write_csv(path: Path, res: CycleResult) -> None:
 
 def summary(res: CycleResult, metrics: dict[str, float], design: dict[str, float], cyc) -> dict[str, Any]:
     k = int(np.argmin(res.clearance))
-    return {
+    return {**_motor_summary(res, cyc),
         "design": design,
         "cycle": cyc.model_dump(mode="json"),
         "period_s": res.traj.period,
@@ -44,9 +44,21 @@ def summary(res: CycleResult, metrics: dict[str, float], design: dict[str, float
         "metrics": metrics,
         "min_clearance_at": {"t_s": float(res.traj.t[k]), "segments": list(res.min_clearance_pair or [])},
         "units": res.units(),
-        "model": "forces: quasi-static plus payload inertia (point mass at the task point, massless links, no "
-        "friction): A^T tau = [m (a - g); 0]",
+        "model": "forces: inverse dynamics by virtual work (docs/cycles.md): every link segment a thin uniform rod "
+        "(dynamics.masses or tube sections), the payload a point mass at the tool point, gravity, no friction; "
+        "A^T tau = [F_links + F_payload; 0]",
     }
+
+
+def _motor_summary(res: CycleResult, cyc) -> dict[str, Any]:
+    """picks_per_minute, cycle_time_s and the binding limit with motors (``dynamics.motors``), else {}."""
+    from scalesynth.cycle.analysis import motor_metrics
+
+    vals, binding = motor_metrics(res, cyc)
+    if not vals:
+        return {}
+    return {"picks_per_minute": vals["picks_per_minute"], "cycle_time_s": vals["cycle_time_s"],
+            "binding_limit": binding, "dwell_s": cyc.dwell_s}
 
 
 def _section(cfg, design, options, res: CycleResult):

@@ -23,6 +23,8 @@ import numpy as np
 
 from scalesynth.cycle import analysis, trajectory
 from scalesynth.cycle import config as ccfg
+from scalesynth.dynamics import motors
+from scalesynth.dynamics.inverse import link_forces
 from scalesynth.errors import ScalesynthError
 from scalesynth.mechanisms.base import Mechanism, wrap_angle
 
@@ -164,8 +166,8 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
             except ScalesynthError:
                 ok[j] = False
     keep = np.nonzero(ok)[0]
-    live, packed, lci, q, A, qd, qdd, acc = (live[keep], packed[keep], lci[keep], q[keep], A[keep], qd[keep],
-                                             qdd[keep], acc[keep])
+    live, packed, lci, q, A, qd, qdd, acc, size = (live[keep], packed[keep], lci[keep], q[keep], A[keep], qd[keep],
+                                                   qdd[keep], acc[keep], size[keep])
     jc = None if jc is None else [jc[j] for j in keep]
     resolved = [resolved[j] for j in keep]
     if not len(live):
@@ -178,6 +180,26 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
     else:  # per design: J_c's memory layout as analyse has it, so that einsum sums in the same order
         per = [analysis._forces(mech, A[j], jc[j], acc[j], cyc.payload, g, length_unit) for j in range(nd)]
         force, force_gravity = np.array([f[0] for f in per]), np.array([f[1] for f in per])
+    # the links' inertia and weight (dynamics.inverse, per design), added as analyse adds them
+    ok = np.ones(nd, dtype=bool)
+    for j in range(nd):
+        try:
+            links, links_g, _ = link_forces(mech, resolved[j], options, cyc, traj, label, size[j],
+                                            analysis.si_velocity_map(mech, A[j], length_unit), length_unit)
+        except ScalesynthError:
+            ok[j] = False
+            continue
+        force[j] += links
+        force_gravity[j] += links_g
+    if not ok.all():
+        keep = np.nonzero(ok)[0]
+        live, packed, lci, q, A, qd, qdd, acc, force, force_gravity = (
+            live[keep], packed[keep], lci[keep], q[keep], A[keep], qd[keep], qdd[keep], acc[keep], force[keep],
+            force_gravity[keep])
+        resolved = [resolved[j] for j in keep]
+        nd = len(live)
+        if not nd:
+            return {}
     gaps = _clearance(mech, resolved, options, packed, traj.p, q)
     deflection = _deflection(mech, resolved, options, packed, traj.p,
                              cyc.payload * (g[None, None, :] - acc * ccfg.METRES_PER_UNIT[length_unit]))
@@ -202,6 +224,10 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
         cols["cycle_max_deflection"] = np.minimum(np.max(deflection, axis=1), analysis.CYCLE_PENALTY)
     if limited:
         cols["max_cycles_per_minute"] = 60.0 / cyc.cycle_time * scale
+    mot = motors.of_cycle(cyc, nj)
+    if mot is not None:
+        cols.update(motors.cycle_motor_metrics(mot, traj, cyc, mech.joint_units, length_unit, qd, qdd, force,
+                                               force_gravity)[0])
     return {int(i): {name: float(col[j]) for name, col in cols.items()} for j, i in enumerate(live)}
 
 

@@ -37,7 +37,9 @@ class Segment:
 
     ``name`` identifies the segment (e.g. 'arm1'), ``body`` the rigid body it belongs to (several segments of
     one body, e.g. the sides of a platform triangle, share a body name), ``group`` the body's kind (the body name
-    without its number). A zero-length segment is a ball.
+    without its number). A zero-length segment is a ball. ``carries_mass``: whether the dynamics spreads its
+    body's mass over this segment (False for a parallelogram's short end links: its mass sits on the two long
+    bars; ``scalesynth.dynamics.bodies``).
     """
 
     name: str
@@ -45,6 +47,7 @@ class Segment:
     a: np.ndarray
     b: np.ndarray
     radius: float
+    carries_mass: bool = True
 
     @property
     def group(self) -> str:

@@ -97,8 +97,9 @@ def link_geometry(legs, widths: Sequence[float], rad: Mapping[str, float], pose,
     pairs: list[tuple[str, str]] = []
     base_pts, plat_pts = [], []
 
-    def seg(name, body, a, b):
-        segs.append(links.Segment(name, body, np.asarray(a, dtype=float), np.asarray(b, dtype=float), rad[body]))
+    def seg(name, body, a, b, carries_mass=True):
+        segs.append(links.Segment(name, body, np.asarray(a, dtype=float), np.asarray(b, dtype=float), rad[body],
+                                  carries_mass))
 
     for i, (leg, w, qi) in enumerate(zip(legs, widths, q, strict=True), 1):
         h = 0.5 * float(w)
@@ -110,7 +111,8 @@ def link_geometry(legs, widths: Sequence[float], rad: Mapping[str, float], pose,
         if leg.type.code == _k.R_PA:
             seg(f"upper_arm{i}", f"upper_arm{i}", leg.base, e)
             if h > 0.0:
-                seg(f"elbow{i}", f"upper_arm{i}", e - side, e + side)
+                # the parallelogram's short end link at the elbow: massless (its mass model, docs/cycles.md)
+                seg(f"elbow{i}", f"upper_arm{i}", e - side, e + side, carries_mass=False)
             pairs += [("base", f"upper_arm{i}"), (f"upper_arm{i}", f"forearm{i}")]
         else:
             lo, hi = leg.limits
