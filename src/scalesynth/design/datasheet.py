@@ -38,7 +38,7 @@ def _section(mech, packed, lo, hi, axes: tuple[int, int], fixed: dict[int, float
     return (fields[0, :, 0] >= 0).reshape(GRID, GRID)
 
 
-def _svg_view(reach, lo, hi, axes, names, zone, segments, unit, title) -> str:
+def _svg_view(reach, lo, hi, axes, names, zone, segments, unit, title, base_plane=False) -> str:
     """One view as SVG: reachable cells (grey), the working zone (blue rectangle), the robot's capsules (dark
     lines), a dimension line of the reachable width and the axes' ranges."""
     W, H, pad = 420, 360, 46
@@ -63,6 +63,10 @@ def _svg_view(reach, lo, hi, axes, names, zone, segments, unit, title) -> str:
     (zx0, zx1), (zy0, zy1) = zone
     parts.append(f'<rect class="zone" x="{X(zx0):.1f}" y="{Y(zy1):.1f}" width="{(zx1 - zx0) * s:.1f}" '
                  f'height="{(zy1 - zy0) * s:.1f}" fill="none" stroke="#1f5fbf" stroke-width="2"/>')
+    if base_plane and y0 < 0 < y1:  # the vertical axis of a side view: the robot's base plane at 0
+        parts.append(f'<line class="base" x1="{pad}" y1="{Y(0):.1f}" x2="{W - pad}" y2="{Y(0):.1f}" stroke="#888" '
+                     f'stroke-dasharray="5,3"/><text x="{W - pad}" y="{Y(0) - 3:.1f}" text-anchor="end" '
+                     'font-size="10" fill="#666">base plane</text>')
     for a, b in segments:
         parts.append(f'<line class="link" x1="{X(a[axes[0]]):.1f}" y1="{Y(a[axes[1]]):.1f}" x2="{X(b[axes[0]]):.1f}"'
                      f' y2="{Y(b[axes[1]]):.1f}" stroke="#333" stroke-width="3" stroke-linecap="round"/>')
@@ -141,13 +145,13 @@ def build(result, row: int, spec=None, label: str | None = None) -> str:
             lo = np.minimum(lo, pts.min(axis=0))
             hi = np.maximum(hi, pts.max(axis=0))
         views.append(_svg_view(_section(mech, packed, lo, hi, (0, 2), {1: pose[1]}), lo, hi, (0, 2), ("x", "z"),
-                               (box["x"], box["z"]), segs, unit, f"side view (x-z at y = {_fmt(pose[1])})"))
+                               (box["x"], box["z"]), segs, unit, f"side view (x-z at y = {_fmt(pose[1])})", True))
         views.append(_svg_view(_section(mech, packed, lo, hi, (0, 1), {2: pose[2]}), lo, hi, (0, 1), ("x", "y"),
                                (box["x"], box["y"]), segs, unit, f"top view (x-y at z = {_fmt(pose[2])})"))
     elif len(axes_names) == 2:
         lo3, hi3 = lo.copy(), hi.copy()
         views.append(_svg_view(_section(mech, packed, lo3, hi3, (0, 1), {2: 0.0}), lo3, hi3, (0, 1), ("x", "y"),
-                               (box["x"], box["y"]), segs, unit, "working range (x-y plane)"))
+                               (box["x"], box["y"]), segs, unit, "working range (x-y plane)", True))
     not_eval = "not evaluated"
     ratio = {n: value(n) for n in ("motor_peak_torque_ratio", "motor_rms_torque_ratio", "motor_speed_ratio")}
     motor = getattr(cfg, "motors", None)
