@@ -87,7 +87,7 @@ EQUAL_ACCURACY_NOTES = {
                   "cell. Piecewise Gauss rules with every breakpoint of the workspace in closed form get the "
                   "volume within budget, but the GCI is 20x the tolerance at "
                   "5 235 points and needs about 60 000: the LCI has V-shaped zeros and layers inside the lobes "
-                  "(`python benchmarks/pauu_quadrature.py`, benchmarks/notes/uniform_plans.md). The tolerance form "
+                  "(`benchmarks/pauu_quadrature.py`, in git history at 76b48df; benchmarks/notes/uniform_plans.md). The tolerance form "
                   "therefore runs the fast path at its calibrated N.",
 }
 

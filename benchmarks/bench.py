@@ -14,7 +14,7 @@
     python benchmarks/bench.py synthesis [CONFIG.yaml ...]  # every config (or these, merged into the stored part):
                                             # ms/design, projected 200 x 200 NSGA-II loop, peak memory
     python benchmarks/bench.py task_accuracy  # configs with a task box: its uniform grid against a 3x finer one
-    python benchmarks/bench.py show         # `scalesynth show` at resolution 96: wall, CPU and JIT seconds per process
+    python benchmarks/bench.py show [--resolution 96] [--repeat 2]  # `scalesynth show`: wall, CPU, JIT s per process
 
 Each part stores its numbers in benchmarks/results/<part>.json; RESULTS.md is rebuilt from all stored parts.
 Speed targets are compared as ratios measured in one run; absolute times are stated with the machine.
@@ -128,7 +128,7 @@ def bench_evaluator() -> dict:
 
 def config_resolution(cfg) -> int | None:
     """The uniform grid a config's workspace runs: ``grid.resolution``, or with ``grid.tolerance`` the grid
-    calibrated for it (2pauu-ppap, evaluate.UNIFORM_PLAN_OF); None: the adaptive evaluator."""
+    calibrated for it (2pauu-ppap, Mechanism.uniform_plan); None: the adaptive evaluator."""
     tolerance = config_tolerance(cfg)
     return cfg.grid.resolution if tolerance is None else uniform_resolution(cfg.mech, tolerance)
 
@@ -840,6 +840,11 @@ def main(argv: list[str]) -> None:
         if argv[1:2] != ["--before"] or len(argv) != 3:
             raise SystemExit("usage: bench.py cpu_target [--before TREE]")
         _run_part("cpu_target", lambda: cpu_target.bench_cpu_target(3, argv[2]))
+        write_results_md()
+        return
+    if argv and argv[0] == "show" and len(argv) > 1:  # show --resolution N --repeat K
+        resolution, repeat = show_speed.parse_args(argv[1:])
+        _run_part("show", lambda: show_speed.bench_show(resolution, repeat))
         write_results_md()
         return
     if argv and argv[0] == "adaptive_twin":  # the NumPy twin timing alone, merged into the stored adaptive rows

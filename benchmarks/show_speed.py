@@ -1,7 +1,7 @@
 """`scalesynth show` of a 3-D design at resolution 96 (issue 14: within 10 s with a warm cache): wall and CPU
 seconds of whole CLI processes, and the Numba work in each.
 
-Run: python benchmarks/show_speed.py [--resolution 96] [--repeat 2]   (or `python benchmarks/bench.py show`)
+Run: python benchmarks/bench.py show [--resolution 96] [--repeat 2]   (bench.py stores it and rebuilds RESULTS.md)
 
 The first process runs on an empty Numba cache directory (it compiles the sampler and every kernel show uses);
 later ones share that cache: the "warm cache" case. Each process runs through tests/compile_probe.py, which counts
@@ -76,16 +76,8 @@ def markdown(entry: dict) -> list[str]:
     return out
 
 
-def main(argv: list[str]) -> None:
-    import bench
-
+def parse_args(argv: list[str]) -> tuple[int, int]:
+    """(resolution, repeat) from ``[--resolution N] [--repeat K]``."""
     resolution = int(argv[argv.index("--resolution") + 1]) if "--resolution" in argv else 96
     repeat = int(argv[argv.index("--repeat") + 1]) if "--repeat" in argv else 2
-    bench._run_part("show", lambda: bench_show(resolution, repeat))
-    bench.write_results_md()
-    print(json.dumps(json.loads((bench.RESULTS / "show.json").read_text()), indent=2))
-
-
-if __name__ == "__main__":
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    main(sys.argv[1:])
+    return resolution, repeat

@@ -80,7 +80,7 @@ def random_designs(cfg, n: int, seed: int = 0) -> list[dict[str, float]]:
 
 def evaluator_label(cfg) -> str:
     """'adaptive, tolerance ...', 'calibrated uniform N = n, tolerance ...' (the tolerance form on a mechanism's
-    calibrated grid, evaluate.UNIFORM_PLAN_OF) or 'uniform N = n'."""
+    calibrated grid, Mechanism.uniform_plan) or 'uniform N = n'."""
     from scalesynth.evaluate import config_tolerance, uniform_resolution
 
     tol = config_tolerance(cfg)

@@ -103,7 +103,7 @@ class _AfterImport(importlib.abc.MetaPathFinder):
     # the evaluations of the commands: workspace grid (uniform or adaptive: evaluate, optimize, plot-front),
     # field and LCI grids (show, plot-bands, plot-task), the cycle (cycle, drives), a pose's stiffness
     hooks = {"scalesynth.mechanisms": _patch_mechanisms,
-             "scalesynth.evaluate": _patch_functions("adaptive_population_stats"),
+             "scalesynth.evaluation.adaptive": _patch_functions("adaptive_population_stats"),
              "scalesynth.kernels.grid": _patch_functions("sample_fields", "sample_grid"),
              "scalesynth.cycle.analysis": _patch_functions("analyse"),
              "scalesynth.stiffness.report": _patch_functions("pose_stiffness")}

@@ -30,7 +30,7 @@ def test_evaluate_json_group1_matches_spec():
         assert key in out
     assert out["volume_m3"] == pytest.approx(61.183182, rel=0.005)  # spec §1.9 exact volume
     assert out["gci"] == pytest.approx(0.3438, abs=0.002)  # spec §1.10 (2-norm, mode ++)
-    # the paper config's tolerance runs the uniform grid calibrated for it (evaluate.UNIFORM_PLAN_OF)
+    # the paper config's tolerance runs the uniform grid calibrated for it (Mechanism.uniform_plan)
     assert out["resolution"] == 72 and 0 < out["seconds"] < 60
     assert out["error_volume"] < 0.002 and out["error_gci"] < 5e-4  # its estimates: the change to N = 144
 

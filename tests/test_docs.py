@@ -159,3 +159,24 @@ def test_api_example_script_runs(tmp_path):
     res = summary["results"]
     assert res["designs_on_front"] >= 2 and res["hypervolume"] > 0 and "m_minus_n" in res["columns"]
     assert (tmp_path / "workspace_lci.png").stat().st_size > 0 and (tmp_path / "quick" / "manifest.json").exists()
+
+
+def test_docs_index_links_every_page():
+    """docs/README.md is the index: it links every page under docs/ and docs/mechanisms/."""
+    index = (DOCS / "README.md").read_text()
+    linked = {(DOCS / t).resolve() for t in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", index) if "://" not in t}
+    pages = [*DOCS.glob("*.md"), *(DOCS / "mechanisms").glob("*.md")]
+    assert len(pages) > 10
+    assert sorted(p.relative_to(DOCS).as_posix() for p in pages
+                  if p.name != "README.md" and p.resolve() not in linked) == []
+
+
+def test_readme_is_a_front_door():
+    """The README is for users: at most about 200 lines, the two commands first, the mechanism table with every
+    registered mechanism, and a link to the docs index and to every page it moved content to."""
+    text = (ROOT / "README.md").read_text()
+    assert len(text.splitlines()) <= 200
+    assert "scripts/run     # main job" in text and "scripts/test    # lint" in text
+    assert [n for n in available() if f"| `{n}` |" not in text] == []
+    for page in ("docs/README.md", "docs/guide.md", "docs/development.md", "benchmarks/RESULTS.md"):
+        assert f"]({page}" in text

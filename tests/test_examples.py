@@ -104,3 +104,16 @@ def test_non_editable_install_in_a_fresh_venv_runs_the_example_from_an_empty_dir
     manifest = json.loads((work / "r" / "manifest.json").read_text())
     assert manifest["status"] == "finished" and manifest["name"] == "quick"
     assert (work / "r" / "pareto.csv").stat().st_size > 0 and (work / "r" / "plots").is_dir()
+
+
+def test_example_list_lines_are_whole_sentences():
+    """Each `example --list` line is the name and the first whole sentence of the example's header comment: it ends
+    with a full stop, its brackets close, and the header starts with it (nothing cut mid-sentence)."""
+    res = runner.invoke(app, ["example", "--list"])
+    assert res.exit_code == 0
+    for line in res.stdout.splitlines():
+        name, text = line.split(maxsplit=1)
+        header = " ".join(x.lstrip("#").strip() for x in examples.text(name).splitlines() if x.startswith("#"))
+        assert text.endswith("."), line
+        assert text.count("(") == text.count(")") and text.count("[") == text.count("]"), line
+        assert header.startswith(text), line

@@ -9,8 +9,7 @@ import numpy as np
 from numba import njit
 
 from scalesynth.evaluate import (
-    ADAPTIVE_PLAN_OF,
-    INTERVAL_PLAN_OF,
+    ADAPTIVE_PLAN,
     Tolerance,
     adaptive_plan,
     adaptive_population_stats,
@@ -121,12 +120,13 @@ def test_c_model_and_interference_free_keep_the_psi_columns():
         assert MECH.interval_kernel_for(options) is None
         assert MECH.column_axis(options) == 2 and column_axis(MECH, options) == 2
         assert MECH.column_order_kernel(MECH.lci_kernel, options) is MECH.lci_kernel
-        assert adaptive_plan(MECH, options) == ADAPTIVE_PLAN_OF["rps-upu"]
+        assert adaptive_plan(MECH, options) == MECH.node_plan
     assert MECH.interval_kernel_for(plain) is MECH.interval_kernel
     assert MECH.column_axis(plain) == 0 and column_axis(MECH, plain) == 0
     assert column_axis(MECH, plain, intervals=False) == 2
-    assert adaptive_plan(MECH, plain) == INTERVAL_PLAN_OF["rps-upu"]
-    assert adaptive_plan(MECH) == ADAPTIVE_PLAN_OF["rps-upu"]
+    assert adaptive_plan(MECH, plain) == MECH.interval_plan
+    assert adaptive_plan(MECH) == MECH.node_plan
+    assert MECH.node_plan not in (None, ADAPTIVE_PLAN[3]) and MECH.interval_plan not in (None, MECH.node_plan)
     # rps-upu-tool (a subclass) keeps its own columns along its last axis
     tool = get("rps-upu-tool")
     tool_options = tool.resolve_options({})

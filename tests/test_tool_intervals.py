@@ -97,14 +97,15 @@ def test_the_interval_plan_only_where_every_column_is_in_closed_form():
     """evaluate.adaptive_plan: rps-upu-tool's interval plan (no z-levels: the column lengths are exact) with its
     interval kernel; with interference_free (the clearance decides reachability too, so every column would fall
     back to nodes) the node plan, whose z-levels find the thin slabs nodes miss."""
-    from scalesynth.evaluate import ADAPTIVE_PLAN_OF, INTERVAL_PLAN_OF, adaptive_plan
+    from scalesynth.evaluate import ADAPTIVE_PLAN, adaptive_plan
 
     mech = get("rps-upu-tool")
     plain = mech.resolve_options({})
     free = mech.resolve_options({"interference_free": True})
     assert mech.interval_kernel_for(plain) is mech.interval_kernel
     assert mech.interval_kernel_for(free) is None
-    assert adaptive_plan(mech, plain) == INTERVAL_PLAN_OF["rps-upu-tool"]
+    assert adaptive_plan(mech, plain) == mech.interval_plan
     assert adaptive_plan(mech, plain).zlevels == 0
-    assert adaptive_plan(mech, free) == ADAPTIVE_PLAN_OF["rps-upu-tool"]
-    assert adaptive_plan(mech) == ADAPTIVE_PLAN_OF["rps-upu-tool"]
+    assert adaptive_plan(mech, free) == mech.node_plan
+    assert adaptive_plan(mech) == mech.node_plan
+    assert mech.node_plan not in (None, ADAPTIVE_PLAN[3]) and mech.interval_plan not in (None, mech.node_plan)

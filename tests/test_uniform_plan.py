@@ -1,4 +1,4 @@
-"""The tolerance form on a calibrated uniform grid (evaluate.UNIFORM_PLAN_OF: 2pauu-ppap, whose uniform fast path is
+"""The tolerance form on a calibrated uniform grid (Mechanism.uniform_plan: 2pauu-ppap, whose uniform fast path is
 far cheaper than the adaptive evaluator at equal accuracy): which grid a tolerance picks, that the values are that
 grid's, the error estimates the change to the grid twice as fine, and that a tolerance tighter than every calibrated
 step goes to the adaptive evaluator."""
@@ -33,7 +33,7 @@ def test_a_tolerance_picks_the_coarsest_step_at_least_as_tight():
     assert plan.resolution_for(Tolerance(0.001, 5e-4)) is None  # tighter than every step: adaptive
     mech = get("2pauu-ppap")
     assert uniform_resolution(mech, Tolerance()) == 72  # the default tolerance (0.2 %, 5e-4)
-    # the calibrated steps (evaluate.UNIFORM_PLAN_OF's comment: benchmarks/uniform_ladder.py on two design sets)
+    # the calibrated steps (the comment on 2pauu-ppap's uniform_plan: benchmarks/uniform_ladder.py on two design sets)
     assert uniform_resolution(mech, Tolerance(0.001, 2.5e-4)) == 112
     assert uniform_resolution(mech, Tolerance(0.001, 5e-4)) == 112  # the 0.2 % step is too loose in volume
     assert uniform_resolution(mech, Tolerance(0.0005, 1e-4)) == 144

@@ -123,11 +123,12 @@ def test_the_interval_plan_only_where_every_column_is_in_closed_form():
     """evaluate.adaptive_plan: ups-sspr's interval plan (2 z-cells: the column lengths are exact, the z-cells only
     serve the fields' Gauss rule) with its interval kernel; with interference_free the node plan (4 z-cells and
     bisection)."""
-    from scalesynth.evaluate import ADAPTIVE_PLAN_OF, INTERVAL_PLAN_OF, adaptive_plan
+    from scalesynth.evaluate import ADAPTIVE_PLAN, adaptive_plan
 
     plain = UPS.resolve_options({})
     free = UPS.resolve_options({"interference_free": True})
-    assert adaptive_plan(UPS, plain) == INTERVAL_PLAN_OF["ups-sspr"]
-    assert adaptive_plan(UPS, plain).cells < ADAPTIVE_PLAN_OF["ups-sspr"].cells
-    assert adaptive_plan(UPS, free) == ADAPTIVE_PLAN_OF["ups-sspr"]
-    assert adaptive_plan(UPS) == ADAPTIVE_PLAN_OF["ups-sspr"]
+    assert adaptive_plan(UPS, plain) == UPS.interval_plan
+    assert adaptive_plan(UPS, plain).cells < UPS.node_plan.cells
+    assert adaptive_plan(UPS, free) == UPS.node_plan
+    assert adaptive_plan(UPS) == UPS.node_plan
+    assert UPS.node_plan not in (None, ADAPTIVE_PLAN[3]) and UPS.interval_plan not in (None, UPS.node_plan)

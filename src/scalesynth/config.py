@@ -41,7 +41,7 @@ class _Strict(BaseModel):
 
 class ToleranceConfig(_Strict):
     """Accuracy target of the tolerance form: the adaptive evaluator (per design, from its own error estimate), or a
-    mechanism's calibrated uniform grid (evaluate.UNIFORM_PLAN_OF)."""
+    mechanism's calibrated uniform grid (Mechanism.uniform_plan)."""
 
     volume: float = Field(0.002, gt=0.0, le=0.5, description="relative error of the workspace measure")
     gci: float = Field(5.0e-4, gt=0.0, le=0.5, description="absolute error of the GCI")

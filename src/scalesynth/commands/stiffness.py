@@ -18,6 +18,7 @@ from scalesynth.cliapp import (
     app,
     handles_errors,
 )
+from scalesynth.errors import InvalidParameter
 
 
 @app.command("stiffness")
@@ -34,9 +35,13 @@ def stiffness_cmd(
 ) -> None:
     """Deflection, compliance and stiffness of the platform at one pose (working mode = the kernel's), and the
     frame model solved (links, joints, actuators, platform, load) with every unit."""
-    from scalesynth.stiffness.report import pose_stiffness
+    from scalesynth.mechanisms import available, get
+    from scalesynth.stiffness.report import JOINT_MODELS, modelled, pose_stiffness
 
     mech, design, options = _design_inputs(mechanism, design_choice, sets)
+    if joints in JOINT_MODELS and not modelled(mech):  # a bad --joints is named first (pose_stiffness)
+        names = [n for n in available() if modelled(get(n))]
+        raise InvalidParameter(f"mechanism: no stiffness model for {mech.name} yet (modelled: {', '.join(names)})")
     p = _parse_vector("--pose", pose, len(mech.task_axes))
     if load is not None:
         n = len(options["load"]) if "load" in options else 3

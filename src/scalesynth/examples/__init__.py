@@ -2,11 +2,12 @@
 
 These YAML files are the source of truth; ``configs/`` in the repository holds byte-identical copies for the
 README's commands (tests/test_examples.py checks that they agree). Each file starts with comment lines that say
-what it is; the first of them is the one-line description shown by ``--list``.
+what it is; their first sentence is the one-line description shown by ``--list``.
 """
 
 from __future__ import annotations
 
+import re
 from importlib import resources
 
 from scalesynth.errors import ConfigError
@@ -32,8 +33,13 @@ def text(name: str) -> str:
 
 
 def description(name: str) -> str:
-    """The first comment line of example ``name``, without the '#'."""
+    """The first sentence of example ``name``'s leading comment block (its lines joined, without the '#'): a whole
+    sentence, ending with its full stop."""
+    header = []
     for line in text(name).splitlines():
-        if line.startswith("#"):
-            return line.lstrip("#").strip()
-    return ""
+        if not line.startswith("#"):
+            break
+        header.append(line.lstrip("#").strip())
+    joined = " ".join(header)
+    end = re.search(r"\.(\s|$)", joined)  # a full stop before a space or the end (not a decimal point)
+    return joined[: end.start() + 1] if end else joined

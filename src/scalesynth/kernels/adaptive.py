@@ -63,7 +63,8 @@ makes the same refinement decisions there (up to rounding): its extensive statis
 Parallel over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
 The columns' L and S live in a sparse cell store (initial_cells, refine_cells: each column with its neighbours'
 cells), not in a dense grid of the finest level, whose copies and sums cost more than the refined columns at level
-3 (tests/test_adaptive_store.py compares the two; benchmarks/adaptive_store_ab.py the evaluator before and after).
+3 (tests/test_adaptive_store.py compares the two; benchmarks/adaptive_store_ab.py, in git history at 76b48df, the
+evaluator before and after).
 """
 
 from __future__ import annotations

@@ -21,32 +21,16 @@ import sys
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from scalesynth.declarations import MAX_MAGNITUDE, Option, Parameter  # noqa: F401 - the mechanisms' vocabulary
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.names import hint
 
-
-@dataclass(frozen=True)
-class Parameter:
-    """A numeric design parameter (a length unless ``unit`` says otherwise)."""
-
-    name: str
-    default: float
-    doc: str
-    unit: str = "length"
-    positive: bool = True  # must be > 0; otherwise any finite value
-
-
-@dataclass(frozen=True)
-class Option:
-    """A non-design setting (working mode, limits, offsets). ``default`` None means 'off' or 'derived'."""
-
-    name: str
-    default: Any
-    doc: str
+if TYPE_CHECKING:
+    from scalesynth.evaluation.plans import ColumnPlan, UniformPlan
 
 
 @dataclass(frozen=True)
@@ -135,6 +119,11 @@ class Mechanism(ABC):
     # (column, unit) of each derived_columns entry, unit as Parameter.unit ('length', 'angle', '1' or a text with
     # {length}); the labels of plots and report.html read them. A tuple: the mechanism stays hashable
     derived_units: tuple[tuple[str, str], ...] = ()
+    # the evaluator's plans for this mechanism (scalesynth.evaluation.plans), chosen by benchmark and explained where
+    # each mechanism sets them; None: the default plan per task dimension, or no calibrated uniform grid
+    node_plan: ClassVar[ColumnPlan | None] = None  # the adaptive evaluator with nodes and bisections
+    interval_plan: ClassVar[ColumnPlan | None] = None  # with its closed-form column intervals (interval_kernel_for)
+    uniform_plan: ClassVar[UniformPlan | None] = None  # the tolerance form on a calibrated uniform grid
 
     @property
     def n_fields(self) -> int:
@@ -454,12 +443,6 @@ def svd_lci(matrix) -> float:
     """sigma_min / sigma_max of a matrix by NumPy's SVD (the kernels' reference); 0 for a zero matrix."""
     sv = np.linalg.svd(np.asarray(matrix, dtype=float), compute_uv=False)
     return float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
-
-
-# Every number a user gives (design values, bounds, options, grid region, task, poses) is refused above this
-# magnitude (config units): the kernels multiply up to a few lengths together and take powers up to 8 of them, and
-# 1e12 keeps every such product far inside float64 (1e96 < 1.8e308), so every number written stays finite.
-MAX_MAGNITUDE = 1e12
 
 
 def check_magnitude(field_name: str, value: float) -> float:

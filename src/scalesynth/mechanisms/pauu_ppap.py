@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.evaluation.plans import ColumnPlan, UniformPlan
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import SIGMA_CAP, cos_third_acos, inverse_singular_values, sv_3x3
@@ -626,6 +627,22 @@ STIFFNESS_FIELDS = (
 
 class PauuPpap(Mechanism):
     """Seed-000 mechanism; see module docstring."""
+
+    # the adaptive evaluator's plan (scalesynth.evaluation.plans): the 3-D default with beta 3 (its lobe tips are
+    # shells thinner than the 8 coarse z-cells, hence z-levels confirmed twice and box-face columns)
+    node_plan = ColumnPlan(24, 8, 5, 3, beta=3.0, zlevels=5, zconfirm=2, faces=True)
+    # the tolerance form on its uniform grid: its uniform fast path (column intervals, mirror symmetries) costs about
+    # 1/15 of the adaptive evaluator at (0.2 %, 5e-4) (N = 72: 0.96 ms against 15 ms per design on the quarter box of
+    # its symmetries, one thread). Ladders on the config's bounds (paper_2pauu_ppap.yaml; quick.yaml has the same),
+    # worst volume / GCI error as multiples of the tolerance on seed 0 | seed 1 (benchmarks/notes/uniform_plans.md):
+    # N = 72 at (0.2 %, 5e-4): 0.41, 0.44 | 0.50, 0.48 (N = 56: 0.67, 0.70 | 1.06, 1.04; N = 64: 1.04 on seed 0);
+    # N = 32 at (1 %, 2.5e-3): 0.68, 0.32 | 0.51, 0.52; N = 24 at (3 %, 5e-3): 0.57, 0.46 | 0.50, 0.74 (N = 20: 0.85,
+    # 0.88 on seed 0). Tighter steps, against N = 448 (`uniform_ladder.py 2pauu-ppap SEED ... --ref 448`): N = 112 at
+    # (0.1 %, 2.5e-4): 0.53, 0.60 | 0.58, 0.76 (N = 96: 0.88x in GCI on seed 1); N = 144 at (0.05 %, 1e-4): 0.28,
+    # 0.59 | 0.60, 0.72 (N = 128: 0.93x on seed 1). Without them such a tolerance ran the adaptive evaluator: 0.12 s
+    # per design at (0.05 %, 1e-4), where N = 144 takes about 4 ms
+    uniform_plan = UniformPlan(((0.0005, 1.0e-4, 144), (0.001, 2.5e-4, 112), (0.002, 5.0e-4, 72), (0.01, 2.5e-3, 32),
+                                (0.03, 5.0e-3, 24)))
 
     def check_options(self, options: dict[str, Any]) -> None:
         check_stiffness_options(options, 3, LINK_GROUPS)

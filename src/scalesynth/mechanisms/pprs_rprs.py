@@ -32,6 +32,7 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.evaluation.plans import ColumnPlan
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.clearance import put_segment as _put_seg
 from scalesynth.kernels.clearance import segment_distance
@@ -998,6 +999,24 @@ def _pose_distance(a: np.ndarray, b: np.ndarray, length: float) -> float:
 # ----- the mechanism ---------------------------------------------------------------------------------------
 class PprsRprs(Mechanism):
     """Seed-001 mechanism; see module docstring. FK solutions are full poses named by ``pose_axes``."""
+
+    # the adaptive evaluator's plans (scalesynth.evaluation.plans). Node plan (interference_free only: else the
+    # interval plan): the 3-D default; searched before its box pad (bounding_box) and column intervals: none of 332
+    # plans (against N = 192) was within 0.8x on seed 0, the default included (0.96x); N = 192 is itself up to 1.35x
+    # off N = 384 on seed-0 designs, and the default is 1.9x off N = 768 on a seed-1 design (0.36 % too large, its
+    # own estimate 0.88x: it stops early; benchmarks/notes/adaptive_plans.md)
+    node_plan = None
+    # interval plan: its workspaces are thin slabs (median 27-28 mm of a 215-256 mm box) whose columns hold one
+    # interval, so 1 z-cell and the midpoint rule serve the fields; its refinement is driven by walls (vertical planes
+    # of the rail and link limits), where the measure jumps but the LCI does not, so the refined columns inherit their
+    # fields (field_levels 0, kernels.adaptive step 3b) and refine 4 times less eagerly (beta 4): (24, 1, 5, 3,
+    # beta 4, no faces, fields on level 0, 1 Gauss point) is within 0.68x / 0.54x / 0.76x / 0.78x / 0.63x (volume,
+    # against the exact volume of the column intervals on a 2400^2 cross grid) and 0.47x / 0.51x / 0.50x / 0.56x /
+    # 0.76x (GCI, against 324^2 columns of exact intervals with fields everywhere) on seeds 0-4 at 2 056-2 609 calls
+    # per design, where the plan before, (24, 2, 5, 3, beta 1, faces), took 5 341-6 793 and was 1.14x off on a seed-3
+    # design; 12 or 16 columns miss small workspaces (1.52x, 1.16x on seed 1) (benchmarks/pprs_columns.py,
+    # benchmarks/notes/pprs_rprs.md)
+    interval_plan = ColumnPlan(24, 1, 5, 3, beta=4.0, field_levels=0, gauss_points=1)
 
     pose_axes = ("x", "y", "z", "phi", "theta", "psi")
 

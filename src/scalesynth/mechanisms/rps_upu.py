@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit
 
 from scalesynth.errors import InvalidParameter, InvalidPose
+from scalesynth.evaluation.plans import ColumnPlan
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.clearance import min_capsule_gap, put_segment
 from scalesynth.kernels.conditioning import inverse_singular_values, sv_3x3
@@ -788,6 +789,23 @@ STIFFNESS_OPTIONS = stiffness_options("mm", ACTUATOR_STIFFNESS, "axial stiffness
 
 class RpsUpu(Mechanism):
     """Seed-002 mechanism; see module docstring."""
+
+    # the adaptive evaluator's plans (scalesynth.evaluation.plans). Node plan (psi-columns; since the z-column
+    # intervals it runs only for the C-model and interference_free): no cheaper plan of a grid search (870 plans)
+    # passes both design sets ((15, 8, 6, 3, beta 3.5): 0.61x on seed 0, 1.4-1.6x on seed-1 designs against N = 192),
+    # so (24, 8, 5, 3, beta 3) stays (0.82x / 0.80x on seed 0; 0.56x / 0.75x on seed 1 without the design whose
+    # N = 96 reference is 2.45x off N = 192's). Its workspaces are smooth and thick (the benchmark meets the
+    # tolerance without z-levels or face columns)
+    node_plan = ColumnPlan(24, 8, 5, 3, beta=3.0)
+    # interval plan (P-model; its columns run along z, column_axis): (8, 6, 5, 2, beta 3, 2 z-levels confirmed once)
+    # is within 0.77x of the tolerance against N = 192 on seeds 0-3 and N = 384 on seed 4 (N = 192 is off there) at
+    # 2 988 calls per design (seed 0), 0.44x the time of (8, 8, 5, 2, beta 1, 3 z-levels), which was within 0.58x at
+    # 7 186 calls: its 200 x 200 loop had reached 30 s, the goal. The psi-column node plan took 23 958. Without
+    # z-levels the fields' Gauss rule along z misses the GCI (16-48 fixed z-cells: 1.1-4.4x; the LCI varies along z
+    # more than the coarse cells resolve on some designs); more z-levels are not safer here (3 instead of 2: 2.02x in
+    # GCI on seed 0 against N = 384), so only the searched plan is trusted (benchmarks/notes/adaptive_plans.md).
+    # Inherited fields (kernels.adaptive step 3b) are not allowed by its GCI (1.19x on seed 1)
+    interval_plan = ColumnPlan(8, 6, 5, 2, beta=3.0, zlevels=2, zconfirm=1)
 
     # ----- options, packing -------------------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
@@ -1633,6 +1651,29 @@ class RpsUpuTool(RpsUpu):
     uses the principal branch (cos theta > 0, cos psi > 0). The Jacobian dq/dT is in mm/mm, so the LCI needs no
     characteristic length. Only the P-model has the closed-form inverse, so there is no ``model`` option.
     """
+
+    # node plan (with interference_free; else the interval plan): from benchmarks/plan_search.py's 1926 plans (LCI
+    # kernel; benchmarks/notes/adaptive_plans.md), the one with the widest margin against the better reference
+    # N = 192 (N = 96 is 0.2-0.6x the volume tolerance off it on most designs) among the cheap ones: 10 x 10 columns
+    # of 8 z-cells (up to 3 doublings, confirmed twice), 5 bisections, 2 levels, face columns: 122 299 calls/design,
+    # 4.4x fewer than the 3-D default's 533 892. Errors x tolerance (volume, GCI) against N = 192, seeds 0 / 1 / 2:
+    # 0.50, 0.73 / 0.46, 0.47 / 0.43, 0.40. The cheapest plan passing the rule, (12, 12, 4, 2, beta 1, 2 z-levels
+    # confirmed once): 93 874 calls, but 0.80x in GCI on seed 1. Both are more accurate at 2 levels than at 3
+    # (0.82-1.02x: a third level refines part of the boundary and loses a cancellation), so the margin, not the level
+    # count, is the safety here. Their own estimates stop above the tolerance (the reported error_volume is
+    # conservative, up to 4.6x, as ups-sspr's). Without face columns or z-levels no plan passes seed 0 (the task
+    # box's wall and thin slabs)
+    node_plan = ColumnPlan(10, 8, 5, 2, beta=1.0, zlevels=3, zconfirm=2, faces=True)
+    # interval plan (columns in closed form: no z-levels needed to find thin shells; the z-cells only serve the Gauss
+    # rule of the fields): benchmarks/plan_search.py's 14 plans against N = 192 on seeds 0, 1, 2
+    # (benchmarks/notes/adaptive_plans.md): (10, 16, 5, 2, beta 1, faces) is within 0.60x (volume) and 0.52x (GCI) of
+    # the tolerance on all three at 7 320 calls per design, against its node plan's 19 512 (with intervals) or 61 150
+    # (without); 8 columns or 12 z-cells miss (8.5x the volume tolerance on a seed-0 design; 1.65x in GCI), and 8
+    # z-cells with no z-levels are 12x off in GCI (the fields' Gauss rule needs the 16). With inherited fields
+    # (kernels.adaptive step 3b) on the same plan: 3 132 calls per design against 7 320, 0.43x the time
+    # (plan_search.py --ab), with the same worst errors against N = 192 on seeds 0-4 (volume 0.60 / 0.91x, GCI
+    # 0.50 / 0.46x; before 0.60 / 0.91x, 0.52 / 0.62x)
+    interval_plan = ColumnPlan(10, 16, 5, 2, beta=1.0, faces=True, field_levels=0)
 
     def check_options(self, options: dict[str, Any]) -> None:
         self._check_limits(options)

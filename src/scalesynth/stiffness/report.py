@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from scalesynth.errors import InvalidParameter
-from scalesynth.mechanisms.base import Mechanism
 from scalesynth.stiffness.solve import solve
+
+if TYPE_CHECKING:  # annotations only: nothing below the mechanisms imports them
+    from scalesynth.mechanisms.base import Mechanism
 
 
 def modelled(mech: Mechanism) -> bool:
@@ -36,16 +38,15 @@ JOINT_MODELS = ("ideal", "bonded")
 def pose_stiffness(mech: Mechanism, design: Mapping[str, float], options: Mapping[str, Any], pose,
                    joints: str = "ideal") -> dict:
     """Deflection under options['load'], compliance and stiffness of the platform DOFs, stiffness_min and the model
-    solved, every unit stated. ``joints``: 'ideal' (moment-free passive joints, the per-voxel fields' model) or
-    'bonded' (passive joints welded). Raises InvalidParameter for an unmodelled mechanism or a bad ``joints``,
+    solved, every unit stated. ``mech``: any object with the Mechanism interface and a ``stiffness_model``.
+    ``joints``: 'ideal' (moment-free passive joints, the per-voxel fields' model) or 'bonded' (passive joints
+    welded). Raises InvalidParameter for an unmodelled mechanism or a bad ``joints``,
     InvalidPose outside the workspace."""
     if joints not in JOINT_MODELS:
         raise InvalidParameter(f"--joints: must be one of {', '.join(JOINT_MODELS)}, got {joints!r}")
     if not modelled(mech):
-        from scalesynth.mechanisms import available, get
-
-        names = [n for n in available() if modelled(get(n))]
-        raise InvalidParameter(f"mechanism: no stiffness model for {mech.name} yet (modelled: {', '.join(names)})")
+        # the command line names the modelled mechanisms (commands.stiffness, above the registry)
+        raise InvalidParameter(f"mechanism: no stiffness model for {mech.name} yet")
     model = mech.stiffness_model(design, options, pose, joints)
     res = solve(model)
     u = model.length_unit

@@ -13,8 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from scalesynth.declarations import Option
 from scalesynth.errors import InvalidParameter
-from scalesynth.mechanisms.base import Option
 from scalesynth.names import hint
 
 # Every positive stiffness input (Young's modulus, tube diameter and wall, actuator stiffness) lies in
@@ -67,7 +67,7 @@ def _number(name: str, value: Any) -> float:
 
 def _positive(name: str, value: Any) -> float:
     """A stiffness input in [SMALLEST, MAX_MAGNITUDE] (see SMALLEST: the arithmetic it enters)."""
-    from scalesynth.mechanisms.base import MAX_MAGNITUDE
+    from scalesynth.declarations import MAX_MAGNITUDE
 
     v = _number(name, value)
     if not (v > 0 and math.isfinite(v)):
