@@ -483,7 +483,7 @@ def markdown() -> str:
         "its column name (units in the name; `{band}` is the band index k, chosen with `band: k`). Families:",
         "`workspace` (statistic of a per-voxel field over the reachable workspace), `task` (over the reachable part",
         "of `task.box`; needs a task), `path` (along `task.path`), `design` (from the design parameters), `cycle`",
-        "(along the config's `cycle`, see the README's Cycles section). A",
+        "(along the config's `cycle`, docs/cycles.md). A",
         "minimised objective needs a finite worst value for the hypervolume reference: `bounding_box` is the",
         "bounding-box measure of the largest design in the bounds, `bounds_corners` the largest value over the",
         "corners of the bounds; metrics without one can be maximised or constrained.",
