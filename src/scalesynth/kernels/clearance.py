@@ -16,7 +16,7 @@ from scalesynth.kernels.flags import FASTMATH
 _EPS = 1e-300
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _clamp01(v):
     return 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
 
@@ -64,7 +64,7 @@ def planar_capsule_gap(ax, ay, bx, by, ra, cx, cy, dx, dy, rc):
     return segment_distance(ax, ay, 0.0, bx, by, 0.0, cx, cy, 0.0, dx, dy, 0.0) - ra - rc
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def put_segment(seg, k, ax, ay, az, bx, by, bz):
     """Row k of a (n, 6) capsule array: the segment (ax, ay, az) -> (bx, by, bz)."""
     seg[k, 0] = ax

@@ -15,7 +15,7 @@ from numba import njit
 from scalesynth.kernels.flags import FASTMATH
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
     """(sigma_min/sigma_max, sigma_min, sigma_max) of the 3x3 matrix with rows (a11, a12, a13), (a21, ...), (a31, ...).
 
@@ -88,7 +88,7 @@ def sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
     return math.sqrt(ratio), math.sqrt(prod / lmid), smax
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def cos_third_acos(r):
     """cos(acos(r) / 3) for r in [-1, 1] (clamped), the scaled largest eigenvalue of the trigonometric cubic solution,
     without a transcendental call, so that a loop of it vectorises (libm's acos and cos do not).
@@ -108,13 +108,13 @@ def cos_third_acos(r):
     return 0.5 * (1.0 + u)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def lci_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33):
     """sigma_min/sigma_max of the 3x3 matrix with rows (a11, a12, a13), (a21, ...), (a31, ...) (see sv_3x3)."""
     return sv_3x3(a11, a12, a13, a21, a22, a23, a31, a32, a33)[0]
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def sv_2x2(a, b, c, d):
     """(sigma_min/sigma_max, sigma_min, sigma_max) of [[a, b], [c, d]] in closed form."""
     f = a * a + b * b + c * c + d * d
@@ -134,7 +134,7 @@ def sv_2x2(a, b, c, d):
     return math.sqrt(ratio), math.sqrt(smin2), smax
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def lci_2x2(a, b, c, d):
     """sigma_min/sigma_max of [[a, b], [c, d]] in closed form (see sv_2x2)."""
     return sv_2x2(a, b, c, d)[0]
@@ -144,7 +144,7 @@ def lci_2x2(a, b, c, d):
 SIGMA_CAP = 1e12
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def inverse_singular_values(smin_a, smax_a):
     """(sigma_min, sigma_max) of J = A^-1 from A's extreme singular values: 1/smax_a and 1/smin_a (capped)."""
     lo = 1.0 / smax_a if smax_a > 1.0 / SIGMA_CAP else SIGMA_CAP

@@ -82,7 +82,7 @@ def scale_extensive(stats: np.ndarray, n_fields: int, factor: float) -> np.ndarr
     return out
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def write_unreachable(out):
     """The pose is not reachable: LCI -1, every other field 0."""
     out[0] = -1.0
@@ -90,7 +90,7 @@ def write_unreachable(out):
         out[f] = 0.0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def write_singular(out):
     """An exact singular pose where the conditioning matrix is not formed (a zero-length leg, a folded chain):
     LCI 0, sigma_min 0 and sigma_max SIGMA_CAP (unbounded or undetermined), other fields 0. Grids meet such
@@ -102,7 +102,7 @@ def write_singular(out):
         out[f] = 0.0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _band_index(lci, edges):
     """Band k holds (edges[k], edges[k+1]]; the first band also holds its lower edge."""
     nb = edges.shape[0] - 1

@@ -6,7 +6,7 @@ from numba import njit
 from scalesynth.kernels.flags import FASTMATH
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def sort_span(a, start, stop):
     """Insertion sort of a[start:stop] in place (a handful of candidate heights)."""
     for i in range(start + 1, stop):
@@ -18,7 +18,7 @@ def sort_span(a, start, stop):
         a[j + 1] = v
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def add_piece(out, k, a, b):
     """Add the reachable piece [a, b] to the k sorted intervals in out[:k] (float64, (K, 2)), pieces coming in
     order: it extends the last interval when that ends at a (a candidate height between two reachable pieces),

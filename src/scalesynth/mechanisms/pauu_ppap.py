@@ -80,7 +80,7 @@ _ADJACENT = links.adjacency([("base", "arm1"), ("base", "arm2"), ("arm1", "link1
 _PAIRS = links.kernel_pairs(_BODIES, _ADJACENT)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _chain(a, b, yy, l1, l2, sigma):
     """One chain's IK root sigma in algebraic form: (ok, cos theta, sin theta, Jq entry), no transcendental calls.
 
@@ -98,7 +98,7 @@ def _chain(a, b, yy, l1, l2, sigma):
     return True, (a * kk + sigma * b * sq) * inv, (-b * kk + sigma * a * sq) * inv, -sigma * l1 * sq
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _angle_in(c, s, lo, hi):
     t = math.atan2(s, c)
     two_pi = 2.0 * math.pi
@@ -125,7 +125,7 @@ def _clearance(p, x, y, z, c1, s1, c2, s2):
     return min_capsule_gap(seg, _PAIRS, p[_RAD : _RAD + 6])
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _chain_stiffness(p, wx, wy, wz, ex, ez):
     """(ok, kappa, u) of one PaUU chain, ideal joints, the frame of stiffness_model: with the platform's rotations
     held (by the PPaP chain) the chain adds kappa u u^T to the platform's translational stiffness (N/m), u the unit
@@ -201,7 +201,7 @@ def _stiffness(p, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2):
         p[_FX], p[_FX + 1], p[_FX + 2])
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _put_stiffness(p, out, w1x, w1y, w1z, c1, s1, w2x, w2y, w2z, c2, s2):
     """Slots _F_STIFFNESS_MIN, _F_DEFLECTION of a reachable pose: _stiffness when the packed options ask for it
     (options.stiffness_metrics), else 0 (written: the grid kernels reuse ``out``)."""
@@ -238,7 +238,7 @@ def point_reach(p, x, y, z, out):
     _fields(p, x, y, z, out, False, False, False)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, with_clearance, with_stiffness, every=True):
     """point_fields (both True) or kinematic_fields (both False; constants, so each copy keeps its branches). The
     stiffness fields are computed only when the packed options ask for them (options.stiffness_metrics), so that
@@ -302,7 +302,7 @@ def _fields(p, x, y, z, out, with_clearance, with_stiffness, every=True):
         _put_stiffness(p, out, w1x, y, w1z, c1, s1, w2x, y, w2z, c2, s2)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _k_range(zlo, zhi, lo, step, nz):
     """Indices k (inclusive range, widened by one cell each side) whose cell centres may lie in [zlo, zhi]."""
     k0 = int(math.floor((zlo - lo) / step - 0.5)) - 1
@@ -314,7 +314,7 @@ def _k_range(zlo, zhi, lo, step, nz):
     return k0, k1
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _mirror_plan(lo, step, n):
     """(first index to visit, weight of visited indices, index of the unmirrored middle cell or -1) for an axis.
 

@@ -76,7 +76,7 @@ _F_CLEARANCE = 5  # slot of the clearance field in the field kernel's out (its i
 N_PACKED = 30
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _arm(u, y, l1, l2, sigma):
     """cos(alpha), sin(alpha) of one chain's IK root sigma, without transcendental calls, and
     S = sqrt(D^2 + E^2 - F^2), the discriminant of spec §2.2.
@@ -100,7 +100,7 @@ def _arm(u, y, l1, l2, sigma):
     return True, (u * k - sigma * y * s) * inv, (y * k + sigma * u * s) * inv, s
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _arc_ok(p, k, c, s):
     """True if the angle with cosine c and sine s lies in arm limit k (slots p[k:k+6]), modulo 2 pi.
 
@@ -116,7 +116,7 @@ def _arc_ok(p, k, c, s):
     return after_lo and before_hi
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _kinematics(p, x, y, out, conditioning=True):
     """Slots 0-2 at P = (x, y) in the packed working mode: LCI (sigma_min/sigma_max of J), sigma_min and sigma_max
     of J = dx/dq (mm/rad); unreachable: write_unreachable. Returns (ok, cos, sin of alpha1, cos, sin of alpha2).
@@ -163,7 +163,7 @@ def kinematic_fields(p, x, y, z, out):
     _fields(p, x, y, out, False)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _leg_compliance(p, u, y, c, s):
     """Compliance (mm/N) of one RRR chain along its forearm, ideal joints: the forearm (a pinned bar) stretches,
     and the arm tip Q moves as a cantilever on a torsional actuator spring under the forearm force. Returns the
@@ -178,7 +178,7 @@ def _leg_compliance(p, u, y, c, s):
     return ex, ey, l2 / p[_EA2] + along * along * l1 / p[_EA1] + across * across * bend
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _stiffness(p, x, y, c1, s1, c2, s2):
     """(stiffness_min N/mm, deflection mm) at a reachable P, ideal joints: platform stiffness
     K = sum_i u_i u_i^T / c_i (u_i forearm unit vector, c_i its chain's compliance: a per-leg condensation), its
@@ -203,7 +203,7 @@ def _stiffness(p, x, y, c1, s1, c2, s2):
     return kmin, min(math.sqrt(dx * dx + dy * dy), DEFLECTION_CAP)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _clearance(p, x, y, c1, s1, c2, s2):
     """Smallest gap (mm) between the link capsules that share no joint (as in link_geometry): base B2-B1,
     arm_i B_i-Q_i, forearm_i Q_i-P and the platform ball at P; negative where two of them overlap."""
@@ -244,7 +244,7 @@ def point_reach(p, x, y, z, out):
         out[0] = -1.0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, out, stiffness):
     """point_fields, with the stiffness slots only when ``stiffness`` (a constant: each caller's copy keeps its
     branch)."""

@@ -166,7 +166,7 @@ def _jacobi_6x6(a):
     return min(smin / smax, 1.0), smin, smax
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _laguerre_step(w, x):
     """Laguerre step on p(x) = det(x I - T) (T: d = w[12], e^2 = w[13]), from p, p', p'' of the division-free
     three-term recurrence; 0 at a root (p == 0) or where the step is undefined."""
@@ -197,7 +197,7 @@ def _laguerre_step(w, x):
     return 6.0 / den
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _above(w, x):
     """Number of eigenvalues of T greater than x: the sign changes of the Sturm sequence det(x I_k - T_k), k = 0..6
     (the negative pivots of x I - T = L D L^T); -1 where a term is zero (or its product underflows), which fails
@@ -333,7 +333,7 @@ def _lci_6x6(a):
     return _sv_6x6(a)[0]
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _put_row(a, row, scale, gx, gy, gz, rx, ry, rz, inv_alen):
     """Row ``row`` of the scaled Jacobian: scale * [g, (r x g) / angle_length]."""
     a[row, 0] = scale * gx
@@ -345,7 +345,7 @@ def _put_row(a, row, scale, gx, gy, gz, rx, ry, rz, inv_alen):
     a[row, 5] = k * (rx * gy - ry * gx)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _force_flex(p, ll, lx, ly, lz, s, ax, ay, az, fax, fay, faz, fbx, fby, fbz, hax, hay, haz, hbx, hby, hbz, hk):
     """Flexibility f_a^T C f_b of a chain under two forces through C (see _chain_columns): the link (length ll,
     unit l, clamped at D), the column (length s, unit a, clamped at B; the force's moment about D is ll l x f) and
@@ -491,7 +491,7 @@ def _conditioning(p, conv_r, u3x, u3y, e3x, e3y, rho3, h3, mu3sq, mu3, lam1, k1,
     return _sv_work(a)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _capsule_gap(p, rail, u3x, u3y, b3x, b3y, p2x, p2y, s1, s2, d3x, d3y, d3z, c1x, c1y, c1z, c2x, c2y, c2z, c3x, c3y,
                  c3z):
     """Clearance (field 3, mm) of the capsules of link_geometry at one pose (_fields' points)."""
@@ -518,7 +518,7 @@ def _capsule_gap(p, rail, u3x, u3y, b3x, b3y, p2x, p2y, s1, s2, d3x, d3y, d3z, c
     return gap
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, stiffness, every=True, others=True):
     """LCI of the scaled twist Jacobian at O1 = (x, y, z) with the packed orientation and branch, or -1 if the
     IK is not real or an actuator leaves its limits (spec §1.3, §1.5, §1.8). 0 at a serial singularity.
@@ -650,7 +650,7 @@ def _fields(p, x, y, z, out, stiffness, every=True, others=True):
 _MAX_CUTS = 11  # candidate heights per column: 2 per stroke limit of chains 1, 2; 4 of s3; 2 of beta; h3 = 0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _put_cut(cuts, n, z, zlo, zhi):
     """Append the candidate height z to cuts[:n] if it lies strictly inside (zlo, zhi) (NaN never does)."""
     if zlo < z < zhi:

@@ -95,7 +95,7 @@ _R22_EPS = 1e-12
 
 
 # ----- point kernel ---------------------------------------------------------------------------------------
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _p_model_rows(g, h, c, e, z, st, ct, sp, cp):
     """Squared leg lengths and the rows of q_i dq_i/d(z, theta, psi) of the P-model, spec §2.3 and §2.5."""
     a = g * g + h * h + z * z - 2.0 * g * h * cp
@@ -114,7 +114,7 @@ def _p_model_rows(g, h, c, e, z, st, ct, sp, cp):
     return True, q1s, q2s, q3s, r11, r12, r13, r21, -r12, r23, r31, r32, 0.0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _yaw(st, ct, sp, cp):
     """The C-model's parasitic yaw phi = atan2(N, M), N = sin theta sin psi, M = cos psi: (ok, n = |(N, M)|, its sine
     sf = N/n and cosine cf = M/n, and the derivatives of n, sf, cf with respect to theta (_t) and psi (_p)); ok False
@@ -131,7 +131,7 @@ def _yaw(st, ct, sp, cp):
             -mm * n_t / n2, (-sp * n - mm * n_p) / n2)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _c_model_rows(g, h, c, e, upu, z, st, ct, sp, cp):
     """Squared leg lengths and the rows of q_i dq_i/d(z, theta, psi) of the C-model (spec §2.3).
 
@@ -226,20 +226,20 @@ def _clearance(p, y0, z, st, ct, sp, cp, sf, cf, pairs, tx, ty, tz, r_tool):
     return min_capsule_gap(seg, pairs, radius)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _leg_ok(qs, lo, hi):
     """(within limits, q) for a squared leg length; tiny negative round-off of a squared norm is clamped."""
     q = math.sqrt(qs) if qs > 0.0 else 0.0
     return lo <= q <= hi, q
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _singular_response(p):
     """(stiffness_min, deflection) at a singular or degenerate pose: 0 and the 1e12 cap (0 under no load)."""
     return 0.0, 0.0 if (p[_FX] == 0.0 and p[_FX + 1] == 0.0 and p[_FX + 2] == 0.0) else _legs_k.DEFLECTION_CAP
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _chain_columns(p, kk, ax, ay, az, bx, by, bz, f2x, f2y, f2z, m2x, m2y, m2z, rx, ry, rz):
     """K += W Phi^-1 W^T for one leg A -> B (ideal joints, the frame of stiffness_model): its two constraint
     wrenches at B are w1 = the force along the leg (it also loads the actuator spring) and w2 = (f2, m2) (N, N mm
@@ -355,7 +355,7 @@ def point_reach(p, x, y, z, out):
     _fields(p, x, y, z, out, False, False)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx, ry, rz):
     """(stiffness_min, deflection) at the constraint-consistent placement of (z, theta, psi): the configured
     C-model pose itself when ``placed`` (y0, sf, cf given), else the C-model pose with the configured chain-3
@@ -372,7 +372,7 @@ def _placement_stiffness(p, y0, z, st, ct, sp, cp, sf, cf, placed, at_origin, rx
     return _stiffness(p, upu, y0, z, st, ct, sp, cp, sf, cf, rx, ry, rz)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, stiffness, every=True, others=True):
     """LCI of the homogenised dq/d(z, L theta, L psi) at task point (x, y, z) = (z, theta, psi), or -1 when a leg
     length leaves the stroke limits or the parametrisation is degenerate (C-model). ``others`` False (a constant,
@@ -1284,7 +1284,7 @@ _D, _ZLO, _ZHI, _TLO, _THI, _PLO, _PHI, _RAD_TOOL = range(N_PACKED, N_PACKED + 8
 N_PACKED_TOOL = N_PACKED + 8
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _c_plane_tool(c, d, z, st, ct, sp, cp):
     """Tool point T = O' + R (0, 0, -d) of the C-model pose (z, theta, psi) with chain 3 'plane' (y0 = -c R[1, 0],
     yaw phi = atan2(sin theta sin psi, cos psi)) and its Jacobian dT/d(z, theta, psi) (rows T_x, T_y, T_z), as
@@ -1368,7 +1368,7 @@ def tool_point_reach(p, x, y, z, out):
     _tool_fields(p, x, y, z, out, False, False)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _tool_fields(p, x, y, z, out, stiffness, every=True, others=True):
     """LCI of dq/dT (dimensionless) at tool point T = (x, y, z) mm of the P-model, principal branch
     (cos theta > 0, cos psi > 0), or -1 when T is out of reach of that branch, its pose leaves the z/theta/psi
@@ -1460,7 +1460,7 @@ def _tool_fields(p, x, y, z, out, stiffness, every=True, others=True):
 
 
 # ----- reachable intervals of a z-column of the tool workspace (closed form) ------------------------------
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _monic_roots(b, c):
     """(real, r1, r2): the roots r1 <= r2 of z^2 + 2 b z + c, the larger-magnitude one first and the other as
     c / it (no cancellation); real False when there are none."""
@@ -1474,7 +1474,7 @@ def _monic_roots(b, c):
     return True, min(t, r), max(t, r)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _leg_window(b, c, lo, hi, shift, lower, upper):
     """One leg whose squared length is z0^2 + 2 b z0 + c (mm^2) at platform height z0 = z + shift (mm), stroke
     [lo, hi] (mm, +-inf = no limit), as _leg_ok decides it: (lower, upper, ex_lo, ex_hi), the window
@@ -1539,7 +1539,7 @@ def _tool_column_intervals(p, x, y, zlo, zhi, out):
     return _sweep_window(lower, upper, a1, b1, a2, b2, a3, b3, out)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _sweep_window(lower, upper, a1, b1, a2, b2, a3, b3, out):
     """The window [lower, upper] minus the open intervals (a_i, b_i) ((inf, inf): none) as sorted closed intervals
     in out[:k]; returns k, or -1 when out has too few rows."""

@@ -85,7 +85,7 @@ _F_STIFFNESS_MIN, _F_DEFLECTION = 3, 4  # slots of the stiffness fields in the f
 _F_CLEARANCE = 5  # slot of the clearance field
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _ups_row(ax, ay, bx, by, sa, ca, sb, cb, px, py, pz, rho, yy):
     """Length and (d l/d alpha, d l/d beta, d l/d Y) of the UPS leg from A = (ax, ay, 0) to B = P + R (bx, by, 0).
 
@@ -121,7 +121,7 @@ def point_reach(p, alpha, beta, yy, out):
         out[0] = -1.0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _kinematics(p, alpha, beta, yy, out, conditioning=True):
     """Slots 0-2 at task point (alpha [rad], beta [rad], Y [mm]): LCI if it lies in the workspace box with every
     actuator length within its limits, else -1 (write_unreachable). LCI = 1/kappa_2 of dl/d(alpha, beta, Y) with the
@@ -203,7 +203,7 @@ def point_fields(p, alpha, beta, yy, out):
     _fields(p, alpha, beta, yy, out, True)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, alpha, beta, yy, out, stiffness, others=True):
     """point_fields, with the stiffness slots only when ``stiffness`` (a constant: each caller's copy keeps its
     branch); ``others`` False (a constant, lci_fields): slot 0 alone."""
@@ -358,7 +358,7 @@ def _stiffness(p, sa, ca, sb, cb, px, py, pz, lmax):
 _MAX_BREAKS = 12
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _leg_crossings(q, u, w, c, lower, upper, brk, n):
     """Append to brk[n:] each Y in (lower, upper) (mm) where q + 2 u Y + 2 w rho(Y) = 0, rho = sqrt(c^2 - Y^2):
     a UPS leg's squared length minus a stroke limit squared, q = K - limit^2 (mm^2). Isolating the root and
@@ -381,7 +381,7 @@ def _leg_crossings(q, u, w, c, lower, upper, brk, n):
     return n
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _column_reach(p, c, am, e2x, e2y, e2z, e3x, e3y, e3z, sb, cb, yy):
     """_kinematics' limit checks at Y = yy (mm) inside the column's window (|Y| < c): l1 and the squared lengths of
     legs 2, 3 from their offsets e = R B' - A (mm) (d = P + e), as _kinematics computes them up to rounding."""

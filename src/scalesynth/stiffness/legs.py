@@ -46,7 +46,7 @@ DEFLECTION_CAP = SIGMA_CAP  # length unit: the per-voxel deflection at a singula
 DEPENDENT_RTOL = 1e-9
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _unit(x, y, z):
     n = math.sqrt(x * x + y * y + z * z)
     if n > 0.0:
@@ -55,7 +55,7 @@ def _unit(x, y, z):
     return 0.0, 0.0, 0.0, 0.0
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def beam_frame(ax, ay, az, bx, by, bz, upx, upy, upz):
     """Local axes of the beam a -> b: ex along it, ey = ``up`` made orthogonal to ex, ez = ex x ey (as the
     reference solver); returns (ex, ey, ez as 9 floats, length). A beam of zero length, or an ``up`` along it,
@@ -106,7 +106,7 @@ def add_beam_compliance(C, ax, ay, az, bx, by, bz, upx, upy, upz, ea, eiy, eiz, 
     return True
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _cross_rows(m, dx, dy, dz, out):
     """out = [d]x m for a 3x3 m ([d]x v = d x v)."""
     for j in range(3):
@@ -383,7 +383,7 @@ def platform_response(K, fx, fy, fz, length):
                      K[5, 5], fx, fy, fz, length)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def outer_add(k, a0, a1, a2, a3, a4, a5):
     """k + a a^T for the 21 upper entries k of a symmetric 6x6 matrix (a tuple, row-major: 00, 01, ..., 05, 11, ...,
     55): a kernel sums its legs' wrench columns a into K in scalars and hands k to response_upper."""
@@ -393,7 +393,7 @@ def outer_add(k, a0, a1, a2, a3, a4, a5):
             k[15] + a3 * a3, k[16] + a3 * a4, k[17] + a3 * a5, k[18] + a4 * a4, k[19] + a4 * a5, k[20] + a5 * a5)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def response_upper(k, fx, fy, fz, length):
     """:func:`platform_response` of the symmetric K given by its 21 upper entries k (row-major: 00, 01, ..., 05,
     11, ..., 55), for kernels that assemble K in scalars."""
@@ -401,7 +401,7 @@ def response_upper(k, fx, fy, fz, length):
                      k[15], k[16], k[17], k[18], k[19], k[20], fx, fy, fz, length)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def response_translational(k00, k01, k02, k11, k12, k22, fx, fy, fz):
     """:func:`platform_response` of a platform whose rotations are held rigidly (only translations are DOFs, e.g.
     seed 000's PPaP chain): K is the symmetric 3x3 translational stiffness given by its upper entries (N/length).
@@ -411,7 +411,7 @@ def response_translational(k00, k01, k02, k11, k12, k22, fx, fy, fz):
     return _stiffness_3x3_response(k00, k01, k02, k11, k12, k22, fx, fy, fz, k00 + k11 + k22)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _stiffness_3x3_response(s00, s01, s02, s11, s12, s22, fx, fy, fz, trace):
     """(stiffness_min, deflection) of the symmetric 3x3 translational stiffness S (upper entries): 1/lambda_max(S^-1)
     and |S^-1 F| capped at DEFLECTION_CAP; singular (0, DEFLECTION_CAP, or 0 deflection under no load) when S is not
@@ -430,14 +430,14 @@ def _stiffness_3x3_response(s00, s01, s02, s11, s12, s22, fx, fy, fz, trace):
     return 1.0 / cmax, min(math.sqrt(dx * dx + dy * dy + dz * dz), DEFLECTION_CAP)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def sym3_inverse(a00, a01, a02, a11, a12, a22):
     """(ok, inverse entries 00, 01, 02, 11, 12, 22) of a symmetric positive definite 3x3 matrix (ok False if it
     is not), for kernels that invert a small stiffness in scalars."""
     return _sym3_inverse(a00, a01, a02, a11, a12, a22)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _sym3_inverse(a00, a01, a02, a11, a12, a22):
     """(ok, inverse entries 00, 01, 02, 11, 12, 22) of a symmetric 3x3 matrix by its adjugate; ok False unless it
     is positive definite (leading minors > 0)."""
@@ -452,7 +452,7 @@ def _sym3_inverse(a00, a01, a02, a11, a12, a22):
             (a00 * a11 - a01 * a01) * inv)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _response(t00, t01, t02, t11, t12, t22, c00, c01, c02, c10, c11, c12, c20, c21, c22, r00, r01, r02, r11, r12,
               r22, fx, fy, fz, length):
     """platform_response from the blocks of K: tt (upper entries), tr (c_ij = K[i, 3 + j]) and rr (upper)."""
@@ -480,7 +480,7 @@ def _response(t00, t01, t02, t11, t12, t22, c00, c01, c02, c10, c11, c12, c20, c
     return _stiffness_3x3_response(s00, s01, s02, s11, s12, s22, fx, fy, fz, tr)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22):
     """Largest eigenvalue of the symmetric 3x3 matrix [[a00, a01, a02], [a01, a11, a12], [a02, a12, a22]] by the
     trigonometric solution of its characteristic cubic (well conditioned for the largest root)."""
@@ -503,7 +503,7 @@ def sym3_max_eigenvalue(a00, a01, a02, a11, a12, a22):
     return q + 2.0 * p * math.cos(math.acos(r) / 3.0)
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def tip_bilinear(length, ea, ei, gj, ex, ey, ez, f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z):
     """w1^T C w2 for two wrenches w = (F, M) at the tip of a round-section cantilever (length, unit axis e from
     the clamp to the tip; EA, EI, GJ): C's translations (L/EA) e e^T + (L^3/3EI)(I - e e^T), rotations

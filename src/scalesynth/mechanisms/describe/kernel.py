@@ -59,7 +59,7 @@ N_PACKED = HEAD + N_LEGS * STRIDE
 TWO_PI = 2.0 * math.pi
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _leg(p, k, x, y, z):
     """One leg at platform centre P = (x, y, z), block from p[k]: (ok, fx, fy, fz, jq, q) with (fx, fy, fz) the
     forearm direction (unit), jq = f . t / l (per unit forearm length) and q the actuated joint value; ok False when
@@ -128,7 +128,7 @@ def _leg(p, k, x, y, z):
     return True, fx * inv, fy * inv, fz * inv, jq * inv, q
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, conditioning):
     """Slots 0-2 (LCI, sigma_min, sigma_max of dx/dq) at P, or write_unreachable; ``conditioning`` (a constant)
     False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel)."""

@@ -65,7 +65,7 @@ JACOBI_TOL = 1e-15  # columns count as orthogonal when |c_i . c_j| <= JACOBI_TOL
 JACOBI_SWEEPS = 60
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _leg(p, k, x, y, z):
     """One leg at platform centre P = (x, y, z), block from p[k]: (ok, fx, fy, fz, jq, q, square): f the unit rod or
     leg direction, jq = f . t per unit rod length (UPS: 1), q the actuated joint value and square True where the
@@ -135,7 +135,7 @@ def _leg(p, k, x, y, z):
     return True, fx, fy, fz, 1.0, q, False
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _jacobi_extremes(g):
     """(s_min, s_max) of the 6 x 6 matrix g by one-sided Jacobi: rotate pairs of columns until every pair is
     orthogonal; the singular values are then the columns' norms. g is overwritten."""
@@ -178,7 +178,7 @@ def _jacobi_extremes(g):
     return smin, smax
 
 
-@njit(cache=True, fastmath=FASTMATH, inline="always")
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, conditioning):
     """Slots 0-2 (LCI, sigma_min, sigma_max of the homogenised dx/dq) at P, or write_unreachable; ``conditioning``
     (a constant) False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel)."""
