@@ -207,11 +207,12 @@ def _finite_difference_velocity_map(solve, pose, h=1e-6):
 ])
 def test_the_adept_cycle_runs_through_the_cli(tmp_path, config, solve):
     """`scalesynth cycle` on the shipped config: exit 0, cycle.csv with every column, finite forces; at the first
-    sample (at rest: poly345 starts with zero acceleration) the actuator forces hold the 1 kg payload's weight:
-    A^T tau = m g_up with A = dq/dx from finite differences of the independent IK."""
+    sample (at rest: poly345 starts with zero acceleration) the actuator forces of massless links
+    (dynamics.masses {}) hold the 1 kg payload's weight: A^T tau = m g_up with A = dq/dx from finite differences of
+    the independent IK."""
     out = tmp_path / "cyc"
     res = CliRunner().invoke(app, ["cycle", str(ROOT / "configs" / config), "--set", "cycle.samples=80",
-                                   "--out", str(out)])
+                                   "--set", "dynamics.masses={}", "--out", str(out)])
     assert res.exit_code == 0, res.output
     assert {p.name for p in out.iterdir()} >= {"cycle.csv", "cycle.json", "actuators.png", "path.png"}
     data = np.genfromtxt(out / "cycle.csv", delimiter=",", names=True)

@@ -266,17 +266,16 @@ def test_delta_cycle_forces_match_pinocchio(tmp_path):
         assert _rel(cols[f"force{i + 1}"], tau[:, i]) < 1e-6, f"force{i + 1}"
 
 
-def _fivebar_against_pinocchio(tmp_path, masses: dict | None) -> None:
+def _fivebar_against_pinocchio(tmp_path, masses: dict) -> None:
     """configs/fivebar_pnp_cycle.yaml (adept cycle, 1 kg payload, gravity -y, 40 samples) with ``masses`` as
-    dynamics.masses (None: no dynamics section, i.e. massless links): every sample's force<i> (N m) against the
-    Pinocchio closed chain's arm torque, 1e-6 relative to each actuator's peak; Pinocchio's arm rates against
+    dynamics.masses ({}: massless links; without a dynamics section the links weigh what their sections do): every
+    sample's force<i> (N m) against the Pinocchio closed chain's arm torque, 1e-6 relative to each actuator's peak; Pinocchio's arm rates against
     cycle.csv's qd, qdd."""
     data = _config("fivebar_pnp_cycle.yaml")
-    if masses is not None:
-        data["dynamics"] = {"masses": masses}
+    data["dynamics"] = {"masses": masses}
     data["cycle"]["samples"] = 40
     cols = _cycle_csv(tmp_path, data)
-    mass = {"arm": 0.0, "forearm": 0.0, "platform": 0.0, **(masses or {})}
+    mass = {"arm": 0.0, "forearm": 0.0, "platform": 0.0, **masses}
     mm = 1e-3
     r, l1, l2 = (data["design"][k] * mm for k in ("r", "l1", "l2"))
     g = np.asarray(data["cycle"]["gravity"], float)
@@ -296,9 +295,9 @@ def _fivebar_against_pinocchio(tmp_path, masses: dict | None) -> None:
 
 
 def test_fivebar_payload_only_cycle_forces_match_pinocchio(tmp_path):
-    """Without dynamics.masses (no dynamics section) the links are massless: the payload-only force model of
-    docs/cycles.md against Pinocchio with massless links and the 1 kg payload at P."""
-    _fivebar_against_pinocchio(tmp_path, None)
+    """dynamics.masses {} makes every link massless: the payload-only force model of docs/cycles.md against
+    Pinocchio with massless links and the 1 kg payload at P."""
+    _fivebar_against_pinocchio(tmp_path, {})
 
 
 def test_fivebar_cycle_forces_match_pinocchio(tmp_path):

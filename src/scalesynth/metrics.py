@@ -39,6 +39,24 @@ STATISTICS = ("mean", "std", "min", "max")
 WORST_BOUNDING_BOX = "bounding_box"  # measure of the bounding box of the largest design within the bounds
 WORST_BOUNDS_CORNERS = "bounds_corners"  # largest value over the corners of the optimisation bounds
 
+# what `scalesynth design` compares and its datasheet shows (scalesynth.design): requirement -> (metric, sense of
+# the bound, label); the columns of a comparison, metric -> (label, is a length); the datasheet's dexterity rows
+DESIGN_REQUIREMENTS = {
+    "envelope": ("task_coverage", "min", "reaches the whole working zone"),
+    "cycle": ("cycle_feasible", "min", "follows the cycle without singularity"),
+    "rate": ("picks_per_minute", "min", "picks per minute"),
+    "deflection": ("task_max_deflection", "max", "deflection under the spec's force"),
+}
+DESIGN_COLUMNS = {"link_length_sum": ("link length sum", True), "footprint_radius": ("footprint radius", True),
+                  "task_gci": ("task GCI", False), "task_min_lci": ("task min LCI", False),
+                  "task_max_deflection": ("max deflection", True), "picks_per_minute": ("picks/min", False),
+                  "cycle_time_s": ("cycle time s", False),
+                  "motor_peak_torque_ratio": ("peak torque / motor peak", False),
+                  "motor_rms_torque_ratio": ("RMS torque / motor rated", False),
+                  "motor_speed_ratio": ("speed / motor max", False)}
+DATASHEET_DEXTERITY = (("task_gci", "task GCI (mean LCI over the zone)"),
+                       ("task_min_lci", "smallest LCI over the zone"), ("gci", "workspace GCI"))
+
 # the LCI statistics keep the names the dexterity literature uses
 _LCI_NAMES = {"mean": "gci", "std": "fci", "min": "min_lci", "max": "max_lci"}
 _STAT_WORDS = {"mean": "mean", "std": "standard deviation", "min": "minimum", "max": "maximum"}

@@ -14,23 +14,13 @@ from typing import Any
 
 import numpy as np
 
+from scalesynth import metrics
 from scalesynth.cycle.config import METRES_PER_UNIT
 from scalesynth.design.spec import DesignSpec
 
-# requirement -> (metric, sense of the bound, label)
-REQUIREMENTS = {
-    "envelope": ("task_coverage", "min", "reaches the whole working zone"),
-    "cycle": ("cycle_feasible", "min", "follows the cycle without singularity"),
-    "rate": ("picks_per_minute", "min", "picks per minute"),
-    "deflection": ("task_max_deflection", "max", "deflection under the spec's force"),
-}
-# columns shown per design: metric name -> (label, a length?)
-SHOWN = {"link_length_sum": ("link length sum", True), "footprint_radius": ("footprint radius", True),
-         "task_gci": ("task GCI", False), "task_min_lci": ("task min LCI", False),
-         "task_max_deflection": ("max deflection", True), "picks_per_minute": ("picks/min", False),
-         "cycle_time_s": ("cycle time s", False), "motor_peak_torque_ratio": ("peak torque / motor peak", False),
-         "motor_rms_torque_ratio": ("RMS torque / motor rated", False),
-         "motor_speed_ratio": ("speed / motor max", False)}
+# the requirements and columns a comparison shows (the catalogue module keeps every metric name)
+REQUIREMENTS = metrics.DESIGN_REQUIREMENTS
+SHOWN = metrics.DESIGN_COLUMNS
 
 
 def _num(v) -> float | None:

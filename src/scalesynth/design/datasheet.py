@@ -111,7 +111,7 @@ def _rate_rows(cfg, design) -> list[tuple[str, str]]:
 def build(result, row: int, spec=None, label: str | None = None) -> str:
     """The datasheet page (HTML text) of row ``row`` of a run's front."""
     from scalesynth.design.export import default_pose, geometry_at
-    from scalesynth.metrics import catalogue
+    from scalesynth.metrics import DATASHEET_DEXTERITY, catalogue
 
     cfg = result.cfg
     mech = cfg.mech
@@ -183,9 +183,7 @@ def build(result, row: int, spec=None, label: str | None = None) -> str:
         ("Peak speed and acceleration (over the cycle)", peaks),
         ("Motor and gear", motor_rows),
         ("Stiffness", [("largest deflection over the zone", defl_text)]),
-        ("Dexterity", [("task GCI (mean LCI over the zone)", _fmt(value("task_gci"))),
-                       ("smallest LCI over the zone", _fmt(value("task_min_lci"))),
-                       ("workspace GCI", _fmt(value("gci")))]),
+        ("Dexterity", [(text, _fmt(value(name))) for name, text in DATASHEET_DEXTERITY]),
         ("Mass", [("moving mass", f"{not_eval}: " + ("the run has no dynamics section"
                                                      if "picks_per_minute" in cat else "no mass model"))]),
     ]
