@@ -16,7 +16,8 @@ from scalesynth.errors import ScalesynthError
 from conftest import ROOT
 
 CONFIGS = {"planar-fivebar": "fivebar_packing", "pprs-rprs": "pprs_rprs", "2pauu-ppap": "paper_2pauu_ppap",
-           "rps-upu-tool": "rps_upu_tool", "rps-upu": "rps_upu", "ups-sspr": "ups_sspr"}
+           "rps-upu-tool": "rps_upu_tool", "rps-upu": "rps_upu", "ups-sspr": "ups_sspr", "hexa": "hexa",
+           "hexapod": "hexapod"}
 
 
 def _cfg(name):

@@ -10,9 +10,11 @@ each task axis (step 1e-5 of the mechanism's size, or 1e-5 rad); e_dd = (de/dx) 
 term by a second difference of e along x_d (the pose moving by 1e-4 of its scale): both from the motion law's
 analytic x_d, x_dd, so accurate to about 1e-7 relative on smooth laws.
 
-A mechanism whose task holds degrees of freedom constant (pprs-rprs: the platform orientation; velocity_map has
-columns past the task axes) needs the endpoints' derivatives along those too: ``held_link_points`` when the
-mechanism provides it, else the links' generalised force on them is taken as 0 (docs/cycles.md).
+A mechanism whose task holds degrees of freedom constant (the platform orientation of pprs-rprs and the 6-DOF
+described mechanisms; velocity_map has columns past the task axes) needs the endpoints' derivatives along those
+too: the generalised force on held axis j is M_j = sum_e (de/dtheta_j) . f_e (virtual work of a virtual turn at
+fixed position), from the mechanism's ``held_link_jacobian`` where it has one (the 6-DOF ones), and A^T tau =
+[F; M]; without it M is taken as 0 (pprs-rprs, docs/cycles.md).
 """
 
 from __future__ import annotations
@@ -78,17 +80,39 @@ def endpoint_motion(mech, design, options, p, pd, pdd, label: str, size: float):
     return e[:, 2 * k + 1], jac, vel, acc
 
 
+def endpoint_forces(a_si: np.ndarray, masses: np.ndarray, g3: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rods' endpoint forces f (n, s, 2, 3), N, from endpoint accelerations (n, s, 2, 3) m/s^2, masses (s,) kg
+    and gravity g3 (3,) m/s^2, and their weight part (1, s, 3) per endpoint."""
+    m6 = masses[None, :, None] / 6.0
+    weight = -0.5 * masses[None, :, None] * g3[None, None, :]
+    f = np.stack([m6 * (2.0 * a_si[:, :, 0] + a_si[:, :, 1]) + weight,
+                  m6 * (a_si[:, :, 0] + 2.0 * a_si[:, :, 1]) + weight], axis=2)
+    return f, weight
+
+
+def held_forces(mech, design, options, p: np.ndarray, acc: np.ndarray, masses: np.ndarray, g3: np.ndarray,
+                label: str, length_unit: str) -> tuple[np.ndarray, np.ndarray]:
+    """The links' generalised moments on the held rotations (n, r) N m and their gravity part (n, r), from the
+    mechanism's held_link_jacobian (n, r, s, 2, 3) and the endpoint accelerations (n, s, 2, 3; length unit per
+    s^2); (n, 0) arrays for a mechanism without one."""
+    n = len(p)
+    if not hasattr(mech, "held_link_jacobian"):
+        return np.zeros((n, 0)), np.zeros((n, 0))
+    m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
+    jh = mech.held_link_jacobian(design, options, p, label) * m_per_unit  # m per rad
+    f, weight = endpoint_forces(acc * m_per_unit, masses, g3)
+    M = np.einsum("nrsec,nsec->nr", jh, f)
+    M_g = np.einsum("nrsec,sec->nr", jh, np.broadcast_to(weight[0][:, None, :], f.shape[1:]))
+    return M, M_g
+
+
 def generalised_forces(mech, jac: np.ndarray, acc: np.ndarray, masses: np.ndarray, g3: np.ndarray,
                        length_unit: str) -> tuple[np.ndarray, np.ndarray]:
     """The links' generalised force on the task axes (n, k) and its gravity part (n, k): N along a length axis,
     N m about an angle axis, from the Jacobians (n, k, s, 2, 3), endpoint accelerations (n, s, 2, 3; length unit
     per s^2), segment masses (s,) kg and gravity g3 (3,) m/s^2."""
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
-    a_si = acc * m_per_unit
-    m6 = masses[None, :, None] / 6.0
-    weight = -0.5 * masses[None, :, None] * g3[None, None, :]  # (1, s, 3) per endpoint
-    f = np.stack([m6 * (2.0 * a_si[:, :, 0] + a_si[:, :, 1]) + weight,
-                  m6 * (a_si[:, :, 0] + 2.0 * a_si[:, :, 1]) + weight], axis=2)  # (n, s, 2, 3)
+    f, weight = endpoint_forces(acc * m_per_unit, masses, g3)
     col = np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])
     jac_si = jac * col[None, :, None, None, None]  # m per m or m per rad
     F = np.einsum("nksec,nsec->nk", jac_si, f)
@@ -97,7 +121,8 @@ def generalised_forces(mech, jac: np.ndarray, acc: np.ndarray, masses: np.ndarra
 
 
 def actuator_forces(mech, A_si: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """tau (n, n_joints) with A_si^T tau = [F; 0] (F (n, k) on the task axes, SI)."""
+    """tau (n, n_joints) with A_si^T tau = [F; 0] (F (n, k') on the task axes and any held axes after them, SI;
+    the rest 0)."""
     n, nj = A_si.shape[:2]
     full = np.zeros((n, nj))
     full[:, : F.shape[1]] = F
@@ -120,10 +145,13 @@ def link_forces(mech, design, options, cyc, traj, label: str, size: float, A_si:
     if not np.any(masses):
         return np.zeros((n, nj)), np.zeros((n, nj)), np.zeros((n, k))
     _, jac, _, acc = endpoint_motion(mech, design, options, traj.p, traj.pd, traj.pdd, label, size)
-    F, F_g = generalised_forces(mech, jac, acc, masses, frame_gravity(cyc, mech), length_unit)
-    if not np.all(np.isfinite(F)):
+    g3 = frame_gravity(cyc, mech)
+    F, F_g = generalised_forces(mech, jac, acc, masses, g3, length_unit)
+    M, M_g = held_forces(mech, design, options, traj.p, acc, masses, g3, label, length_unit) if nj > k else (
+        np.zeros((n, 0)), np.zeros((n, 0)))
+    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(M))):
         from scalesynth.errors import InvalidPose
 
         raise InvalidPose("cycle: a sample lies on the boundary of the workspace (the links' motion is not defined "
                           "around it)")
-    return actuator_forces(mech, A_si, F), actuator_forces(mech, A_si, F_g), F
+    return (actuator_forces(mech, A_si, np.hstack([F, M])), actuator_forces(mech, A_si, np.hstack([F_g, M_g])), F)

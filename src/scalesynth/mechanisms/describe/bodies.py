@@ -13,10 +13,18 @@ the carriage's cross direction) and h half the leg's parallelogram ``width``:
 * ``base``: the closed polygon through the legs' base points B_i; ``platform``: the closed polygon through the
   platform joints Q_i +- h n_i, in angular order about P.
 
+6-DOF legs (sixdof.py), with Q = P + R r the platform joint at the options' orientation R:
+
+* RUS / R-SS: ``upper_arm<i>`` the arm B -> E, ``rod<i>`` the rod E -> Q (one bar);
+* UPS / SPS: ``leg<i>`` the whole leg B -> Q as one body (a telescoping actuator modelled as one rod stretching
+  uniformly between its joints: the dynamics gives it a constant mass; the stiffness frame splits it into a
+  cylinder and a piston, frame6.py);
+* ``base`` and ``platform`` the closed polygons through the B_i and the Q_i, as above.
+
 A body's *group* is its name without the leg number (``Segment.group``): upper_arm, forearm, carriage, rail,
-base, platform. Adjacent (sharing a joint): base-upper_arm, upper_arm-forearm, base-rail, rail-carriage,
-carriage-forearm, forearm-platform, and rail-forearm of one leg: the model puts the carriage's joint on the
-rail's line, so that pair would always touch.
+rod, leg, base, platform. Adjacent (sharing a joint): base-upper_arm, upper_arm-forearm, base-rail, rail-carriage,
+carriage-forearm, forearm-platform, upper_arm-rod, rod-platform, base-leg, leg-platform, and rail-forearm of one
+leg: the model puts the carriage's joint on the rail's line, so that pair would always touch.
 
 Capsule radii: option ``link_radius`` (a number, or a mapping of groups or bodies to radii, a body's entry
 winning over its group's), defaults DEFAULT_RADII_M in metres, converted to the description's length unit.
@@ -33,13 +41,14 @@ import numpy as np
 from scalesynth.errors import InvalidParameter
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.describe import kernel as _k
+from scalesynth.mechanisms.describe import kernel6 as _k6
 
 # capsule radii (m) when link_radius does not give them: illustrative, a mid-size Delta's
 DEFAULT_RADII_M = {"base": 0.04, "upper_arm": 0.025, "forearm": 0.01, "platform": 0.02, "rail": 0.02,
-                   "carriage": 0.03}
+                   "carriage": 0.03, "rod": 0.01, "leg": 0.025}
 UNITS_PER_M = {"m": 1.0, "dm": 10.0, "cm": 100.0, "mm": 1000.0}
 LINK_RADIUS_DOC = ("capsule radius of every body, or {group or body: radius} (groups upper_arm, forearm, carriage, "
-                   "rail, base, platform); null = defaults (docs/describing.md)")
+                   "rail, rod, leg, base, platform); null = defaults (docs/describing.md)")
 # options every described mechanism has, whatever its description declares (schema refuses them as names)
 RESERVED_OPTIONS = ("link_radius", "youngs_modulus", "poisson_ratio", "tube", "sections", "actuator_stiffness", "load")
 
@@ -48,6 +57,10 @@ def leg_bodies(code: float, i: int) -> tuple[str, ...]:
     """The moving bodies of leg i (1-based) of leg type ``code`` (kernel codes), base side first."""
     if code == _k.R_PA:
         return (f"upper_arm{i}", f"forearm{i}")
+    if code == _k6.RUS:
+        return (f"upper_arm{i}", f"rod{i}")
+    if code == _k6.UPS:
+        return (f"leg{i}",)
     return (f"rail{i}", f"carriage{i}", f"forearm{i}")
 
 
@@ -133,6 +146,32 @@ def link_geometry(legs, widths: Sequence[float], rad: Mapping[str, float], pose,
     order = {b: n for n, b in enumerate(body_names([leg.type.code for leg in legs]))}
     segs.sort(key=lambda s: order[s.body])  # stable: a body's segments stay in the order written
     return links.LinkGeometry(tuple(segs), links.adjacency(pairs))
+
+
+def link_geometry6(legs, rad: Mapping[str, float], pose, rot: np.ndarray, q) -> links.LinkGeometry:
+    """Capsules and adjacency of a 6-DOF mechanism (module docstring) at platform centre ``pose`` and orientation
+    ``rot`` (3 x 3) with joint values ``q``; ``legs``: sixdof.Leg6 of the resolved design."""
+    p = np.asarray(pose, dtype=float)
+    segs: list[links.Segment] = []
+    pairs: list[tuple[str, str]] = []
+    base_pts, plat_pts = [], []
+    for i, (leg, qi) in enumerate(zip(legs, q, strict=True), 1):
+        jq = p + rot @ leg.r
+        base_pts.append(leg.base)
+        plat_pts.append(jq)
+        if leg.rus:
+            e = leg.actuated_point(float(qi))
+            segs += [links.Segment(f"upper_arm{i}", f"upper_arm{i}", leg.base.copy(), e, rad[f"upper_arm{i}"]),
+                     links.Segment(f"rod{i}", f"rod{i}", e.copy(), jq, rad[f"rod{i}"])]
+            pairs += [("base", f"upper_arm{i}"), (f"upper_arm{i}", f"rod{i}"), (f"rod{i}", "platform")]
+        else:
+            segs.append(links.Segment(f"leg{i}", f"leg{i}", leg.base.copy(), jq, rad[f"leg{i}"]))
+            pairs += [("base", f"leg{i}"), (f"leg{i}", "platform")]
+    ring = [links.Segment(f"base{k}", "base", a, b, rad["base"])
+            for k, (a, b) in enumerate(_ring(base_pts, np.mean(base_pts, axis=0)), 1)]
+    ring_p = [links.Segment(f"platform{k}", "platform", a, b, rad["platform"])
+              for k, (a, b) in enumerate(_ring(plat_pts, p), 1)]
+    return links.LinkGeometry(tuple(ring + segs + ring_p), links.adjacency(pairs))
 
 
 def _ring(points, centre) -> list[tuple[np.ndarray, np.ndarray]]:

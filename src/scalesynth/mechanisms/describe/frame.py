@@ -37,7 +37,7 @@ STIFFNESS_OPTIONS = ("youngs_modulus", "poisson_ratio", "tube", "sections", "act
 class StiffnessSpec(BaseModel):
     """A description's ``stiffness:`` block: the defaults of the stiffness options (null = the shared default:
     aluminium 70 GPa, nu 0.33, a 40 x 3 mm tube; actuators 1e5 N m/rad rotary, 2e7 N/m linear). Lengths in the
-    description's length unit; ``sections`` by link group (upper_arm, forearm)."""
+    description's length unit; ``sections`` by link group (upper_arm, forearm; 6-DOF: upper_arm, rod or leg)."""
 
     model_config = ConfigDict(extra="forbid")
 
@@ -48,9 +48,13 @@ class StiffnessSpec(BaseModel):
     actuator_stiffness: float | None = Field(None, description="N length/rad (rotary) or N/length (linear)")
 
 
-def link_groups(rotary: bool) -> tuple[str, ...]:
-    """The elastic link groups of the frame."""
-    return ("upper_arm", "forearm") if rotary else ("forearm",)
+def link_groups(code: float) -> tuple[str, ...]:
+    """The elastic link groups of the frame of a mechanism whose legs have type code ``code`` (kernel codes)."""
+    from scalesynth.mechanisms.describe import kernel as _k
+    from scalesynth.mechanisms.describe import kernel6 as _k6
+
+    return {_k.R_PA: ("upper_arm", "forearm"), _k.P_PA: ("forearm",), _k6.RUS: ("upper_arm", "rod"),
+            _k6.UPS: ("leg",)}[code]
 
 
 def options(spec: StiffnessSpec | None, length_unit: str, rotary: bool):
@@ -95,7 +99,7 @@ def stiffness_model(mech, design: Mapping[str, float], opts: Mapping[str, Any], 
                                    "parallelogram's width > 0 (one bar would leave the platform free to turn)")
     rotary = legs[0].type.code == _k.R_PA
     unit_name = mech.default_length_unit
-    fb = FrameBuilder({g: tube_section(opts, g, unit_name) for g in link_groups(rotary)}, joints)
+    fb = FrameBuilder({g: tube_section(opts, g, unit_name) for g in link_groups(legs[0].type.code)}, joints)
     k = opts["actuator_stiffness"]
     bodies = [Body("base", np.zeros(3))]
     for i, (leg, qi, w) in enumerate(zip(legs, q, ws, strict=True), 1):
@@ -129,15 +133,18 @@ def stiffness_model(mech, design: Mapping[str, float], opts: Mapping[str, Any], 
     return fb.model(unit_name, bodies, opts["load"], notes)
 
 
-def check_spec(spec: StiffnessSpec | None, length_unit: str, rotary: bool) -> None:
+def check_spec(spec: StiffnessSpec | None, length_unit: str, code: float) -> None:
     """A description's ``stiffness:`` block checked as the options it sets; ConfigError 'stiffness.<field>: ...'."""
     from scalesynth.errors import ConfigError, InvalidParameter
     from scalesynth.stiffness.sections import check_stiffness_options
 
     if spec is None:
         return
+    from scalesynth.mechanisms.describe.legs import LEG_TYPES
+
+    rotary = next(lt for lt in LEG_TYPES.values() if lt.code == code).joint_unit == "angle"
     values = {o.name: o.default for o in options(spec, length_unit, rotary)}
     try:
-        check_stiffness_options(values, 3, link_groups(rotary))
+        check_stiffness_options(values, 3, link_groups(code))
     except InvalidParameter as err:
         raise ConfigError(str(err).replace("options.", "stiffness.", 1)) from None

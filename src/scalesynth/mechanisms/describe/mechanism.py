@@ -91,9 +91,8 @@ class DescribedMechanism(Mechanism):
 
     # ----- options and packing ------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
-        if self.description.motion == "3T":  # the bodies and stiffness frame of Pa legs (bodies.py, frame.py)
-            bodies.check_link_radius(options, self._codes())
-            check_stiffness_options(options, 3, frame.link_groups(self._codes()[0] == _k.R_PA))
+        bodies.check_link_radius(options, self._codes())
+        check_stiffness_options(options, 3, frame.link_groups(self._codes()[0]))
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":

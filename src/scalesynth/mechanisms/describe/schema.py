@@ -205,7 +205,7 @@ def _check(desc: Description) -> None:
         count += leg.pattern.count if leg.pattern else 1
     from scalesynth.mechanisms.describe.frame import check_spec
 
-    check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].joint_unit == "angle")
+    check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].code)
     need = LEG_COUNT[desc.motion]
     if count != need:
         raise ConfigError(f"legs: motion {desc.motion} needs {need} actuated legs (a square Jacobian), these give "

@@ -31,7 +31,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     svd_lci,
 )
-from scalesynth.mechanisms.describe import expressions
+from scalesynth.mechanisms.describe import bodies, expressions, frame
 from scalesynth.mechanisms.describe import kernel6 as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, LegType
 from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, _footprint, _plans, _turn, _unit
@@ -272,6 +272,78 @@ class SixDofMechanism(DescribedMechanism):
             return np.zeros(3), np.zeros(3)
         return lo, hi
 
+    # ----- bodies, stiffness frame and cycles (bodies.py, frame6.py) ----------------------------------------
+    def link_geometry(self, design, options, pose, q):
+        """Capsules of every body at platform centre ``pose`` (the options' orientation) with joint values ``q``
+        (bodies.py: upper_arm<i> and rod<i> of a RUS leg, leg<i> of a UPS leg, base, platform)."""
+        p = self.check_vector("pose", pose, 3)
+        qv = self.check_vector("inputs", q, len(self.joints))
+        rad = bodies.radii(options, self._codes(), self.default_length_unit)
+        return bodies.link_geometry6(self.legs(design, options), rad, p, self.rotation(options), qv)
+
+    def stiffness_model(self, design, options, pose, joints: str = "ideal"):
+        """The stiffness frame (scalesynth.stiffness.FrameModel) at platform centre ``pose`` in the kernel's
+        branch (frame6.py): arms on actuator springs with rods as bars, or legs as bars with axial actuator
+        springs; a rigid platform. ``joints`` 'bonded' welds the passive universal and spherical joints."""
+        from scalesynth.mechanisms.describe import frame6
+
+        return frame6.stiffness_model(self, design, options, pose, joints)
+
+    def _branch_signs(self, label: str) -> list[float] | None:
+        names = label.split("/")
+        if len(names) != len(self.plans):
+            return None
+        out = []
+        for plan, name in zip(self.plans, names, strict=True):
+            sign = LEG_TYPES[plan.type].branches.get(name)
+            if sign is None:
+                return None
+            out.append(sign)
+        return out
+
+    def cycle_kinematics(self, design, options, poses, label: str) -> tuple[np.ndarray, np.ndarray]:
+        """IK in branch ``label`` and velocity_map at many poses (n, 3); the base class's loop with the legs
+        resolved once and only the branch asked for solved (equal to it: tests/test_sixdof_bodies.py)."""
+        n, nj = len(poses), len(self.joints)
+        q = np.full((n, nj), np.nan)
+        a = np.full((n, nj, nj), np.nan)
+        signs = self._branch_signs(label)
+        if signs is None:
+            return q, a
+        legs = self.legs(design, options)
+        rot = self.rotation(options)
+        for s, pose in enumerate(poses):
+            p = self.check_vector("pose", pose, 3)
+            roots = [leg.roots(p, rot) for leg in legs]
+            if any(sign not in r for r, sign in zip(roots, signs, strict=True)):
+                continue
+            q[s] = [r[sign] for r, sign in zip(roots, signs, strict=True)]
+            rows, _ = self._closure_rows(legs, p, rot, q[s])
+            jq = np.array([float(rows[i, :3] @ leg.actuated_velocity(qi)) if leg.rus else qi
+                           for i, (leg, qi) in enumerate(zip(legs, q[s], strict=True))])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                a[s] = rows / jq[:, None]
+        return q, a
+
+    def held_link_jacobian(self, design, options, poses, label: str, step: float = 1e-5) -> np.ndarray:
+        """d(segment endpoints)/d(theta_j) (n, 3, s, 2, 3), length unit per rad: the link_geometry endpoints as
+        the platform turns by a small angle theta_j about the mechanism frame's axis j at fixed position (R ->
+        Rod(theta_j e_j) R, the omega of velocity_map's last three columns), by central differences of ``step``
+        rad. The inverse dynamics needs it for the moments the actuators apply to hold the orientation
+        (dynamics.inverse); NaN where the branch does not reach."""
+        from scalesynth.dynamics.inverse import link_points
+
+        rot = self.rotation(options)
+        sides = []
+        for j in range(3):
+            for sign in (1.0, -1.0):
+                w = np.zeros(3)
+                w[j] = sign * step
+                turned = dict(options, **{ORIENTATION: list(roll_pitch_yaw(_rodrigues(w) @ rot))})
+                sides.append(link_points(self, design, turned, poses, label))
+        e = np.stack(sides, axis=1)  # (n, 6, s, 2, 3)
+        return (e[:, 0::2] - e[:, 1::2]) / (2.0 * step)
+
     # ----- NumPy kinematics --------------------------------------------------------------------------------
     def inverse_kinematics(self, design, options, pose) -> list[Solution]:
         """Every branch combination whose legs all reach the platform centre ``pose`` at the options' orientation
@@ -425,6 +497,8 @@ def from_description_6dof(desc: Description) -> SixDofMechanism:
     plans = _plans(desc)
     rotary = LEG_TYPES[plans[0].type].joint_unit == "angle"
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items()) + (
+        Option("link_radius", None, bodies.LINK_RADIUS_DOC),
+        *frame.options(desc.stiffness, desc.length_unit, rotary),
         Option(ORIENTATION, [0.0, 0.0, 0.0], "[roll, pitch, yaw] rad of the platform over the whole (constant-"
                "orientation) workspace, R = Rz(yaw) Ry(pitch) Rx(roll)"),
         Option(CHARACTERISTIC_LENGTH, None, "length L of the homogenised Jacobian dx/dq = (v, L omega) per joint "
