@@ -269,8 +269,8 @@ def test_delta_cycle_forces_match_pinocchio(tmp_path):
 def _fivebar_against_pinocchio(tmp_path, masses: dict) -> None:
     """configs/fivebar_pnp_cycle.yaml (adept cycle, 1 kg payload, gravity -y, 40 samples) with ``masses`` as
     dynamics.masses ({}: massless links; without a dynamics section the links weigh what their sections do): every
-    sample's force<i> (N m) against the Pinocchio closed chain's arm torque, 1e-6 relative to each actuator's peak; Pinocchio's arm rates against
-    cycle.csv's qd, qdd."""
+    sample's force<i> (N m) against the Pinocchio closed chain's arm torque, 1e-6 relative to each actuator's
+    peak; Pinocchio's arm rates against cycle.csv's qd, qdd."""
     data = _config("fivebar_pnp_cycle.yaml")
     data["dynamics"] = {"masses": masses}
     data["cycle"]["samples"] = 40

@@ -5,8 +5,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, from_description
+from scalesynth.mechanisms.describe import mobility_check, schema
+from scalesynth.mechanisms.describe.build import from_description
+from scalesynth.mechanisms.describe.mechanism import DescribedMechanism
 from scalesynth.mechanisms.describe.schema import Description, load_description, parse_description
+
+# looked up at each call, so that a test may switch it off (monkeypatch mobility_check.check_mobility)
+schema.MOBILITY_CHECK = lambda desc: mobility_check.check_mobility(desc)
 
 __all__ = ["Description", "DescribedMechanism", "builtin", "builtin_names", "builtin_path", "from_description",
            "load_description", "parse_description"]

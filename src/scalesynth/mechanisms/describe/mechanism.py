@@ -337,12 +337,8 @@ def _footprint(desc_mech_plans, d: Mapping[str, float]) -> float:
     return enclosing_circle_radius(pts)
 
 
-def from_description(desc: Description) -> DescribedMechanism:
-    """The registered mechanism of a validated description (motion 6DOF: sixdof.py's)."""
-    if desc.motion == "6DOF":
-        from scalesynth.mechanisms.describe.sixdof import from_description_6dof
-
-        return from_description_6dof(desc)
+def from_description_3t(desc: Description) -> DescribedMechanism:
+    """The registered mechanism of a validated 3T description (build.from_description dispatches by motion)."""
     plans = _plans(desc)
     lt0 = LEG_TYPES[plans[0].type]
     rotary = lt0.joint_unit == "angle"

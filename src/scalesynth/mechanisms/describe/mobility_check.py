@@ -31,7 +31,7 @@ def _rank(rows: np.ndarray) -> int:
 def check_mobility(desc) -> None:
     """ConfigError naming the leg and the field when the description's legs do not make a 3T platform."""
     from scalesynth.errors import ScalesynthError
-    from scalesynth.mechanisms.describe.mechanism import from_description
+    from scalesynth.mechanisms.describe.build import from_description
 
     if desc.motion != "3T" or any(leg.type not in ("R-Pa", "P-Pa") for leg in desc.legs):
         return

@@ -22,6 +22,10 @@ from scalesynth.mechanisms.describe.frame import StiffnessSpec
 from scalesynth.mechanisms.describe.legs import LEG_TYPES
 from scalesynth.names import hint
 
+# The mobility check builds the mechanism, whose modules import this one: the package (describe/__init__.py)
+# installs it here, so that no import circle runs through the schema.
+MOBILITY_CHECK = None
+
 Expr = float | str
 MOTIONS = ("3T", "6DOF")  # motion types a kernel template handles (kernel.py, kernel6.py)
 LEG_COUNT = {"3T": 3, "6DOF": 6}  # actuated legs each motion needs (a square Jacobian)
@@ -213,9 +217,8 @@ def _check(desc: Description) -> None:
     if len(kinds) > 1:
         raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
                           "yet): use legs of one actuation kind")
-    from scalesynth.mechanisms.describe.mobility_check import check_mobility
-
-    check_mobility(desc)  # the legs make the motion type (a platform that cannot turn, held by its actuators)
+    if MOBILITY_CHECK is not None:
+        MOBILITY_CHECK(desc)  # the legs make the motion type (a platform that cannot turn, held by its actuators)
 
 
 def _expression(where: str, value: Any, names: list[str]) -> expressions.Expression:
