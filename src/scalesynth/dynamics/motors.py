@@ -180,11 +180,21 @@ def time_weights(t: np.ndarray) -> np.ndarray:
     return w / w.sum()
 
 
+def place_vertex(vertices, preset: str | None) -> int:
+    """Index of the place vertex among the path's vertices (m, k; the start not repeated at the end, or repeated):
+    the adept and abb-cycle-1 presets' far bottom vertex (S + across, index 3), else the vertex farthest from the
+    start (pick is the start, index 0)."""
+    verts = np.asarray(vertices, dtype=float)
+    if len(verts) > 2 and np.array_equal(verts[-1], verts[0]):
+        verts = verts[:-1]
+    if preset in ("adept", "abb-cycle-1") and len(verts) == 6:
+        return 3
+    return int(np.argmax(np.linalg.norm(verts - verts[0], axis=1)))
+
+
 def rest_samples(traj, preset: str | None) -> tuple[int, ...]:
-    """Sample indices of pick (the start) and place: the adept preset's far bottom vertex (S + across), else the
-    vertex farthest from the start."""
-    verts = traj.vertices[:-1]
-    place = 3 if preset == "adept" and len(verts) == 6 else int(np.argmax(np.linalg.norm(verts - verts[0], axis=1)))
+    """Sample indices of pick (the start) and place (``place_vertex``)."""
+    place = place_vertex(traj.vertices[:-1], preset)
     at = [int(np.argmin(np.abs(traj.t - traj.vertex_times[k]))) for k in (0, place)]
     return tuple(at)
 
