@@ -349,13 +349,20 @@ def test_a_1130_mm_packaging_delta_runs_at_vendors_rates_and_slows_with_payload(
 
 
 def test_delta_picks_config_optimises_picks_per_minute(tmp_path):
-    """configs/delta_picks.yaml at a small budget (4 designs, 1 generation): exit 0, and population.csv has a
-    picks_per_minute column with a design above 0 (a Delta of these sizes on a 1.5 kW servo runs the cycle)."""
+    """configs/delta_picks.yaml at a small budget (8 designs, 2 generations, seed 1): exit 0, population.csv has a
+    picks_per_minute column with a design above 0 (a Delta of these sizes on a 1.5 kW servo runs the cycle), the
+    front is not empty (a design reaches both rims of the cylinder within the motor limits) and report.md and
+    report.html carry the knee design's datasheet."""
     import csv
 
     out = tmp_path / "run"
-    _cli(["optimize", "configs/delta_picks.yaml", "--set", f"output.dir={out}", "--set", "algorithm.pop_size=4",
-          "--set", "algorithm.n_gen=1"])
+    _cli(["optimize", "configs/delta_picks.yaml", "--set", f"output.dir={out}", "--set", "algorithm.pop_size=8",
+          "--set", "algorithm.n_gen=2"])
     rows = list(csv.DictReader((out / "population.csv").open()))
     assert rows and "picks_per_minute" in rows[0]
     assert max(float(r["picks_per_minute"]) for r in rows) > 0
+    front = list(csv.DictReader((out / "pareto.csv").open()))
+    assert front and all(float(r["path_reachable"]) == 1.0 for r in front)
+    report = (out / "report.md").read_text()
+    assert "## Datasheet of the" in report and "| kg | picks/min |" in report
+    assert "<h2>Datasheet of the" in (out / "report.html").read_text()

@@ -136,3 +136,33 @@ def markdown_table(sheet: dict[str, Any]) -> str:
            "|" + "---|" * len(header)]
     out += ["| " + " | ".join(r) + " |" for r in rows]
     return "\n".join(out)
+
+
+def of_featured(result, featured: list[tuple[str, int]]) -> tuple[str, dict[str, Any] | str] | None:
+    """The datasheet of a run's first featured design (the knee where there is one) when its config has a cycle
+    and motors: (label, sheet), or (label, why) when that design's cycle cannot be followed; None otherwise."""
+    from scalesynth.cycle.analysis import analyse
+    from scalesynth.errors import ScalesynthError
+
+    cfg = result.cfg
+    if cfg.cycle is None or getattr(cfg.cycle, "_motors", None) is None or not featured:
+        return None
+    label, row = next((f for f in featured if f[0] == "knee"), featured[0])
+    design = result.design_of(result.pareto.iloc[row])
+    options = cfg.resolved_options()
+    try:
+        res = analyse(cfg.mech, design, options, cfg.cycle, cfg.units.length)
+        return label, datasheet(cfg.mech, design, options, cfg.cycle, cfg.units.length, res)
+    except ScalesynthError as err:
+        return label, str(err)
+
+
+def html_table(sheet: dict[str, Any]) -> str:
+    """The datasheet as an HTML table with its header line (report.html)."""
+    import html
+
+    header, rows = table_rows(sheet)
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in r) + "</tr>" for r in rows)
+    return (f"<p>{html.escape(text_table(sheet).splitlines()[0])}</p><table><thead><tr>{head}</tr></thead>"
+            f"<tbody>{body}</tbody></table>")
