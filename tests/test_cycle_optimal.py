@@ -284,7 +284,7 @@ def test_abb_cycle_1_turns_a_rotation_task_axis_by_90_degrees_over_the_across_mo
 def test_abb_cycle_1_needs_cartesian_task_axes(tmp_path):
     """On rps-upu (z, theta, psi) the preset is refused with one line naming the field, exit 2."""
     path = tmp_path / "c.yaml"
-    path.write_text("mechanism: rps-upu\nunits: {length: mm}\ndesign: {g: 80, h: 50, c: 50, e: 0}\n"
+    path.write_text("name: c\nmechanism: rps-upu\nunits: {length: mm}\ndesign: {g: 80, h: 50, c: 50, e: 0}\n"
                     "bounds: {g: [60, 100]}\ncycle: {preset: abb-cycle-1, start: [40, 0, 0], cycles_per_minute: 60}\n"
                     "objectives: [{metric: volume, sense: max}]\n")
     proc = _cli(["cycle", str(path), "--out", str(tmp_path / "o")], code=2)
