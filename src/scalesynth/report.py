@@ -264,8 +264,10 @@ def field_sections(cfg: RunConfig, design: dict[str, float], field: str, title: 
     return target
 
 
-def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> str:
-    """report.md: key numbers of the run (from the RunResult and its manifest) and links to its plots."""
+def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any],
+                sheet: tuple[str, Any] | None = None) -> str:
+    """report.md: key numbers of the run (from the RunResult and its manifest) and links to its plots; ``sheet``
+    (label, datasheet or why not) of a featured design where the run has motors (``cycle.datasheet.of_featured``)."""
     cfg, pareto, history, manifest, problem = (result.cfg, result.pareto, result.history, result.manifest,
                                                result.problem)
     mkey = cfg.mech.measure_key(cfg.units.length)
@@ -309,6 +311,12 @@ def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[
     for label, i in bands_info.get("featured", []):
         row = pareto.iloc[i]
         lines.append(f"| {label} | " + " | ".join(f"{row[c]:.4g}" for c in cols) + " |")
+    if sheet is not None:
+        from scalesynth.cycle.datasheet import markdown_table
+
+        label, body = sheet
+        lines += ["", f"## Datasheet of the {label} design", "",
+                  markdown_table(body) if isinstance(body, dict) else f"Its cycle cannot be followed: {body}"]
     refs = front_info.get("references", [])
     if refs:
         lines += ["", "## Reference designs re-evaluated under the same model", ""]
@@ -334,17 +342,20 @@ def report_text(result: RunResult, front_info: dict[str, Any], bands_info: dict[
     return "\n".join(lines) + "\n"
 
 
-def write_report(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any]) -> None:
-    rio.write_text(result.out_dir / REPORT, report_text(result, front_info, bands_info))
+def write_report(result: RunResult, front_info: dict[str, Any], bands_info: dict[str, Any],
+                 sheet: tuple[str, Any] | None = None) -> None:
+    rio.write_text(result.out_dir / REPORT, report_text(result, front_info, bands_info, sheet))
 
 
 def write_plots_and_report(result: RunResult) -> None:
     """Every plot, the per-band Pareto sets, report.md and report.html of a run, from the RunResult (no files
     re-read, no second problem)."""
+    from scalesynth.cycle.datasheet import of_featured
     from scalesynth.report_html import write_report_html
 
     front = plot_front(result)
     bands = plot_bands(result)
-    write_report(result, front, bands)
+    sheet = of_featured(result, bands.get("featured") or [])
+    write_report(result, front, bands, sheet)
     xk, yk = _axes(result.problem, result.cfg)
-    write_report_html(result, bands.get("featured") or [], (xk, yk), bands.get("band_sizes"))
+    write_report_html(result, bands.get("featured") or [], (xk, yk), bands.get("band_sizes"), sheet)

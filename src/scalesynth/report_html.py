@@ -19,9 +19,9 @@ VIEW_RESOLUTION = 40  # cells per axis of the featured designs' 3-D views (40^3 
 
 
 def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, str],
-                      band_sizes: list[int] | None = None) -> Path:
+                      band_sizes: list[int] | None = None, sheet: tuple[str, Any] | None = None) -> Path:
     """Write report.html for a results.RunResult; ``featured`` (label, pareto row) and the front's ``axes`` as the
-    report and plots use them."""
+    report and plots use them; ``sheet`` (label, datasheet or why not) as report.md's."""
     cfg, pareto, history, population, problem = (result.cfg, result.pareto, result.history, result.population,
                                                  result.problem)
     run_dir = result.out_dir
@@ -85,6 +85,13 @@ def write_report_html(result, featured: list[tuple[str, int]], axes: tuple[str, 
                 for panel in panels:
                     blocks.append(figs.html(ia.heatmap_figure(panel, flabel, f"{caption}: {flabel}, {panel['title']}",
                                                               vmin, vmax), 520))
+    if sheet is not None:
+        from scalesynth.cycle.datasheet import html_table
+
+        name, body = sheet
+        blocks.append(f"<h2>Datasheet of the {_html.escape(name)} design</h2>")
+        blocks.append(html_table(body) if isinstance(body, dict)
+                      else f"<p>Its cycle cannot be followed: {_html.escape(body)}</p>")
     if band_sizes:
         edges = cfg.dexterity.band_edges
         items = "".join(f"<li>LCI {wv.band_labels(edges)[k]}: {n} designs in <code>bands/pareto_band{k}.csv</code>"

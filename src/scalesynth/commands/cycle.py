@@ -19,11 +19,12 @@ from scalesynth.errors import ConfigError
 
 
 def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | None = None, out: Path | None = None,
-              force: bool = False):
+              force: bool = False, need_motors: bool = False):
     """Analyse the cycle and write its files; returns the summary dict (cycle.json's content plus file paths).
 
     The output directory is staged and swapped in whole (``scalesynth.rundir``): a failure or an interrupt leaves
-    the previous one as it was. It must be new, empty or a cycle directory unless ``force``."""
+    the previous one as it was. It must be new, empty or a cycle directory unless ``force``. ``need_motors``
+    (``--datasheet``): a config without a motors section is refused before anything is written."""
     from scalesynth import rundir
     from scalesynth.cycle import analysis, output
     from scalesynth.selection import load_design
@@ -39,6 +40,8 @@ def run_cycle(source: Path, sets: list[str] | None = None, design_choice: str | 
         out_dir = cfg.output_dir() / "cycle"
     if cfg.cycle is None:
         raise ConfigError("cycle: the config has no cycle section (cycle.path or cycle.preset)")
+    if need_motors and getattr(cfg.cycle, "_motors", None) is None:
+        raise ConfigError("--datasheet: the config has no motors section (the datasheet needs motors)")
     options = cfg.resolved_options()
     with rundir.staged(out_dir, output.OUTPUT, force) as staged:  # --out checked and locked before the analysis
         res = analysis.analyse(cfg.mech, design, options, cfg.cycle, cfg.units.length)
@@ -59,9 +62,12 @@ def cycle_cmd(
     out: Annotated[Path | None, typer.Option("--out", help="output directory")] = None,
     as_json: JsonOpt = False,
     force: ForceOpt = False,
+    show_datasheet: Annotated[bool, typer.Option(
+        "--datasheet", help="print the design's datasheet (needs motors): picks/min against payload, tool and "
+        "motor peaks")] = False,
 ) -> None:
     """Pick-and-place cycle of a design: actuator curves and forces, LCI and link clearance (cycle.csv, plots)."""
-    info = run_cycle(source, sets, design, out, force)
+    info = run_cycle(source, sets, design, out, force, need_motors=show_datasheet)
     if as_json:
         _print_json(info)
         return
@@ -71,4 +77,12 @@ def cycle_cmd(
         typer.echo(f"  {key:<26} {value:.6g}")
     where = info["min_clearance_at"]
     typer.echo(f"  min clearance at t = {where['t_s']:.4g} s between {' and '.join(where['segments']) or '-'}")
+    if "time_optimal_picks_per_minute" in info:
+        typer.echo(f"  time-optimal (toppra, peak torque and speed): {info['time_optimal_picks_per_minute']:.4g} "
+                   f"picks/min, {info['time_optimal_cycle_time_s']:.4g} s, binding "
+                   f"{info['time_optimal_binding_limit']}")
+    if show_datasheet:
+        from scalesynth.cycle.datasheet import text_table
+
+        typer.echo(text_table(info["datasheet"]))
     typer.echo("wrote " + ", ".join(info["files"]))

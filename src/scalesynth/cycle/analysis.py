@@ -244,19 +244,10 @@ def analyse(
     flip = np.nonzero(sign[1:] != sign[:-1])[0]
     if flip.size:
         raise CycleError(f"cycle: a singularity lies between {_where(mech, traj, int(flip[0]))} and the next sample")
-    pd_full = np.zeros((n, nj))
-    pd_full[:, :k] = traj.pd
-    pdd_full = np.zeros((n, nj))
-    pdd_full[:, :k] = traj.pdd
-    qd = np.einsum("nij,nj->ni", A, pd_full)
-    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(kin, mech, traj, size)
+    qd, qdd, force, force_gravity, task_force, force_map, vel, acc = _rates_and_forces(
+        mech, design, options, cyc, length_unit, traj, kin, A, label, size)
     g = ccfg.gravity_vector(cyc, mech)
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
-    vel, acc, jc = _payload_motion(mech, design, options, traj, size)
-    force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
-    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, label, size,
-                                                   si_velocity_map(mech, A, length_unit), length_unit)
-    force, force_gravity, task_force = force + links, force_gravity + links_gravity, task_force + links_task
     gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)
     at = int(np.argmin(gaps))
     return CycleResult(
@@ -268,6 +259,50 @@ def analyse(
         deflection=deflection_along(mech, design, options, traj.p, cyc.payload * (g[None, :] - acc * m_per_unit)),
         **_motor_columns(mech, cyc, qd, qdd, force, force_gravity, length_unit),
     )
+
+
+def _rates_and_forces(mech: Mechanism, design, options, cyc, length_unit: str, traj, kin, A: np.ndarray, label: str,
+                      size: float):
+    """Actuator rates and forces along the sampled motion ``traj`` (p, pd, pdd), A (n, nj, nj) the velocity map at
+    traj.p: (qd, qdd, force, force_gravity, task_force, force_map, payload velocity, payload acceleration), the
+    links' and the payload's inverse dynamics together (the arrays of CycleResult)."""
+    n, k = traj.p.shape
+    nj = len(mech.joints)
+    pd_full = np.zeros((n, nj))
+    pd_full[:, :k] = traj.pd
+    pdd_full = np.zeros((n, nj))
+    pdd_full[:, :k] = traj.pdd
+    qd = np.einsum("nij,nj->ni", A, pd_full)
+    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(kin, mech, traj, size)
+    g = ccfg.gravity_vector(cyc, mech)
+    vel, acc, jc = _payload_motion(mech, design, options, traj, size)
+    force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
+    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, label, size,
+                                                   si_velocity_map(mech, A, length_unit), length_unit)
+    return (qd, qdd, force + links, force_gravity + links_gravity, task_force + links_task, force_map, vel, acc)
+
+
+def sample_dynamics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, length_unit: str, p: np.ndarray,
+                    pd: np.ndarray, pdd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The inverse dynamics of ``analyse`` at arbitrary task states: poses p (n, k) with velocities pd and
+    accelerations pdd (task units per s, s^2) -> qd, qdd (n, nj; joint units per s, s^2), force and its gravity
+    part (n, nj; N or N m). Design and options resolved; no workspace or branch checks (the caller's path has
+    passed ``analyse``). Raises CycleError where a pose is out of reach."""
+    design = mech.resolve_design(design)
+    options = mech.resolve_options(options)
+    p, pd, pdd = (np.asarray(v, dtype=float) for v in (p, pd, pdd))
+    n = len(p)
+    traj = trajectory.Trajectory(t=np.arange(n, dtype=float), p=p, pd=pd, pdd=pdd, segment=np.zeros(n, dtype=int),
+                                 vertices=p[:1], vertex_times=np.zeros(1), law=("given",))
+    label = mech.kernel_branch(options)
+    kin = _kinematics_source(mech, design, options, label, False)
+    q, A = kin(p)
+    if not np.all(np.isfinite(q)):
+        raise CycleError(f"cycle: {_where(mech, traj, int(np.argmin(np.all(np.isfinite(q), axis=1))))} is out of "
+                         f"reach in working mode {label}")
+    qd, qdd, force, force_gravity, *_ = _rates_and_forces(mech, design, options, cyc, length_unit, traj, kin, A,
+                                                           label, _size(mech, design, options))
+    return qd, qdd, force, force_gravity
 
 
 def _motor_columns(mech, cyc, qd, qdd, force, force_gravity, length_unit) -> dict[str, np.ndarray]:

@@ -4,6 +4,8 @@
 cycle:
   path: [[x, y], ...]        # closed polyline in task axes (joined back to the first point; angles in rad), or:
   preset: adept              # 25 mm up, 305 mm across, 25 mm down and back (mechanisms with 2 Cartesian axes)
+                             # or abb-cycle-1: the same path (ABB's "Cycle 1", 25-305-25 mm), 90 deg of tool
+                             # rotation over the across move where the task axes have a rotation, dwell_s 0.035
   start: [x, y]              # adept: start point (task coordinates, the config's length unit)
   direction: [1, 0]          # adept: the 'across' direction (task axes; default: the first Cartesian axis
                              #        that is not vertical); it must be perpendicular to gravity
@@ -29,11 +31,14 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator,
 from scalesynth.cycle.trajectory import LAWS
 from scalesynth.names import hint
 
-PRESETS = ("adept",)
+PRESETS = ("adept", "abb-cycle-1")
 G0 = 9.80665  # standard gravity, m/s^2
 # adept cycle (mm): 25 up, 305 across, 25 down, then back the same way
 ADEPT_UP_MM = 25.0
 ADEPT_ACROSS_MM = 305.0
+# ABB IRB 360 "Cycle 1": the adept path with 90 degrees of tool rotation and 35 ms of vacuum at pick and at place
+ABB_ROTATION_RAD = 0.5 * math.pi
+ABB_DWELL_S = 0.035
 METRES_PER_UNIT = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 0.001}
 
 
@@ -132,6 +137,8 @@ class CycleConfig(BaseModel):
             raise ValueError("start/direction: only with a preset")
         if (self.cycles_per_minute is None) == (self.period is None):
             raise ValueError("give either cycles_per_minute or period")
+        if self.preset == "abb-cycle-1" and "dwell_s" not in self.model_fields_set:
+            self.dwell_s = ABB_DWELL_S  # the vacuum time of ABB's cycle, unless the config sets its own
         return self
 
     # ----- derived values ---------------------------------------------------------------------------------
@@ -171,14 +178,20 @@ def gravity_vector(cyc: CycleConfig, mech) -> np.ndarray:
 def vertices(cyc: CycleConfig, mech, length_unit: str) -> np.ndarray:
     """The polyline's points (m, k) in task units: the path as given, or the adept cycle's six vertices
     S, S + u h, S + u h + d w, S + d w, S + u h + d w, S + u h (the loop closes back to S), with h = 25 mm and
-    w = 305 mm in the length unit, u = up (against gravity), d = the across direction."""
+    w = 305 mm in the length unit, u = up (against gravity), d = the across direction. abb-cycle-1: the same, and
+    where the task axes include an angle (a tool rotation) the first one turns by +90 degrees over the across
+    move (vertices 2 to 4 at S's angle + pi/2) and back over the return."""
     if cyc.path is not None:
         return np.asarray(cyc.path, dtype=float)
     scale = 0.001 / METRES_PER_UNIT[length_unit]
     up, across = adept_axes(cyc, mech)
     s = np.asarray(cyc.start, dtype=float)
     h, w = ADEPT_UP_MM * scale * up, ADEPT_ACROSS_MM * scale * across
-    return np.array([s, s + h, s + h + w, s + w, s + h + w, s + h])
+    out = np.array([s, s + h, s + h + w, s + w, s + h + w, s + h])
+    angles = [a for a, u in enumerate(mech.task_units) if u == "angle"]
+    if cyc.preset == "abb-cycle-1" and angles:
+        out[2:5, angles[0]] += ABB_ROTATION_RAD
+    return out
 
 
 def adept_axes(cyc: CycleConfig, mech) -> tuple[np.ndarray, np.ndarray]:

@@ -61,6 +61,20 @@ def _motor_summary(res: CycleResult, cyc) -> dict[str, Any]:
             "binding_limit": binding, "dwell_s": cyc.dwell_s}
 
 
+def motor_extras(cfg, design, options, res: CycleResult) -> dict[str, Any]:
+    """With motors: the time-optimal cycle at the cycle's payload (``dynamics.optimal``: toppra under peak torque
+    and speed, ``time_optimal_*``) and the ``datasheet`` (``cycle.datasheet``); {} without."""
+    from scalesynth.cycle.datasheet import datasheet
+
+    sheet = datasheet(cfg.mech, design, options, cfg.cycle, cfg.units.length, res)
+    if sheet is None:
+        return {}
+    row = next(r for r in sheet["rows"] if r["payload_kg"] == float(cfg.cycle.payload))
+    keys = ("time_optimal_picks_per_minute", "time_optimal_cycle_time_s", "time_optimal_binding_limit",
+            "time_optimal_rms_torque_ratio")
+    return {**{k: row[k] for k in keys}, "datasheet": sheet}
+
+
 def _section(cfg, design, options, res: CycleResult):
     """LCI on the workspace section through the path: (lci (n, n), extent, axes (i, j), label)."""
     from scalesynth.kernels.grid import sample_grid
@@ -133,6 +147,7 @@ def write_all(out_dir: Path, cfg, design, options, res: CycleResult, metrics: di
     """cycle.csv, the plots and, last, cycle.json (listing them) into ``out_dir``; returns cycle.json's content."""
     write_csv(out_dir / "cycle.csv", res)
     info = summary(res, metrics, design, cfg.cycle)
+    info.update(motor_extras(cfg, design, options, res))
     plots = write_plots(out_dir, cfg, design, options, res)
     info["files"] = ["cycle.csv", "cycle.json", *(p.name for p in plots)]
     rio.write_json(out_dir / "cycle.json", info)

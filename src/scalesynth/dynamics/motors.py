@@ -120,7 +120,7 @@ def motor_side(motors: Motors, qd_si, qdd_si, force, force_gravity):
     return speed, g, a
 
 
-def _rms2(g, a, w, s, dwell_total, g_rest2):
+def mean_square_torque(g, a, w, s, dwell_total, g_rest2):
     """Mean square motor torque (..., nj) over one cycle at rate factor s (...,): the motion (period T0 / s; w the
     samples' time weights summing to 1) and the dwell at rest (dwell_total s, mean square holding torque
     g_rest2 (..., nj))."""
@@ -156,12 +156,14 @@ def rate_limits(motors: Motors, speed, g, a, w, period: float, dwell_total: floa
     holding_rms = np.any(slow > R2, axis=1) | np.any(g_rest2 > R2, axis=1)
     fast = np.isfinite(s) & ~holding & ~holding_rms
     over = np.zeros(D, dtype=bool)
-    over[fast] = np.any(_rms2(g[fast], a[fast], w, s[fast], dwell_total / period, g_rest2[fast]) > R2, axis=1)
+    over[fast] = np.any(mean_square_torque(g[fast], a[fast], w, s[fast], dwell_total / period, g_rest2[fast]) > R2,
+                        axis=1)
     if np.any(over):
         lo, hi = np.zeros(int(over.sum())) + 1e-12 * s[over], s[over].copy()
         for _ in range(_BISECTION_STEPS):
             mid = 0.5 * (lo + hi)
-            bad = np.any(_rms2(g[over], a[over], w, mid, dwell_total / period, g_rest2[over]) > R2, axis=1)
+            bad = np.any(mean_square_torque(g[over], a[over], w, mid, dwell_total / period, g_rest2[over]) > R2,
+                         axis=1)
             hi = np.where(bad, mid, hi)
             lo = np.where(bad, lo, mid)
         s[over], binding[over] = lo, "rated_torque"
@@ -180,11 +182,21 @@ def time_weights(t: np.ndarray) -> np.ndarray:
     return w / w.sum()
 
 
+def place_vertex(vertices, preset: str | None) -> int:
+    """Index of the place vertex among the path's vertices (m, k; the start not repeated at the end, or repeated):
+    the adept and abb-cycle-1 presets' far bottom vertex (S + across, index 3), else the vertex farthest from the
+    start (pick is the start, index 0)."""
+    verts = np.asarray(vertices, dtype=float)
+    if len(verts) > 2 and np.array_equal(verts[-1], verts[0]):
+        verts = verts[:-1]
+    if preset in ("adept", "abb-cycle-1") and len(verts) == 6:
+        return 3
+    return int(np.argmax(np.linalg.norm(verts - verts[0], axis=1)))
+
+
 def rest_samples(traj, preset: str | None) -> tuple[int, ...]:
-    """Sample indices of pick (the start) and place: the adept preset's far bottom vertex (S + across), else the
-    vertex farthest from the start."""
-    verts = traj.vertices[:-1]
-    place = 3 if preset == "adept" and len(verts) == 6 else int(np.argmax(np.linalg.norm(verts - verts[0], axis=1)))
+    """Sample indices of pick (the start) and place (``place_vertex``)."""
+    place = place_vertex(traj.vertices[:-1], preset)
     at = [int(np.argmin(np.abs(traj.t - traj.vertex_times[k]))) for k in (0, place)]
     return tuple(at)
 
@@ -209,7 +221,7 @@ def cycle_motor_metrics(motors: Motors, traj, cyc, joint_units, length_unit: str
     with np.errstate(divide="ignore"):
         cycle_time = np.where(s > 0, period / np.where(s > 0, s, 1.0) + dwell, CYCLE_TIME_PENALTY)
     g_rest2 = np.mean(g[:, list(rest)] ** 2, axis=1)
-    rms = np.sqrt(_rms2(g, a, w, np.ones(len(s)), dwell / period, g_rest2))
+    rms = np.sqrt(mean_square_torque(g, a, w, np.ones(len(s)), dwell / period, g_rest2))
     out = {
         "picks_per_minute": np.where(s > 0, 60.0 / cycle_time, 0.0),
         "cycle_time_s": np.minimum(cycle_time, CYCLE_TIME_PENALTY),
