@@ -249,12 +249,13 @@ def analyse(
     pdd_full = np.zeros((n, nj))
     pdd_full[:, :k] = traj.pdd
     qd = np.einsum("nij,nj->ni", A, pd_full)
-    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(kin, mech, traj, size)
+    a_dot = _a_dot_xdot(kin, mech, traj, size)
+    qdd = np.einsum("nij,nj->ni", A, pdd_full) + a_dot
     g = ccfg.gravity_vector(cyc, mech)
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     vel, acc, jc = _payload_motion(mech, design, options, traj, size)
     force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
-    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, label, size,
+    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, size, q, A, a_dot,
                                                    si_velocity_map(mech, A, length_unit), length_unit)
     force, force_gravity, task_force = force + links, force_gravity + links_gravity, task_force + links_task
     gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)

@@ -101,6 +101,17 @@ def kernel_pairs(segment_bodies: Sequence[str], adjacent: frozenset[frozenset[st
                      if b[i] != b[j] and frozenset((b[i], b[j])) not in adjacent], dtype=np.int64).reshape(-1, 2)
 
 
+def endpoints_array(ends: Sequence[tuple[Any, Any]], m: int) -> np.ndarray:
+    """Segment endpoints at m poses stacked as (m, n_segments, 2, 3) from a list of (a, b) per segment, each a
+    point (3,) (fixed) or points (m, 3): the vectorised twin of LinkGeometry.as_arrays' a and b (a mechanism's
+    ``link_endpoints``)."""
+    out = np.empty((m, len(ends), 2, 3))
+    for i, (a, b) in enumerate(ends):
+        out[:, i, 0] = a
+        out[:, i, 1] = b
+    return out
+
+
 def point(*coords: float) -> np.ndarray:
     """A 3-D point from 2 or 3 coordinates (planar points get z = 0)."""
     c = [float(v) for v in coords]
