@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from scalesynth.cycle import config as ccfg
 from scalesynth.dynamics import bodies
-from scalesynth.dynamics.inverse import JACOBIAN_STEP, SECOND_STEP, actuator_forces, frame_gravity, generalised_forces
+from scalesynth.dynamics.inverse import JACOBIAN_STEP, SECOND_STEP, actuator_forces, frame_gravity
 
 
 def link_points_by_ik(mech, design, options, poses: np.ndarray, label: str) -> np.ndarray:
@@ -46,6 +47,22 @@ def endpoint_motion_by_ik(mech, design, options, p, pd, pdd, label: str, size: f
     second = e[:, 2 * k] - 2.0 * e[:, 2 * k + 1] + e[:, 2 * k + 2]
     acc[moving] += second[moving] / (eps[moving] ** 2)[:, None, None, None]
     return e[:, 2 * k + 1], jac, vel, acc
+
+
+def generalised_forces(mech, jac, acc, masses, g3, length_unit: str):
+    """F (n, k) and its gravity part from Jacobians (n, k, s, 2, 3) and accelerations (n, s, 2, 3), as the module
+    docstring of scalesynth.dynamics.inverse states (sample-major layout)."""
+    m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
+    a_si = acc * m_per_unit
+    m6 = masses[None, :, None] / 6.0
+    weight = -0.5 * masses[None, :, None] * g3[None, None, :]  # (1, s, 3) per endpoint
+    f = np.stack([m6 * (2.0 * a_si[:, :, 0] + a_si[:, :, 1]) + weight,
+                  m6 * (a_si[:, :, 0] + 2.0 * a_si[:, :, 1]) + weight], axis=2)  # (n, s, 2, 3)
+    col = np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])
+    jac_si = jac * col[None, :, None, None, None]  # m per m or m per rad
+    F = np.einsum("nksec,nsec->nk", jac_si, f)
+    F_g = np.einsum("nksec,sec->nk", jac_si, np.broadcast_to(weight[0][:, None, :], f.shape[1:]))
+    return F, F_g
 
 
 def link_forces_by_ik(mech, design, options, cyc, traj, label: str, size: float, A_si: np.ndarray,

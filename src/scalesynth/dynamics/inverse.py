@@ -45,21 +45,22 @@ def frame_gravity(cyc, mech) -> np.ndarray:
 
 
 def endpoints(mech, design, options, poses: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Segment endpoints (m, n_segments, 2, 3), length unit, at poses (m, k) with joint values q (m, n_joints): the
-    mechanism's vectorised ``link_endpoints`` where it has one, else link_geometry per pose. NaN rows where q is not
-    finite."""
+    """Segment endpoints coordinate-major (n_segments, 2, 3, m), length unit, at poses (m, k) with joint values q
+    (m, n_joints): the mechanism's vectorised ``link_endpoints`` (links.endpoints_array) where it has one, else
+    link_geometry per pose. NaN where q is not finite."""
+    bad = ~np.all(np.isfinite(q), axis=1)
     if hasattr(mech, "link_endpoints"):
         out = mech.link_endpoints(design, options, poses, q)
-        out[~np.all(np.isfinite(q), axis=1)] = np.nan
+        out[..., bad] = np.nan
         return out
     out = None
     for s, pose in enumerate(poses):
-        if not np.all(np.isfinite(q[s])):
+        if bad[s]:
             continue
         a, b, _ = mech.link_geometry(design, options, pose, q[s]).as_arrays()
         if out is None:
-            out = np.full((len(poses), len(a), 2, 3), np.nan)
-        out[s, :, 0], out[s, :, 1] = a, b
+            out = np.full((len(a), 2, 3, len(poses)), np.nan)
+        out[:, 0, :, s], out[:, 1, :, s] = a, b
     if out is None:
         raise ValueError("no pose of the cycle is reachable")
     return out
@@ -69,55 +70,58 @@ def link_points(mech, design, options, poses: np.ndarray, label: str) -> np.ndar
     """Segment endpoints (m, n_segments, 2, 3), length unit, at poses (m, k): IK (cycle_kinematics) in branch
     ``label``, then ``endpoints``. NaN where the branch does not reach."""
     q, _ = mech.cycle_kinematics(design, options, poses, label)
-    return endpoints(mech, design, options, poses, q)
+    return np.moveaxis(endpoints(mech, design, options, poses, q), -1, 0)
 
 
 def endpoint_motion(mech, design, options, p, pd, pdd, q, A, a_dot, size: float, segments=None):
-    """Endpoints e (n, s, 2, 3), their Jacobians J (n, k, s, 2, 3) = de/dx (length unit per task unit),
-    velocities (n, s, 2, 3) and accelerations (n, s, 2, 3) (length unit per s, s^2) along the sampled motion
-    p, pd, pdd (n, k), from the cycle's joint values q (n, nj), velocity map A (n, nj, nj) and (dA/dt) x_dot
-    a_dot (n, nj). ``segments``: an index of the segments to keep (default all)."""
+    """Endpoints e (s, 2, 3, n), their Jacobians J (s, 2, 3, k, n) = de/dx (length unit per task unit) and
+    accelerations (s, 2, 3, n) (length unit per s^2) along the sampled motion p, pd, pdd (n, k), from the cycle's
+    joint values q (n, nj), velocity map A (n, nj, nj) and (dA/dt) x_dot a_dot (n, nj); coordinate-major (samples
+    last). ``segments``: an index of the segments to keep (default all)."""
     n, k = p.shape
-    nj = q.shape[1]
     scale = np.array([size if u == "length" else 1.0 for u in mech.task_units])
     h = JACOBIAN_STEP * scale
     reach = np.max(np.abs(pd) / scale, axis=1)
-    eps = np.where(reach > 0.0, SECOND_STEP / np.where(reach > 0.0, reach, 1.0), 0.0)
-    steps = np.eye(k) * h
-    dq = np.transpose(A[:, :, :k], (0, 2, 1)) * h[None, :, None]  # (n, k, nj): q moves along A e_j
-    qd = np.einsum("nij,nj->ni", A[:, :, :k], pd)
-    bend = 0.5 * (eps * eps)[:, None] * a_dot
-    poses = np.concatenate([p[:, None, :] + steps[None], p[:, None, :] - steps[None],
-                            np.stack([p + eps[:, None] * pd, p, p - eps[:, None] * pd], axis=1)], axis=1)
-    qs = np.concatenate([q[:, None, :] + dq, q[:, None, :] - dq,
-                         np.stack([q + eps[:, None] * qd + bend, q, q - eps[:, None] * qd + bend], axis=1)], axis=1)
-    e = endpoints(mech, design, options, poses.reshape(-1, k), qs.reshape(-1, nj)).reshape(n, 2 * k + 3, -1, 2, 3)
-    if segments is not None:
-        e = e[:, :, segments]
-    jac = (e[:, :k] - e[:, k:2 * k]) / (2.0 * h)[None, :, None, None, None]
-    vel = np.einsum("nksec,nk->nsec", jac, pd)
-    acc = np.einsum("nksec,nk->nsec", jac, pdd)
     moving = reach > 0.0
-    second = e[:, 2 * k] - 2.0 * e[:, 2 * k + 1] + e[:, 2 * k + 2]
-    acc[moving] += second[moving] / (eps[moving] ** 2)[:, None, None, None]
-    return e[:, 2 * k + 1], jac, vel, acc
+    eps = np.where(moving, SECOND_STEP / np.where(moving, reach, 1.0), 0.0)
+    # the 2k + 3 evaluations, evaluation-major (2k + 3, n, .): x +- h e_j with q +- h A e_j, then x + eps x_d,
+    # x, x - eps x_d with q +- eps q_d + eps^2/2 a_dot
+    dx = np.eye(k)[:, None, :] * h[:, None, None]  # (k, 1, k)
+    dq = np.transpose(A[:, :, :k], (2, 0, 1)) * h[:, None, None]  # (k, n, nj)
+    step_x = eps[:, None] * pd
+    step_q = eps[:, None] * np.einsum("nij,nj->ni", A[:, :, :k], pd)
+    bend = 0.5 * (eps * eps)[:, None] * a_dot
+    poses = np.concatenate([p + dx, p - dx, (p + step_x)[None], p[None], (p - step_x)[None]])
+    qs = np.concatenate([q + dq, q - dq, (q + step_q + bend)[None], q[None], (q - step_q + bend)[None]])
+    e = endpoints(mech, design, options, poses.reshape(-1, k), qs.reshape(-1, q.shape[1]))
+    if segments is not None:
+        e = e[segments]
+    e = e.reshape(*e.shape[:3], 2 * k + 3, n)
+    jac = (e[..., :k, :] - e[..., k:2 * k, :]) / (2.0 * h)[:, None]
+    acc = jac[..., 0, :] * pdd[:, 0]
+    for j in range(1, k):
+        acc += jac[..., j, :] * pdd[:, j]
+    inv_eps2 = np.where(moving, 1.0 / np.where(moving, eps * eps, 1.0), 0.0)
+    acc += (e[..., 2 * k, :] - 2.0 * e[..., 2 * k + 1, :] + e[..., 2 * k + 2, :]) * inv_eps2
+    return e[..., 2 * k + 1, :], jac, acc
 
 
 def generalised_forces(mech, jac: np.ndarray, acc: np.ndarray, masses: np.ndarray, g3: np.ndarray,
                        length_unit: str) -> tuple[np.ndarray, np.ndarray]:
     """The links' generalised force on the task axes (n, k) and its gravity part (n, k): N along a length axis,
-    N m about an angle axis, from the Jacobians (n, k, s, 2, 3), endpoint accelerations (n, s, 2, 3; length unit
-    per s^2), segment masses (s,) kg and gravity g3 (3,) m/s^2."""
+    N m about an angle axis, from the Jacobians (s, 2, 3, k, n), endpoint accelerations (s, 2, 3, n; length unit
+    per s^2), segment masses (s,) kg and gravity g3 (3,) m/s^2 (endpoint_motion's layout)."""
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     a_si = acc * m_per_unit
-    m6 = masses[None, :, None] / 6.0
-    weight = -0.5 * masses[None, :, None] * g3[None, None, :]  # (1, s, 3) per endpoint
-    f = np.stack([m6 * (2.0 * a_si[:, :, 0] + a_si[:, :, 1]) + weight,
-                  m6 * (a_si[:, :, 0] + 2.0 * a_si[:, :, 1]) + weight], axis=2)  # (n, s, 2, 3)
-    col = np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])
-    jac_si = jac * col[None, :, None, None, None]  # m per m or m per rad
-    F = np.einsum("nksec,nsec->nk", jac_si, f)
-    F_g = np.einsum("nksec,sec->nk", jac_si, np.broadcast_to(weight[0][:, None, :], f.shape[1:]))
+    m6 = masses[:, None, None] / 6.0
+    weight = -0.5 * masses[:, None] * g3[None, :]  # (s, 3) per endpoint
+    f = np.empty_like(a_si)
+    f[:, 0] = m6 * (2.0 * a_si[:, 0] + a_si[:, 1]) + weight[:, :, None]
+    f[:, 1] = m6 * (a_si[:, 0] + 2.0 * a_si[:, 1]) + weight[:, :, None]
+    col = np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])  # m per m or m per rad
+    flat = jac.reshape(-1, *jac.shape[-2:])  # (s 2 3, k, n)
+    F = np.einsum("lkn,ln->nk", flat, f.reshape(-1, f.shape[-1])) * col
+    F_g = np.einsum("lkn,l->nk", flat, np.repeat(weight[:, None, :], 2, axis=1).ravel()) * col
     return F, F_g
 
 
@@ -145,9 +149,10 @@ def link_forces(mech, design, options, cyc, traj, size: float, q: np.ndarray, A:
     k = traj.p.shape[1]
     if not np.any(masses):
         return np.zeros((n, nj)), np.zeros((n, nj)), np.zeros((n, k))
-    heavy = np.nonzero(masses)[0]  # massless segments add nothing
-    _, jac, _, acc = endpoint_motion(mech, design, options, traj.p, traj.pd, traj.pdd, q, A, a_dot, size, heavy)
-    F, F_g = generalised_forces(mech, jac, acc, masses[heavy], frame_gravity(cyc, mech), length_unit)
+    heavy = np.nonzero(masses)[0] if not np.all(masses) else None  # massless segments add nothing
+    _, jac, acc = endpoint_motion(mech, design, options, traj.p, traj.pd, traj.pdd, q, A, a_dot, size, heavy)
+    F, F_g = generalised_forces(mech, jac, acc, masses if heavy is None else masses[heavy],
+                                frame_gravity(cyc, mech), length_unit)
     if not np.all(np.isfinite(F)):
         from scalesynth.errors import InvalidPose
 

@@ -102,13 +102,18 @@ def kernel_pairs(segment_bodies: Sequence[str], adjacent: frozenset[frozenset[st
 
 
 def endpoints_array(ends: Sequence[tuple[Any, Any]], m: int) -> np.ndarray:
-    """Segment endpoints at m poses stacked as (m, n_segments, 2, 3) from a list of (a, b) per segment, each a
-    point (3,) (fixed) or points (m, 3): the vectorised twin of LinkGeometry.as_arrays' a and b (a mechanism's
-    ``link_endpoints``)."""
-    out = np.empty((m, len(ends), 2, 3))
-    for i, (a, b) in enumerate(ends):
-        out[:, i, 0] = a
-        out[:, i, 1] = b
+    """Segment endpoints at m poses, coordinate-major (n_segments, 2, 3, m), from a list of (a, b) per segment
+    in link_geometry's order: the vectorised twin of LinkGeometry.as_arrays' a and b (a mechanism's
+    ``link_endpoints``). A point is an array (3,) (fixed), an array (m, 3), or 3 coordinates each a number or an
+    array (m,)."""
+    out = np.empty((len(ends), 2, 3, m))
+    for i, pair in enumerate(ends):
+        for j, pt in enumerate(pair):
+            if isinstance(pt, np.ndarray) and pt.ndim == 2:
+                out[i, j] = pt.T
+            else:
+                for c in range(3):
+                    out[i, j, c] = pt[c]
     return out
 
 

@@ -491,14 +491,13 @@ class PlanarFivebar(Mechanism):
         ]))
 
     def link_endpoints(self, design, options, poses, q) -> np.ndarray:
-        """Vectorised twin of link_geometry's segment endpoints at poses (m, 2) with arm angles q (m, 2): (m, 6, 2, 3)
-        mm, segments in link_geometry's order."""
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 2) with arm angles q (m, 2): (6, 2, 3, m)
+        mm (links.endpoints_array), segments in link_geometry's order."""
         pts, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
         r, l1 = design["r"], design["l1"]
-        zero = np.zeros(len(pts))
-        b1, b2, p = links.point(r, 0.0), links.point(-r, 0.0), np.stack([pts[:, 0], pts[:, 1], zero], axis=-1)
-        e1 = np.stack([r + l1 * np.cos(q[:, 0]), l1 * np.sin(q[:, 0]), zero], axis=-1)
-        e2 = np.stack([-r + l1 * np.cos(q[:, 1]), l1 * np.sin(q[:, 1]), zero], axis=-1)
+        b1, b2, p = (r, 0.0, 0.0), (-r, 0.0, 0.0), (pts[:, 0], pts[:, 1], 0.0)
+        e1 = (r + l1 * np.cos(q[:, 0]), l1 * np.sin(q[:, 0]), 0.0)
+        e2 = (-r + l1 * np.cos(q[:, 1]), l1 * np.sin(q[:, 1]), 0.0)
         return links.endpoints_array([(b2, b1), (b1, e1), (b2, e2), (e1, p), (e2, p), (p, p)], len(pts))
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
