@@ -1029,6 +1029,25 @@ class RpsUpu(Mechanism):
         adjacent = [("base", f"leg{i}") for i in (1, 2, 3)] + [(f"leg{i}", "platform") for i in (1, 2, 3)]
         return segs, adjacent
 
+    def _capsule_ends(self, design, options, x: np.ndarray) -> list:
+        """_capsules' segment endpoints at poses x (m, 3), vectorised: [(a, b)] with points (3,) or (m, 3); NaN
+        rows where the C-model parametrisation is degenerate."""
+        g, h, c, e = self._geom(design)
+        valid, p, R, _, _ = _platform(self._geom(design), options["model"], options["c3_variant"], x)
+        a = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        bp = np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]])
+        b = p[:, None, :] + np.einsum("kj,mij->mki", bp, R)
+        b[~valid] = np.nan
+        sides = ((1, 2), (2, 3), (3, 1))
+        return ([(a[i - 1], a[j - 1]) for i, j in sides] + [(a[i], b[:, i]) for i in range(3)]
+                + [(b[:, i - 1], b[:, j - 1]) for i, j in sides])
+
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3): (9, 2, 3, m) mm
+        (links.endpoints_array), segments in link_geometry's order; q is not needed."""
+        x = np.asarray(poses, dtype=float)
+        return links.endpoints_array(self._capsule_ends(design, options, x), len(x))
+
     def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
         """Capsules (mm) at a pose (z, theta, psi): the base triangle A1 A2 A3, each leg A_i -> B_i (cylinder and
         piston as one capsule) and the platform triangle B1 B2 B3 (spec §2.2, the configured model). Adjacent:
@@ -1797,6 +1816,32 @@ class RpsUpuTool(RpsUpu):
         _, _, origin, _ = self._joint_points(design, self._p(options), x)
         segs.append(links.Segment("tool", "tool", origin, self.tool_point(design, options, x), radii["tool"]))
         return links.LinkGeometry(tuple(segs), links.adjacency([*adjacent, ("tool", "platform")]))
+
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at tool points (m, 3) with legs q (m, 3):
+        (10, 2, 3, m) mm (links.endpoints_array). The pose of each point as _pose_for picks it: of the (up to four)
+        poses placing the tool there, in poses_of_tool_point's order, the first whose legs are closest to q."""
+        t, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
+        d = options["tool_offset"]
+        geom = self._geom(design)
+        with np.errstate(invalid="ignore"):
+            ps0 = np.arcsin(np.clip(t[:, 1] / d, -1.0, 1.0))
+            best, x = np.full(len(t), np.inf), np.full((len(t), 3), np.nan)
+            for ps in (ps0, math.pi - ps0):
+                cp = np.cos(ps)
+                ok = (np.abs(t[:, 1]) <= d) & (np.abs(cp) > 1e-12) & (np.abs(t[:, 0]) <= d * np.abs(cp))
+                th0 = np.arcsin(np.clip(-t[:, 0] / np.where(ok, d * cp, 1.0), -1.0, 1.0))
+                for th in (th0, math.pi - th0):
+                    cand = np.column_stack([t[:, 2] + d * np.cos(th) * cp, wrap_angle(th), wrap_angle(ps)])
+                    _, legs, _ = _legs(geom, "P", "plane", np.where(ok[:, None], cand, 0.0))
+                    miss = np.where(ok, np.abs(legs - q).max(axis=1), np.inf)
+                    closer = miss < best
+                    best, x = np.where(closer, miss, best), np.where(closer[:, None], cand, x)
+        ends = self._capsule_ends(design, self._p(options), x)
+        _, p, _, _, _ = _platform(geom, "P", "plane", x)
+        z, th, ps = x.T
+        tool = (-d * np.sin(th) * np.cos(ps), d * np.sin(ps), z - d * np.cos(th) * np.cos(ps))
+        return links.endpoints_array([*ends, (p, tool)], len(t))
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """dq/dT (mm/mm) of the tool point; infinite where cos theta cos psi = 0 or a leg length is 0."""
