@@ -135,6 +135,44 @@ def link_geometry(legs, widths: Sequence[float], rad: Mapping[str, float], pose,
     return links.LinkGeometry(tuple(segs), links.adjacency(pairs))
 
 
+def link_endpoints(legs, widths: Sequence[float], poses: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Vectorised twin of link_geometry's segment endpoints at platform centres ``poses`` (m, 3) with joint values
+    ``q`` (m, n_legs): (n_segments, 2, 3, m) in link_geometry's order (links.endpoints_array). The platform
+    polygon's order is the angular order of the joints' offsets Q_i +- h n_i - P (pose-independent)."""
+    p = np.asarray(poses, dtype=float)
+    q = np.asarray(q, dtype=float)
+    segs: list[tuple[str, Any, Any]] = []  # (body, a, b)
+    base_pts, plat_offsets = [], []
+    for i, (leg, w) in enumerate(zip(legs, widths, strict=True), 1):
+        h = 0.5 * float(w)
+        qi = q[:, i - 1]
+        if leg.type.code == _k.R_PA:
+            e = leg.base + leg.arm * (np.cos(qi)[:, None] * leg.u + np.sin(qi)[:, None] * leg.w)
+        else:
+            e = leg.base + qi[:, None] * leg.u
+        j = p + leg.platform
+        side = h * leg.normal
+        base_pts.append(leg.base)
+        plat_offsets += [leg.platform - side, leg.platform + side] if h > 0.0 else [leg.platform]
+        if leg.type.code == _k.R_PA:
+            segs.append((f"upper_arm{i}", leg.base, e))
+            if h > 0.0:
+                segs.append((f"upper_arm{i}", e - side, e + side))
+        else:
+            lo, hi = leg.limits
+            segs.append((f"rail{i}", leg.base + lo * leg.u, leg.base + hi * leg.u))
+            segs.append((f"carriage{i}", e - side, e + side))
+        if h > 0.0:
+            segs += [(f"forearm{i}", e + side, j + side), (f"forearm{i}", e - side, j - side)]
+        else:
+            segs.append((f"forearm{i}", e, j))
+    segs += [("base", a, b) for a, b in _ring(base_pts, np.mean(base_pts, axis=0))]
+    segs += [("platform", p + a, p + b) for a, b in _ring(plat_offsets, np.zeros(3))]
+    order = {b: n for n, b in enumerate(body_names([leg.type.code for leg in legs]))}
+    segs.sort(key=lambda s: order[s[0]])
+    return links.endpoints_array([(a, b) for _, a, b in segs], len(p))
+
+
 def _ring(points, centre) -> list[tuple[np.ndarray, np.ndarray]]:
     """Sides of the closed polygon through ``points`` in angular order about ``centre`` (xy-plane angle); one point
     gives one ball, two points one side."""
