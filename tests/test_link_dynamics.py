@@ -72,3 +72,14 @@ def test_link_forces_equal_the_reference_twin(name):
     np.testing.assert_allclose(F, ref_F, rtol=0, atol=5e-8 * np.max(np.abs(ref_F)))
     # the gravity part needs first derivatives only (truncation ~1e-10)
     np.testing.assert_allclose(tau_g, ref_g, rtol=0, atol=1e-8 * np.max(np.abs(ref_g)))
+
+
+def test_p_model_leg_lengths_equal_the_legs_kinematics():
+    """rps-upu-tool's closed-form P-model leg lengths (the branch choice of link_endpoints) against _legs."""
+    from scalesynth.mechanisms.rps_upu import _legs, _p_leg_lengths
+
+    geom = (120.0, 60.0, 80.0, 150.0)  # g, h, c, e (mm)
+    rng = np.random.default_rng(1)
+    x = np.column_stack([rng.uniform(100, 300, 50), rng.uniform(-3, 3, 50), rng.uniform(-3, 3, 50)])
+    _, q, _ = _legs(geom, "P", "plane", x)
+    np.testing.assert_allclose(_p_leg_lengths(geom, x), q, rtol=1e-13)

@@ -539,6 +539,16 @@ def _legs(geom: tuple, model: str, variant: str, x: np.ndarray):
     return valid, q, jx
 
 
+def _p_leg_lengths(geom: tuple, x: np.ndarray) -> np.ndarray:
+    """Leg lengths (n, 3) of the P-model at poses x (n, 3) = (z, theta, psi) in closed form (phi = y0 = 0, so
+    B_i = (0, 0, z) + Ry(theta) Rx(psi) b_i'): _legs' q without its Jacobians."""
+    g, h, c, e = geom
+    z, st, ct, sp, cp = x[:, 0], np.sin(x[:, 1]), np.cos(x[:, 1]), np.sin(x[:, 2]), np.cos(x[:, 2])
+    return np.stack([np.sqrt((h * st * sp) ** 2 + (g - h * cp) ** 2 + (z - h * ct * sp) ** 2),
+                     np.sqrt((h * st * sp) ** 2 + (h * cp - g) ** 2 + (z + h * ct * sp) ** 2),
+                     np.sqrt((c * ct - e) ** 2 + (z - c * st) ** 2)], axis=-1)
+
+
 # ----- forward kinematics -----------------------------------------------------------------------------------
 def _p_angles(geom: tuple, q: np.ndarray, z: np.ndarray, cos_theta: np.ndarray, sin_theta: np.ndarray) -> np.ndarray:
     """Complete P-model candidates (z, theta, psi) from z and theta (spec §2.4): cos psi from q1^2 + q2^2,
@@ -1833,8 +1843,7 @@ class RpsUpuTool(RpsUpu):
                 th0 = np.arcsin(np.clip(-t[:, 0] / np.where(ok, d * cp, 1.0), -1.0, 1.0))
                 for th in (th0, math.pi - th0):
                     cand = np.column_stack([t[:, 2] + d * np.cos(th) * cp, wrap_angle(th), wrap_angle(ps)])
-                    _, legs, _ = _legs(geom, "P", "plane", np.where(ok[:, None], cand, 0.0))
-                    miss = np.where(ok, np.abs(legs - q).max(axis=1), np.inf)
+                    miss = np.where(ok, np.abs(_p_leg_lengths(geom, cand) - q).max(axis=1), np.inf)
                     closer = miss < best
                     best, x = np.where(closer, miss, best), np.where(closer[:, None], cand, x)
         ends = self._capsule_ends(design, self._p(options), x)
