@@ -1846,11 +1846,17 @@ class RpsUpuTool(RpsUpu):
                     miss = np.where(ok, np.abs(_p_leg_lengths(geom, cand) - q).max(axis=1), np.inf)
                     closer = miss < best
                     best, x = np.where(closer, miss, best), np.where(closer[:, None], cand, x)
-        ends = self._capsule_ends(design, self._p(options), x)
-        _, p, _, _, _ = _platform(geom, "P", "plane", x)
-        z, th, ps = x.T
-        tool = (-d * np.sin(th) * np.cos(ps), d * np.sin(ps), z - d * np.cos(th) * np.cos(ps))
-        return links.endpoints_array([*ends, (p, tool)], len(t))
+        # the P-model's joints in closed form: phi = y0 = 0, p = (0, 0, z), R = Ry(theta) Rx(psi), so R (0, +-h, 0)
+        # = +-h (st sp, cp, ct sp) and R (c, 0, 0) = c (ct, 0, -st)
+        g, h, c, e = geom
+        z, st, ct, sp, cp = x[:, 0], np.sin(x[:, 1]), np.cos(x[:, 1]), np.sin(x[:, 2]), np.cos(x[:, 2])
+        a = [(0.0, -g, 0.0), (0.0, g, 0.0), (e, 0.0, 0.0)]
+        b = [(-h * st * sp, -h * cp, z - h * ct * sp), (h * st * sp, h * cp, z + h * ct * sp),
+             (c * ct, 0.0, z - c * st)]
+        sides = ((0, 1), (1, 2), (2, 0))
+        tool = (-d * st * cp, d * sp, z - d * ct * cp)
+        return links.endpoints_array([(a[i], a[j]) for i, j in sides] + [(a[i], b[i]) for i in range(3)]
+                                     + [(b[i], b[j]) for i, j in sides] + [((0.0, 0.0, z), tool)], len(t))
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """dq/dT (mm/mm) of the tool point; infinite where cos theta cos psi = 0 or a leg length is 0."""
