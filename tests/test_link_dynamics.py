@@ -47,7 +47,7 @@ def test_vectorised_endpoints_equal_link_geometry(name):
     rng = np.random.default_rng(0)
     poses = traj.p + 1e-3 * size * rng.standard_normal(traj.p.shape) * (np.array(mech.task_units) == "length")
     qs = q + 1e-3 * rng.standard_normal(q.shape)
-    fast = mech.link_endpoints(d, o, poses, qs)  # (segments, 2, 3, poses)
+    fast = mech.link_endpoints(d, o, poses, qs).segments()  # (segments, 2, 3, poses)
     for s in range(len(poses)):
         a, b, _ = mech.link_geometry(d, o, poses[s], qs[s]).as_arrays()
         np.testing.assert_allclose(fast[:, 0, :, s], a, rtol=0, atol=1e-12 * size)

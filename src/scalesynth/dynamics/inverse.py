@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from scalesynth.cycle import config as ccfg
+from scalesynth.mechanisms.links import SegmentPoints
 
 JACOBIAN_STEP = 1e-5
 SECOND_STEP = 1e-4
@@ -44,40 +45,43 @@ def frame_gravity(cyc, mech) -> np.ndarray:
     return out
 
 
-def endpoints(mech, design, options, poses: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Segment endpoints coordinate-major (n_segments, 2, 3, m), length unit, at poses (m, k) with joint values q
-    (m, n_joints): the mechanism's vectorised ``link_endpoints`` (links.endpoints_array) where it has one, else
-    link_geometry per pose. NaN where q is not finite."""
+def endpoints(mech, design, options, poses: np.ndarray, q: np.ndarray) -> SegmentPoints:
+    """Segment endpoints (links.SegmentPoints), length unit, at poses (m, k) with joint values q (m, n_joints): the
+    mechanism's vectorised ``link_endpoints`` where it has one, else link_geometry per pose (every end its own
+    moving point). NaN points where q is not finite."""
     bad = ~np.all(np.isfinite(q), axis=1)
     if hasattr(mech, "link_endpoints"):
         out = mech.link_endpoints(design, options, poses, q)
-        out[..., bad] = np.nan
+        out.points[..., bad] = np.nan
         return out
-    out = None
+    ends = None
     for s, pose in enumerate(poses):
         if bad[s]:
             continue
         a, b, _ = mech.link_geometry(design, options, pose, q[s]).as_arrays()
-        if out is None:
-            out = np.full((len(a), 2, 3, len(poses)), np.nan)
-        out[:, 0, :, s], out[:, 1, :, s] = a, b
-    if out is None:
+        if ends is None:
+            ends = np.full((len(a), 2, 3, len(poses)), np.nan)
+        ends[:, 0, :, s], ends[:, 1, :, s] = a, b
+    if ends is None:
         raise ValueError("no pose of the cycle is reachable")
-    return out
+    s = ends.shape[0]
+    return SegmentPoints(ends.reshape(2 * s, 3, -1), np.arange(2 * s).reshape(s, 2), np.full((s, 2, 3), np.nan))
 
 
 def link_points(mech, design, options, poses: np.ndarray, label: str) -> np.ndarray:
     """Segment endpoints (m, n_segments, 2, 3), length unit, at poses (m, k): IK (cycle_kinematics) in branch
-    ``label``, then ``endpoints``. NaN where the branch does not reach."""
+    ``label``, then ``endpoints``. NaN rows where the branch does not reach."""
     q, _ = mech.cycle_kinematics(design, options, poses, label)
-    return np.moveaxis(endpoints(mech, design, options, poses, q), -1, 0)
+    out = np.moveaxis(endpoints(mech, design, options, poses, q).segments(), -1, 0)
+    out[~np.all(np.isfinite(q), axis=1)] = np.nan
+    return out
 
 
-def endpoint_motion(mech, design, options, p, pd, pdd, q, A, a_dot, size: float, segments=None):
-    """Endpoints e (s, 2, 3, n), their Jacobians J (s, 2, 3, k, n) = de/dx (length unit per task unit) and
-    accelerations (s, 2, 3, n) (length unit per s^2) along the sampled motion p, pd, pdd (n, k), from the cycle's
-    joint values q (n, nj), velocity map A (n, nj, nj) and (dA/dt) x_dot a_dot (n, nj); coordinate-major (samples
-    last). ``segments``: an index of the segments to keep (default all)."""
+def endpoint_motion(mech, design, options, p, pd, pdd, q, A, a_dot, size: float):
+    """The moving points (links.SegmentPoints at the samples), their Jacobians J (P, 3, k, n) = de/dx (length
+    unit per task unit) and accelerations (P, 3, n) (length unit per s^2) along the sampled motion p, pd, pdd
+    (n, k), from the cycle's joint values q (n, nj), velocity map A (n, nj, nj) and (dA/dt) x_dot a_dot (n, nj);
+    coordinate-major (samples last)."""
     n, k = p.shape
     scale = np.array([size if u == "length" else 1.0 for u in mech.task_units])
     h = JACOBIAN_STEP * scale
@@ -93,35 +97,53 @@ def endpoint_motion(mech, design, options, p, pd, pdd, q, A, a_dot, size: float,
     bend = 0.5 * (eps * eps)[:, None] * a_dot
     poses = np.concatenate([p + dx, p - dx, (p + step_x)[None], p[None], (p - step_x)[None]])
     qs = np.concatenate([q + dq, q - dq, (q + step_q + bend)[None], q[None], (q - step_q + bend)[None]])
-    e = endpoints(mech, design, options, poses.reshape(-1, k), qs.reshape(-1, q.shape[1]))
-    if segments is not None:
-        e = e[segments]
-    e = e.reshape(*e.shape[:3], 2 * k + 3, n)
+    sp = endpoints(mech, design, options, poses.reshape(-1, k), qs.reshape(-1, q.shape[1]))
+    e = sp.points.reshape(*sp.points.shape[:2], 2 * k + 3, n)
     jac = (e[..., :k, :] - e[..., k:2 * k, :]) / (2.0 * h)[:, None]
     acc = jac[..., 0, :] * pdd[:, 0]
     for j in range(1, k):
         acc += jac[..., j, :] * pdd[:, j]
     inv_eps2 = np.where(moving, 1.0 / np.where(moving, eps * eps, 1.0), 0.0)
     acc += (e[..., 2 * k, :] - 2.0 * e[..., 2 * k + 1, :] + e[..., 2 * k + 2, :]) * inv_eps2
-    return e[..., 2 * k + 1, :], jac, acc
+    return SegmentPoints(e[..., 2 * k + 1, :], sp.index, sp.fixed), jac, acc
 
 
-def generalised_forces(mech, jac: np.ndarray, acc: np.ndarray, masses: np.ndarray, g3: np.ndarray,
-                       length_unit: str) -> tuple[np.ndarray, np.ndarray]:
+def point_masses(index: np.ndarray, masses: np.ndarray, n_points: int) -> np.ndarray:
+    """The rods' constant mass matrix on the moving points (P, P) kg: segment a -> b of mass m adds m/3 on the
+    diagonal at a and b and m/6 between them (T = m/6 (|va|^2 + va.vb + |vb|^2)); fixed ends (-1) drop out."""
+    out = np.zeros((n_points, n_points))
+    for (a, b), m in zip(index, masses, strict=True):
+        if m == 0.0:
+            continue
+        for u, v in ((a, a), (b, b)):
+            if u >= 0:
+                out[u, v] += m / 3.0
+        if a >= 0 and b >= 0:
+            out[a, b] += m / 6.0
+            out[b, a] += m / 6.0
+    return out
+
+
+def generalised_forces(mech, index: np.ndarray, jac: np.ndarray, acc: np.ndarray, masses: np.ndarray,
+                       g3: np.ndarray, length_unit: str) -> tuple[np.ndarray, np.ndarray]:
     """The links' generalised force on the task axes (n, k) and its gravity part (n, k): N along a length axis,
-    N m about an angle axis, from the Jacobians (s, 2, 3, k, n), endpoint accelerations (s, 2, 3, n; length unit
-    per s^2), segment masses (s,) kg and gravity g3 (3,) m/s^2 (endpoint_motion's layout)."""
+    N m about an angle axis, from the moving points' Jacobians (P, 3, k, n) and accelerations (P, 3, n; length
+    unit per s^2), which point each segment end is (``index`` (s, 2), -1 fixed), segment masses (s,) kg and
+    gravity g3 (3,) m/s^2 (endpoint_motion's layout). Per point, the forces of the rod ends on it summed:
+    f = M a - (weight share), M = point_masses."""
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
-    a_si = acc * m_per_unit
-    m6 = masses[:, None, None] / 6.0
-    weight = -0.5 * masses[:, None] * g3[None, :]  # (s, 3) per endpoint
-    f = np.empty_like(a_si)
-    f[:, 0] = m6 * (2.0 * a_si[:, 0] + a_si[:, 1]) + weight[:, :, None]
-    f[:, 1] = m6 * (a_si[:, 0] + 2.0 * a_si[:, 1]) + weight[:, :, None]
+    n_points = jac.shape[0]
+    weight = np.zeros((n_points, 3))  # -m g / 2 per moving end
+    for (a, b), m in zip(index, masses, strict=True):
+        for u in (a, b):
+            if u >= 0:
+                weight[u] -= 0.5 * m * g3
+    mass = point_masses(index, masses, n_points)
+    f = np.tensordot(mass, acc * m_per_unit, axes=(1, 0)) + weight[:, :, None]  # (P, 3, n)
     col = np.array([1.0 if u == "length" else m_per_unit for u in mech.task_units])  # m per m or m per rad
-    flat = jac.reshape(-1, *jac.shape[-2:])  # (s 2 3, k, n)
+    flat = jac.reshape(-1, *jac.shape[-2:])  # (P 3, k, n)
     F = np.einsum("lkn,ln->nk", flat, f.reshape(-1, f.shape[-1])) * col
-    F_g = np.einsum("lkn,l->nk", flat, np.repeat(weight[:, None, :], 2, axis=1).ravel()) * col
+    F_g = np.einsum("lkn,l->nk", flat, weight.ravel()) * col
     return F, F_g
 
 
@@ -149,10 +171,8 @@ def link_forces(mech, design, options, cyc, traj, size: float, q: np.ndarray, A:
     k = traj.p.shape[1]
     if not np.any(masses):
         return np.zeros((n, nj)), np.zeros((n, nj)), np.zeros((n, k))
-    heavy = np.nonzero(masses)[0] if not np.all(masses) else None  # massless segments add nothing
-    _, jac, acc = endpoint_motion(mech, design, options, traj.p, traj.pd, traj.pdd, q, A, a_dot, size, heavy)
-    F, F_g = generalised_forces(mech, jac, acc, masses if heavy is None else masses[heavy],
-                                frame_gravity(cyc, mech), length_unit)
+    sp, jac, acc = endpoint_motion(mech, design, options, traj.p, traj.pd, traj.pdd, q, A, a_dot, size)
+    F, F_g = generalised_forces(mech, sp.index, jac, acc, masses, frame_gravity(cyc, mech), length_unit)
     if not np.all(np.isfinite(F)):
         from scalesynth.errors import InvalidPose
 

@@ -1259,7 +1259,7 @@ class PprsRprs(Mechanism):
 
     def link_endpoints(self, design, options, poses, q) -> np.ndarray:
         """Vectorised twin of link_geometry's segment endpoints at poses (m, 3) (the options' orientation) or (m, 6)
-        with inputs q (m, 6): (12, 2, 3, m) mm (links.endpoints_array), segments in link_geometry's order."""
+        with inputs q (m, 6): links.SegmentPoints, segments in link_geometry's order."""
         pts, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
         geo = Geometry.of(design, options)
         if pts.shape[1] == 3:  # one rotation for every pose, as full_pose adds it
@@ -1274,7 +1274,7 @@ class PprsRprs(Mechanism):
         b3 = geo.rail * geo.u[2]
         d3 = b3 + s3[:, None] * (-np.cos(beta)[:, None] * geo.u[2] + np.sin(beta)[:, None] * np.array([0.0, 0.0, 1.0]))
         o = np.zeros(3)
-        return links.endpoints_array([
+        return links.segment_points([
             (o, geo.rail * geo.u[0]), (o, geo.rail * geo.u[1]), (o, b3), (b[0], d[0]), (b[1], d[1]), (b3, d3),
             (d[0], c[0]), (d[1], c[1]), (d3, c[2]), (c[0], c[1]), (c[1], c[2]), (c[2], c[0])], len(pts))
 

@@ -1048,15 +1048,16 @@ class RpsUpu(Mechanism):
         bp = np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]])
         b = p[:, None, :] + np.einsum("kj,mij->mki", bp, R)
         b[~valid] = np.nan
+        b = [b[:, i] for i in range(3)]  # one object per joint (links.segment_points)
         sides = ((1, 2), (2, 3), (3, 1))
-        return ([(a[i - 1], a[j - 1]) for i, j in sides] + [(a[i], b[:, i]) for i in range(3)]
-                + [(b[:, i - 1], b[:, j - 1]) for i, j in sides])
+        return ([(a[i - 1], a[j - 1]) for i, j in sides] + [(a[i], b[i]) for i in range(3)]
+                + [(b[i - 1], b[j - 1]) for i, j in sides])
 
     def link_endpoints(self, design, options, poses, q) -> np.ndarray:
-        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3): (9, 2, 3, m) mm
-        (links.endpoints_array), segments in link_geometry's order; q is not needed."""
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3): links.SegmentPoints, segments in
+        link_geometry's order; q is not needed."""
         x = np.asarray(poses, dtype=float)
-        return links.endpoints_array(self._capsule_ends(design, options, x), len(x))
+        return links.segment_points(self._capsule_ends(design, options, x), len(x))
 
     def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
         """Capsules (mm) at a pose (z, theta, psi): the base triangle A1 A2 A3, each leg A_i -> B_i (cylinder and
@@ -1829,7 +1830,7 @@ class RpsUpuTool(RpsUpu):
 
     def link_endpoints(self, design, options, poses, q) -> np.ndarray:
         """Vectorised twin of link_geometry's segment endpoints at tool points (m, 3) with legs q (m, 3):
-        (10, 2, 3, m) mm (links.endpoints_array). The pose of each point as _pose_for picks it: of the (up to four)
+        links.SegmentPoints. The pose of each point as _pose_for picks it: of the (up to four)
         poses placing the tool there, in poses_of_tool_point's order, the first whose legs are closest to q."""
         t, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
         d = options["tool_offset"]
@@ -1855,7 +1856,7 @@ class RpsUpuTool(RpsUpu):
              (c * ct, 0.0, z - c * st)]
         sides = ((0, 1), (1, 2), (2, 0))
         tool = (-d * st * cp, d * sp, z - d * ct * cp)
-        return links.endpoints_array([(a[i], a[j]) for i, j in sides] + [(a[i], b[i]) for i in range(3)]
+        return links.segment_points([(a[i], a[j]) for i, j in sides] + [(a[i], b[i]) for i in range(3)]
                                      + [(b[i], b[j]) for i, j in sides] + [((0.0, 0.0, z), tool)], len(t))
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:

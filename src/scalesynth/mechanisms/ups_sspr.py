@@ -838,8 +838,8 @@ class UpsSspr(Mechanism):
         return links.LinkGeometry(segments, links.adjacency(ADJACENT))
 
     def link_endpoints(self, design, options, poses, q) -> np.ndarray:
-        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3) = (alpha, beta, Y): (11, 2, 3, m) mm
-        (links.endpoints_array), segments in link_geometry's order; NaN rows where |Y| >= c. q is not needed."""
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3) = (alpha, beta, Y):
+        links.SegmentPoints, segments in link_geometry's order; NaN where |Y| >= c. q is not needed."""
         x = np.asarray(poses, dtype=float)
         a, b, c = design["a"], design["b"], design["c"]
         alpha, beta, yy = x[:, 0], x[:, 1], np.where(np.abs(x[:, 2]) < c, x[:, 2], np.nan)
@@ -857,7 +857,7 @@ class UpsSspr(Mechanism):
              "B1": p, "B2": on_platform(-bxy, bxy), "B3": on_platform(bxy, bxy)}
         parts = [("A1", "A2"), ("A2", "A3"), ("A3", "A1"), ("A0", "M"), ("M", "B0"), ("A2", "B2"), ("A3", "B3"),
                  ("A0", "B1"), ("B1", "B2"), ("B2", "B3"), ("B3", "B1")]
-        return links.endpoints_array([(j[u], j[v]) for u, v in parts], len(x))
+        return links.segment_points([(j[u], j[v]) for u, v in parts], len(x))
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """Jx = dl/d(alpha, beta, Y) (mm/rad, mm/rad, mm/mm): l_dot = Jx x_dot (Jq = I); infinite where Jx is

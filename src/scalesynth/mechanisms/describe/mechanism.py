@@ -213,7 +213,7 @@ class DescribedMechanism(Mechanism):
 
     def link_endpoints(self, design, options, poses, q) -> np.ndarray:
         """Vectorised twin of link_geometry's segment endpoints at platform centres (m, 3) with joint values (m, 3):
-        (n_segments, 2, 3, m) (bodies.link_endpoints)."""
+        links.SegmentPoints (bodies.link_endpoints)."""
         return bodies.link_endpoints(self.legs(design, options), bodies.widths(self.plans, design), poses, q)
 
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
