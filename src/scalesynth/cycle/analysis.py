@@ -245,7 +245,7 @@ def analyse(
     if flip.size:
         raise CycleError(f"cycle: a singularity lies between {_where(mech, traj, int(flip[0]))} and the next sample")
     qd, qdd, force, force_gravity, task_force, force_map, vel, acc = _rates_and_forces(
-        mech, design, options, cyc, length_unit, traj, kin, A, label, size)
+        mech, design, options, cyc, length_unit, traj, kin, q, A, label, size)
     g = ccfg.gravity_vector(cyc, mech)
     m_per_unit = ccfg.METRES_PER_UNIT[length_unit]
     gaps = _clearance_along(mech, design, options, packed, traj.p, q, reference)
@@ -261,11 +261,12 @@ def analyse(
     )
 
 
-def _rates_and_forces(mech: Mechanism, design, options, cyc, length_unit: str, traj, kin, A: np.ndarray, label: str,
-                      size: float):
-    """Actuator rates and forces along the sampled motion ``traj`` (p, pd, pdd), A (n, nj, nj) the velocity map at
-    traj.p: (qd, qdd, force, force_gravity, task_force, force_map, payload velocity, payload acceleration), the
-    links' and the payload's inverse dynamics together (the arrays of CycleResult)."""
+def _rates_and_forces(mech: Mechanism, design, options, cyc, length_unit: str, traj, kin, q: np.ndarray,
+                      A: np.ndarray, label: str, size: float):
+    """Actuator rates and forces along the sampled motion ``traj`` (p, pd, pdd), q (n, nj) the joint values and
+    A (n, nj, nj) the velocity map at traj.p: (qd, qdd, force, force_gravity, task_force, force_map, payload
+    velocity, payload acceleration), the links' and the payload's inverse dynamics together (the arrays of
+    CycleResult)."""
     n, k = traj.p.shape
     nj = len(mech.joints)
     pd_full = np.zeros((n, nj))
@@ -273,12 +274,13 @@ def _rates_and_forces(mech: Mechanism, design, options, cyc, length_unit: str, t
     pdd_full = np.zeros((n, nj))
     pdd_full[:, :k] = traj.pdd
     qd = np.einsum("nij,nj->ni", A, pd_full)
-    qdd = np.einsum("nij,nj->ni", A, pdd_full) + _a_dot_xdot(kin, mech, traj, size)
+    a_dot = _a_dot_xdot(kin, mech, traj, size)
+    qdd = np.einsum("nij,nj->ni", A, pdd_full) + a_dot
     g = ccfg.gravity_vector(cyc, mech)
     vel, acc, jc = _payload_motion(mech, design, options, traj, size)
     force, force_gravity, task_force, force_map = _forces(mech, A, jc, acc, cyc.payload, g, length_unit)
-    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, label, size,
-                                                   si_velocity_map(mech, A, length_unit), length_unit)
+    links, links_gravity, links_task = link_forces(mech, design, options, cyc, traj, size, q, A, a_dot,
+                                                   si_velocity_map(mech, A, length_unit), length_unit, label)
     return (qd, qdd, force + links, force_gravity + links_gravity, task_force + links_task, force_map, vel, acc)
 
 
@@ -300,8 +302,8 @@ def sample_dynamics(mech: Mechanism, design, options, cyc: ccfg.CycleConfig, len
     if not np.all(np.isfinite(q)):
         raise CycleError(f"cycle: {_where(mech, traj, int(np.argmin(np.all(np.isfinite(q), axis=1))))} is out of "
                          f"reach in working mode {label}")
-    qd, qdd, force, force_gravity, *_ = _rates_and_forces(mech, design, options, cyc, length_unit, traj, kin, A,
-                                                           label, _size(mech, design, options))
+    qd, qdd, force, force_gravity, *_ = _rates_and_forces(mech, design, options, cyc, length_unit, traj, kin, q,
+                                                           A, label, _size(mech, design, options))
     return qd, qdd, force, force_gravity
 
 

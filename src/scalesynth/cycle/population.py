@@ -166,8 +166,8 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
             except ScalesynthError:
                 ok[j] = False
     keep = np.nonzero(ok)[0]
-    live, packed, lci, q, A, qd, qdd, acc, size = (live[keep], packed[keep], lci[keep], q[keep], A[keep], qd[keep],
-                                                   qdd[keep], acc[keep], size[keep])
+    live, packed, lci, q, A, a_dot, qd, qdd, acc, size = (live[keep], packed[keep], lci[keep], q[keep], A[keep],
+                                                          a_dot[keep], qd[keep], qdd[keep], acc[keep], size[keep])
     jc = None if jc is None else [jc[j] for j in keep]
     resolved = [resolved[j] for j in keep]
     if not len(live):
@@ -184,8 +184,8 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
     ok = np.ones(nd, dtype=bool)
     for j in range(nd):
         try:
-            links, links_g, _ = link_forces(mech, resolved[j], options, cyc, traj, label, size[j],
-                                            analysis.si_velocity_map(mech, A[j], length_unit), length_unit)
+            links, links_g, _ = link_forces(mech, resolved[j], options, cyc, traj, size[j], q[j], A[j], a_dot[j],
+                                            analysis.si_velocity_map(mech, A[j], length_unit), length_unit, label)
         except ScalesynthError:
             ok[j] = False
             continue

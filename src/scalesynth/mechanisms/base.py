@@ -279,7 +279,9 @@ class Mechanism(ABC):
     # ----- cycle analysis and interference (scalesynth.cycle); optional: a mechanism without them says so --
     def link_geometry(self, design, options, pose, q):
         """Bodies at a pose with joint values q as named capsules, and which bodies share a joint
-        (:class:`scalesynth.mechanisms.links.LinkGeometry`, mechanism frame, length unit, planar z = 0)."""
+        (:class:`scalesynth.mechanisms.links.LinkGeometry`, mechanism frame, length unit, planar z = 0). A mechanism
+        may add its vectorised twin ``link_endpoints(design, options, poses (m, k), q (m, n_joints))`` ->
+        links.SegmentPoints, which the link dynamics use (tests/test_link_dynamics.py holds the two equal)."""
         raise InvalidParameter(f"mechanism: {self.name} has no link geometry yet (cycle and clearance need it)")
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:

@@ -101,6 +101,57 @@ def kernel_pairs(segment_bodies: Sequence[str], adjacent: frozenset[frozenset[st
                      if b[i] != b[j] and frozenset((b[i], b[j])) not in adjacent], dtype=np.int64).reshape(-1, 2)
 
 
+@dataclass(frozen=True)
+class SegmentPoints:
+    """Segment endpoints at m poses, as a mechanism's vectorised ``link_endpoints`` gives them: the distinct moving
+    points once each, coordinate-major, and which point each segment end is.
+
+    ``points`` (P, 3, m): the moving points (length unit); ``index`` (s, 2) int: the point of each segment's a and
+    b, -1 for a fixed end; ``fixed`` (s, 2, 3): the fixed ends' coordinates (NaN at moving ends). A joint shared
+    by several segments is one point (its derivatives are taken once); a fixed end moves with no pose.
+    """
+
+    points: np.ndarray
+    index: np.ndarray
+    fixed: np.ndarray
+
+    def segments(self) -> np.ndarray:
+        """Every segment's endpoints (s, 2, 3, m): LinkGeometry.as_arrays' a and b at each pose."""
+        m = self.points.shape[-1]
+        out = np.empty((*self.index.shape, 3, m))
+        moving = self.index >= 0
+        out[moving] = self.points[self.index[moving]]
+        out[~moving] = self.fixed[~moving][:, :, None]
+        return out
+
+
+def segment_points(ends: Sequence[tuple[Any, Any]], m: int) -> SegmentPoints:
+    """SegmentPoints at m poses from a list of (a, b) per segment in link_geometry's order. A point is an array
+    (3,) or 3 numbers (fixed), an array (m, 3), or 3 coordinates each a number or an array (m,) (moving); the
+    same Python object given for several ends is one point."""
+    index = np.full((len(ends), 2), -1, dtype=np.int64)
+    fixed = np.full((len(ends), 2, 3), np.nan)
+    seen: dict[int, int] = {}
+    moving: list[Any] = []
+    for i, pair in enumerate(ends):
+        for j, pt in enumerate(pair):
+            if isinstance(pt, np.ndarray) and pt.ndim == 1 or all(np.ndim(c) == 0 for c in pt):
+                fixed[i, j] = [float(c) for c in pt]
+                continue
+            if id(pt) not in seen:
+                seen[id(pt)] = len(moving)
+                moving.append(pt)
+            index[i, j] = seen[id(pt)]
+    points = np.empty((len(moving), 3, m))
+    for k, pt in enumerate(moving):
+        if isinstance(pt, np.ndarray):
+            points[k] = pt.T
+        else:
+            for c in range(3):
+                points[k, c] = pt[c]
+    return SegmentPoints(points, index, fixed)
+
+
 def point(*coords: float) -> np.ndarray:
     """A 3-D point from 2 or 3 coordinates (planar points get z = 0)."""
     c = [float(v) for v in coords]

@@ -894,6 +894,18 @@ class PauuPpap(Mechanism):
             ("link2", "platform"),
         ]))
 
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3) with inputs q (m, 3):
+        links.SegmentPoints, segments in link_geometry's order."""
+        pts, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
+        m, n, l1 = design["m"], design["n"], design["l1"]
+        e = self.offset_e(design, options)
+        a = {1: (m, 0.0, e), -1: (-m, 0.0, e)}
+        c = {s: (s * (m + l1 * np.cos(t)), 0.0, e - l1 * np.sin(t)) for s, t in ((1, q[:, 0]), (-1, q[:, 1]))}
+        d = {s: (pts[:, 0] + s * n, pts[:, 1], pts[:, 2]) for s in (1, -1)}
+        return links.segment_points([(a[-1], a[1]), (a[1], c[1]), (a[-1], c[-1]), (c[1], d[1]), (c[-1], d[-1]),
+                                      (d[-1], d[1])], len(pts))
+
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """A = Jq^-1 Jx: q_dot = A P_dot (rad and length per unit time), the inverse of J = Jx^-1 Jq; rows with an
         inverse singularity (Jq_ii = 0) are infinite."""

@@ -490,6 +490,16 @@ class PlanarFivebar(Mechanism):
             ("forearm1", "forearm2"), ("forearm1", "platform"), ("forearm2", "platform"),
         ]))
 
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 2) with arm angles q (m, 2):
+        links.SegmentPoints (mm), segments in link_geometry's order."""
+        pts, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
+        r, l1 = design["r"], design["l1"]
+        b1, b2, p = (r, 0.0, 0.0), (-r, 0.0, 0.0), (pts[:, 0], pts[:, 1], 0.0)
+        e1 = (r + l1 * np.cos(q[:, 0]), l1 * np.sin(q[:, 0]), 0.0)
+        e2 = (-r + l1 * np.cos(q[:, 1]), l1 * np.sin(q[:, 1]), 0.0)
+        return links.segment_points([(b2, b1), (b1, e1), (b2, e2), (e1, p), (e2, p), (p, p)], len(pts))
+
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """A = Jq^-1 Jx (rad/mm): alpha_dot = A P_dot, the inverse of J (spec §2.4); rows with an inverse
         singularity (Jq_ii = 0) are infinite."""

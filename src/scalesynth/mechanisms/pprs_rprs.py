@@ -1276,6 +1276,27 @@ class PprsRprs(Mechanism):
             ("leg3", "link3"), ("link1", "platform"), ("link2", "platform"), ("link3", "platform"),
         ]))
 
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3) (the options' orientation) or (m, 6)
+        with inputs q (m, 6): links.SegmentPoints, segments in link_geometry's order."""
+        pts, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
+        geo = Geometry.of(design, options)
+        if pts.shape[1] == 3:  # one rotation for every pose, as full_pose adds it
+            off = geo.body @ rotation(*np.asarray(options["orientation"], dtype=float)).T
+            c = [pts + off[i] for i in range(3)]
+        else:
+            rot = rotation(pts[:, 3], pts[:, 4], pts[:, 5])
+            c = [pts[:, :3] + np.einsum("mij,j->mi", rot, geo.body[i]) for i in range(3)]
+        w1, w2, beta, s1, s2, s3 = q.T
+        b = [np.multiply.outer(geo.rail - w if geo.conv_r else w, geo.u[k]) for k, w in enumerate((w1, w2))]
+        d = [(b[0][:, 0], b[0][:, 1], b[0][:, 2] + s1), (b[1][:, 0], b[1][:, 1], b[1][:, 2] + s2)]
+        b3 = geo.rail * geo.u[2]
+        d3 = b3 + s3[:, None] * (-np.cos(beta)[:, None] * geo.u[2] + np.sin(beta)[:, None] * np.array([0.0, 0.0, 1.0]))
+        o = np.zeros(3)
+        return links.segment_points([
+            (o, geo.rail * geo.u[0]), (o, geo.rail * geo.u[1]), (o, b3), (b[0], d[0]), (b[1], d[1]), (b3, d3),
+            (d[0], c[0]), (d[1], c[1]), (d3, c[2]), (c[0], c[1]), (c[1], c[2]), (c[2], c[0])], len(pts))
+
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """The twist Jacobian J_t (6 x 6): q_dot = J_t [v; omega]; the task axes are v (mm/s), the held
         orientation's angular velocity omega (rad/s) is 0 along a constant-orientation cycle (spec §1.5)."""

@@ -540,6 +540,16 @@ def _legs(geom: tuple, model: str, variant: str, x: np.ndarray):
     return valid, q, jx
 
 
+def _p_leg_lengths(geom: tuple, x: np.ndarray) -> np.ndarray:
+    """Leg lengths (n, 3) of the P-model at poses x (n, 3) = (z, theta, psi) in closed form (phi = y0 = 0, so
+    B_i = (0, 0, z) + Ry(theta) Rx(psi) b_i'): _legs' q without its Jacobians."""
+    g, h, c, e = geom
+    z, st, ct, sp, cp = x[:, 0], np.sin(x[:, 1]), np.cos(x[:, 1]), np.sin(x[:, 2]), np.cos(x[:, 2])
+    return np.stack([np.sqrt((h * st * sp) ** 2 + (g - h * cp) ** 2 + (z - h * ct * sp) ** 2),
+                     np.sqrt((h * st * sp) ** 2 + (h * cp - g) ** 2 + (z + h * ct * sp) ** 2),
+                     np.sqrt((c * ct - e) ** 2 + (z - c * st) ** 2)], axis=-1)
+
+
 # ----- forward kinematics -----------------------------------------------------------------------------------
 def _p_angles(geom: tuple, q: np.ndarray, z: np.ndarray, cos_theta: np.ndarray, sin_theta: np.ndarray) -> np.ndarray:
     """Complete P-model candidates (z, theta, psi) from z and theta (spec §2.4): cos psi from q1^2 + q2^2,
@@ -1046,6 +1056,26 @@ class RpsUpu(Mechanism):
                  for i, j in sides]
         adjacent = [("base", f"leg{i}") for i in (1, 2, 3)] + [(f"leg{i}", "platform") for i in (1, 2, 3)]
         return segs, adjacent
+
+    def _capsule_ends(self, design, options, x: np.ndarray) -> list:
+        """_capsules' segment endpoints at poses x (m, 3), vectorised: [(a, b)] with points (3,) or (m, 3); NaN
+        rows where the C-model parametrisation is degenerate."""
+        g, h, c, e = self._geom(design)
+        valid, p, R, _, _ = _platform(self._geom(design), options["model"], options["c3_variant"], x)
+        a = np.array([[0.0, -g, 0.0], [0.0, g, 0.0], [e, 0.0, 0.0]])
+        bp = np.array([[0.0, -h, 0.0], [0.0, h, 0.0], [c, 0.0, 0.0]])
+        b = p[:, None, :] + np.einsum("kj,mij->mki", bp, R)
+        b[~valid] = np.nan
+        b = [b[:, i] for i in range(3)]  # one object per joint (links.segment_points)
+        sides = ((1, 2), (2, 3), (3, 1))
+        return ([(a[i - 1], a[j - 1]) for i, j in sides] + [(a[i], b[i]) for i in range(3)]
+                + [(b[i - 1], b[j - 1]) for i, j in sides])
+
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3): links.SegmentPoints, segments in
+        link_geometry's order; q is not needed."""
+        x = np.asarray(poses, dtype=float)
+        return links.segment_points(self._capsule_ends(design, options, x), len(x))
 
     def link_geometry(self, design, options, pose, q) -> links.LinkGeometry:
         """Capsules (mm) at a pose (z, theta, psi): the base triangle A1 A2 A3, each leg A_i -> B_i (cylinder and
@@ -1838,6 +1868,37 @@ class RpsUpuTool(RpsUpu):
         _, _, origin, _ = self._joint_points(design, self._p(options), x)
         segs.append(links.Segment("tool", "tool", origin, self.tool_point(design, options, x), radii["tool"]))
         return links.LinkGeometry(tuple(segs), links.adjacency([*adjacent, ("tool", "platform")]))
+
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at tool points (m, 3) with legs q (m, 3):
+        links.SegmentPoints. The pose of each point as _pose_for picks it: of the (up to four)
+        poses placing the tool there, in poses_of_tool_point's order, the first whose legs are closest to q."""
+        t, q = np.asarray(poses, dtype=float), np.asarray(q, dtype=float)
+        d = options["tool_offset"]
+        geom = self._geom(design)
+        with np.errstate(invalid="ignore"):
+            ps0 = np.arcsin(np.clip(t[:, 1] / d, -1.0, 1.0))
+            best, x = np.full(len(t), np.inf), np.full((len(t), 3), np.nan)
+            for ps in (ps0, math.pi - ps0):
+                cp = np.cos(ps)
+                ok = (np.abs(t[:, 1]) <= d) & (np.abs(cp) > 1e-12) & (np.abs(t[:, 0]) <= d * np.abs(cp))
+                th0 = np.arcsin(np.clip(-t[:, 0] / np.where(ok, d * cp, 1.0), -1.0, 1.0))
+                for th in (th0, math.pi - th0):
+                    cand = np.column_stack([t[:, 2] + d * np.cos(th) * cp, wrap_angle(th), wrap_angle(ps)])
+                    miss = np.where(ok, np.abs(_p_leg_lengths(geom, cand) - q).max(axis=1), np.inf)
+                    closer = miss < best
+                    best, x = np.where(closer, miss, best), np.where(closer[:, None], cand, x)
+        # the P-model's joints in closed form: phi = y0 = 0, p = (0, 0, z), R = Ry(theta) Rx(psi), so R (0, +-h, 0)
+        # = +-h (st sp, cp, ct sp) and R (c, 0, 0) = c (ct, 0, -st)
+        g, h, c, e = geom
+        z, st, ct, sp, cp = x[:, 0], np.sin(x[:, 1]), np.cos(x[:, 1]), np.sin(x[:, 2]), np.cos(x[:, 2])
+        a = [(0.0, -g, 0.0), (0.0, g, 0.0), (e, 0.0, 0.0)]
+        b = [(-h * st * sp, -h * cp, z - h * ct * sp), (h * st * sp, h * cp, z + h * ct * sp),
+             (c * ct, 0.0, z - c * st)]
+        sides = ((0, 1), (1, 2), (2, 0))
+        tool = (-d * st * cp, d * sp, z - d * ct * cp)
+        return links.segment_points([(a[i], a[j]) for i, j in sides] + [(a[i], b[i]) for i in range(3)]
+                                     + [(b[i], b[j]) for i, j in sides] + [((0.0, 0.0, z), tool)], len(t))
 
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """dq/dT (mm/mm) of the tool point; infinite where cos theta cos psi = 0 or a leg length is 0."""

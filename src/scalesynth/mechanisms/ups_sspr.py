@@ -852,6 +852,28 @@ class UpsSspr(Mechanism):
         segments = tuple(links.Segment(n, body, j[a], j[b], rad[body]) for n, body, a, b in parts)
         return links.LinkGeometry(segments, links.adjacency(ADJACENT))
 
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at poses (m, 3) = (alpha, beta, Y):
+        links.SegmentPoints, segments in link_geometry's order; NaN where |Y| >= c. q is not needed."""
+        x = np.asarray(poses, dtype=float)
+        a, b, c = design["a"], design["b"], design["c"]
+        alpha, beta, yy = x[:, 0], x[:, 1], np.where(np.abs(x[:, 2]) < c, x[:, 2], np.nan)
+        rho = np.sqrt(c * c - yy * yy)
+        sa, ca, sb, cb = np.sin(alpha), np.cos(alpha), np.sin(beta), np.cos(beta)
+        p = np.stack([sb * rho, yy, cb * rho], axis=-1)
+        bxy = b * INV_SQRT2
+
+        def on_platform(u, v):  # p + Ry(beta) Rx(alpha) (u, v, 0)
+            return np.stack([p[:, 0] + (cb * u + sb * sa * v), p[:, 1] + ca * v, p[:, 2] + (-sb * u + cb * sa * v)],
+                            axis=-1)
+
+        j = {"A0": np.zeros(3), "A1": np.array([0.0, a, 0.0]), "A2": np.array([-SQRT3_2 * a, -a / 2.0, 0.0]),
+             "A3": np.array([SQRT3_2 * a, -a / 2.0, 0.0]), "M": np.array([0.0, -a / 2.0, 0.0]), "B0": K0 * p,
+             "B1": p, "B2": on_platform(-bxy, bxy), "B3": on_platform(bxy, bxy)}
+        parts = [("A1", "A2"), ("A2", "A3"), ("A3", "A1"), ("A0", "M"), ("M", "B0"), ("A2", "B2"), ("A3", "B3"),
+                 ("A0", "B1"), ("B1", "B2"), ("B2", "B3"), ("B3", "B1")]
+        return links.segment_points([(j[u], j[v]) for u, v in parts], len(x))
+
     def velocity_map(self, design, options, pose, q) -> np.ndarray:
         """Jx = dl/d(alpha, beta, Y) (mm/rad, mm/rad, mm/mm): l_dot = Jx x_dot (Jq = I); infinite where Jx is
         undefined (|Y| = c or a zero-length leg)."""

@@ -174,6 +174,60 @@ def link_geometry6(legs, rad: Mapping[str, float], pose, rot: np.ndarray, q) -> 
     return links.LinkGeometry(tuple(ring + segs + ring_p), links.adjacency(pairs))
 
 
+def link_endpoints(legs, widths: Sequence[float], poses: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Vectorised twin of link_geometry's segment endpoints at platform centres ``poses`` (m, 3) with joint values
+    ``q`` (m, n_legs): links.SegmentPoints, segments in link_geometry's order. The platform
+    polygon's order is the angular order of the joints' offsets Q_i +- h n_i - P (pose-independent)."""
+    p = np.asarray(poses, dtype=float)
+    q = np.asarray(q, dtype=float)
+    segs: list[tuple[str, Any, Any]] = []  # (body, a, b)
+    base_pts, plat_offsets = [], []
+    for i, (leg, w) in enumerate(zip(legs, widths, strict=True), 1):
+        h = 0.5 * float(w)
+        qi = q[:, i - 1]
+        if leg.type.code == _k.R_PA:
+            e = leg.base + leg.arm * (np.cos(qi)[:, None] * leg.u + np.sin(qi)[:, None] * leg.w)
+        else:
+            e = leg.base + qi[:, None] * leg.u
+        j = p + leg.platform
+        side = h * leg.normal
+        # each joint point one object (links.segment_points takes its derivatives once)
+        e_lo, e_hi, j_lo, j_hi = (e - side, e + side, j - side, j + side) if h > 0.0 else (e, e, j, j)
+        base_pts.append(leg.base)
+        plat_offsets += [(leg.platform - side, j_lo), (leg.platform + side, j_hi)] if h > 0.0 else [(leg.platform, j)]
+        if leg.type.code == _k.R_PA:
+            segs.append((f"upper_arm{i}", leg.base, e))
+            if h > 0.0:
+                segs.append((f"upper_arm{i}", e_lo, e_hi))
+        else:
+            lo, hi = leg.limits
+            segs.append((f"rail{i}", leg.base + lo * leg.u, leg.base + hi * leg.u))
+            segs.append((f"carriage{i}", e_lo, e_hi))
+        if h > 0.0:
+            segs += [(f"forearm{i}", e_hi, j_hi), (f"forearm{i}", e_lo, j_lo)]
+        else:
+            segs.append((f"forearm{i}", e, j))
+    segs += [("base", a, b) for a, b in _ring(base_pts, np.mean(base_pts, axis=0))]
+    # the platform polygon in the angular order of the offsets; the ring's points are the offsets' joint points
+    offsets = [off for off, _ in plat_offsets]
+    joint_of = {id(off): pt for off, pt in plat_offsets}
+    for a, b in _ring_unsorted_ids(offsets):
+        segs.append(("platform", joint_of[id(a)], joint_of[id(b)]))
+    order = {b: n for n, b in enumerate(body_names([leg.type.code for leg in legs]))}
+    segs.sort(key=lambda s: order[s[0]])
+    return links.segment_points([(a, b) for _, a, b in segs], len(p))
+
+
+def _ring_unsorted_ids(offsets) -> list[tuple[np.ndarray, np.ndarray]]:
+    """_ring's sides about the origin, keeping the given array objects (so that each can be looked up by id)."""
+    pts = sorted(offsets, key=lambda v: math.atan2(v[1], v[0]))
+    if len(pts) == 1:
+        return [(pts[0], pts[0])]
+    if len(pts) == 2:
+        return [(pts[0], pts[1])]
+    return [(pts[k], pts[(k + 1) % len(pts)]) for k in range(len(pts))]
+
+
 def _ring(points, centre) -> list[tuple[np.ndarray, np.ndarray]]:
     """Sides of the closed polygon through ``points`` in angular order about ``centre`` (xy-plane angle); one point
     gives one ball, two points one side."""

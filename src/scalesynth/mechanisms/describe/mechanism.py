@@ -211,6 +211,11 @@ class DescribedMechanism(Mechanism):
         rad = bodies.radii(options, self._codes(), self.default_length_unit)
         return bodies.link_geometry(self.legs(design, options), bodies.widths(self.plans, design), rad, p, qv)
 
+    def link_endpoints(self, design, options, poses, q) -> np.ndarray:
+        """Vectorised twin of link_geometry's segment endpoints at platform centres (m, 3) with joint values (m, 3):
+        links.SegmentPoints (bodies.link_endpoints)."""
+        return bodies.link_endpoints(self.legs(design, options), bodies.widths(self.plans, design), poses, q)
+
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
         """The stiffness frame (scalesynth.stiffness.FrameModel) at platform centre ``pose`` in the kernel's
         branch: arms or carriages on actuator springs, each parallelogram as two bars on universal joints, a rigid
