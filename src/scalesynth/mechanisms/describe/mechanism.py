@@ -338,7 +338,11 @@ def _footprint(desc_mech_plans, d: Mapping[str, float]) -> float:
 
 
 def from_description(desc: Description) -> DescribedMechanism:
-    """The registered mechanism of a validated description (motion 6DOF: sixdof.py's)."""
+    """The registered mechanism of a validated description (motion 6DOF: sixdof.py's; 2T: planar.py's)."""
+    if desc.motion == "2T":
+        from scalesynth.mechanisms.describe.planar import from_description_2t
+
+        return from_description_2t(desc)
     if desc.motion == "6DOF":
         from scalesynth.mechanisms.describe.sixdof import from_description_6dof
 
