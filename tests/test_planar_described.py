@@ -232,8 +232,8 @@ def test_described_fivebar_has_the_hand_written_bodies_and_kinematics():
     np.testing.assert_allclose(FIVEBAR.jacobians(d, o, pose, q)["J"], HAND.jacobians(d, ho, pose, q)["J"],
                                rtol=1e-12)
     assert FIVEBAR.lci(d, o, pose, q) == pytest.approx(HAND.lci(d, ho, pose, q), rel=1e-12)
-    fk_o = sorted((tuple(s.values) for s in FIVEBAR.forward_kinematics(d, o, q)))
-    fk_h = sorted((tuple(s.values) for s in HAND.forward_kinematics(d, ho, q)))
+    fk_o = sorted(tuple(s.values) for s in FIVEBAR.forward_kinematics(d, o, q))
+    fk_h = sorted(tuple(s.values) for s in HAND.forward_kinematics(d, ho, q))
     np.testing.assert_allclose(fk_o, fk_h, rtol=0, atol=1e-9)
     geo_o, geo_h = FIVEBAR.link_geometry(d, o, pose, q), HAND.link_geometry(d, ho, pose, q)
     assert geo_o.adjacent == geo_h.adjacent
