@@ -65,7 +65,8 @@ def test_example_default_file_name_and_bad_names(tmp_path, monkeypatch):
     assert (tmp_path / "rps_upu.yaml").read_bytes() == (PACKAGED / "rps_upu.yaml").read_bytes()
     res = runner.invoke(app, ["example", "nope"])
     assert res.exit_code == 2 and len(res.stderr.strip().splitlines()) == 1
-    assert res.stderr.startswith("error: example: unknown example 'nope' (available: delta, fivebar_described, fivebar_packing, ")
+    assert res.stderr.startswith("error: example: unknown example 'nope' (available: delta, fivebar_described, "
+                                 "fivebar_packing, ")
     res = runner.invoke(app, ["example"])
     assert res.exit_code == 2 and "give an example name" in res.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rps_upu.yaml"]  # nothing else written

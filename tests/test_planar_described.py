@@ -261,3 +261,25 @@ def test_bad_planar_descriptions_name_the_leg_and_field(change, message):
         parse_description(data, "d.yaml")
     line = str(err.value)
     assert line.startswith("d.yaml: " + message) and "\n" not in line and len(line) <= 200
+
+
+def test_described_fivebar_runs_the_packing_cycle_like_the_hand_written():
+    """configs/fivebar_packing.yaml's Adept cycle (1 kg, 60 cycles/min, link dynamics from the bodies) on both: the
+    same actuator speeds, accelerations and forces, minimum LCI and clearance (1e-9 relative)."""
+    import yaml
+
+    from conftest import ROOT
+
+    data = yaml.safe_load((ROOT / "configs" / "fivebar_packing.yaml").read_text())
+    data.pop("output", None)
+    data["objectives"] = [{"metric": "cycle_max_actuator_force", "sense": "min"},
+                          {"metric": "cycle_min_clearance", "sense": "max"}]
+    data["constraints"] = []
+    hand = evaluate_config(config_from_dict(data)).metrics
+    data["mechanism"] = "planar-fivebar-described"
+    del data["options"]["mode"]
+    ours = evaluate_config(config_from_dict(data)).metrics
+    keys = [k for k in ours if k.startswith("cycle_")]
+    assert len(keys) >= 6 and hand["cycle_feasible"] == 1.0
+    for k in keys:
+        assert ours[k] == pytest.approx(hand[k], rel=1e-9), k
