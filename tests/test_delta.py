@@ -258,7 +258,7 @@ def _bad(**changes):
 @pytest.mark.parametrize(("data", "message"), [
     (_bad(leg_type="P-Pb"),
      "d: legs[0] (leg).type: unknown leg type 'P-Pb' (did you mean 'P-Pa'?; library: R-Pa, P-Pa, RUS, R-SS, UPS, "
-     "SPS)"),
+     "SPS, RR, PR)"),
     (_bad(leg_base=["rail_radus", 0, 0]),
      "d: legs[0] (leg).base.x: unknown parameter 'rail_radus' (did you mean 'rail_radius'?; known: "
      "rail_radius, platform_radius, forearm)"),
@@ -273,7 +273,7 @@ def _bad(**changes):
     (_bad(leg_base=["__import__('os')", 0, 0]),
      "d: legs[0] (leg).base.x: \"__import__('os')\": only numbers, parameters, pi, + - * / ** and sqrt, sin, cos, "
      "tan, radians are allowed"),
-    (_bad(motion="6D"), "d: motion: '6D' is not handled yet (did you mean '6DOF'?; handled: 3T, 6DOF)"),
+    (_bad(motion="6D"), "d: motion: '6D' is not handled yet (did you mean '6DOF'?; handled: 2T, 3T, 6DOF)"),
     (_bad(leg_colour="red"), "d: legs[0].colour: unknown key"),
 ])
 def test_a_bad_description_is_one_line_naming_the_leg_and_the_field(data, message):

@@ -77,60 +77,62 @@ def _draw_module():
     return draw_mechanisms
 
 
-def _expected_lengths(name, mech, design, options):
-    """{link label: length} that the drawing must show: design lengths and the inverse kinematics' joint values."""
+def _expected_lengths(name, mech, design, options, pose, q):
+    """{segment name: length} that the drawing must show: design lengths and the inverse kinematics' joint values
+    q at the drawn pose."""
     if name == "2pauu-ppap":
-        return {"l1, theta1": design["l1"], "l1, theta2": design["l1"], "l2": design["l2"], "e (A1B1)": 2 * design["c"]}
-    if name == "planar-fivebar":
-        return {"l1, alpha1": design["l1"], "l1, alpha2": design["l1"], "l2": design["l2"]}
+        return {"arm1": design["l1"], "arm2": design["l1"], "link1": design["l2"], "link2": design["l2"],
+                "base": 2 * design["m"]}
+    if name.startswith("planar-fivebar"):
+        return {"arm1": design["l1"], "arm2": design["l1"], "forearm1": design["l2"], "forearm2": design["l2"],
+                "base": 2 * design["r"]}
     if name == "pprs-rprs":
-        q = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, 200.0))
-             if s.label == mech.kernel_branch(options)][0]
-        return {"L1": design["L1"], "L2": design["L2"], "L3": design["L3"], "s1": q[3], "s2": q[4], "s3, beta": q[5]}
+        return {"link1": design["L1"], "link2": design["L2"], "link3": design["L3"]}
     if name.startswith("rps-upu"):
-        pose = (79.37, 0.307, 0.113)
-        q = mech.inverse_kinematics(design, options, pose if name == "rps-upu" else
-                                    mech.tool_point(design, options, pose))[0].values
-        out = {"q1": q[0], "q2": q[1], "q3": q[2]}
+        out = {"leg1": q[0], "leg2": q[1], "leg3": q[2], "platform12": 2 * design["h"], "base12": 2 * design["g"]}
         if name == "rps-upu-tool":
-            out[f"tool offset d = {options['tool_offset']:g}"] = options["tool_offset"]
+            out["tool"] = options["tool_offset"]
         return out
     if name == "ups-sspr":
-        (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.2, 0.15, 10.0))]
-        return {"c (SR link A0B1)": design["c"], "l1 (SPR)": q[0], "l2": q[1], "l3": q[2]}
-    if name == "delta":  # each arm labelled with its joint, the three forearms alike
-        return {**{f"upper_arm, theta{i}": design["upper_arm"] for i in (1, 2, 3)}, "forearm": design["forearm"]}
-    if name == "linear-delta":  # each rail from the base plane to its carriage: the carriage depth s_i by the IK
-        (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, -1.0))
-                if s.label == "near/near/near"]
-        return {**{f"carriage, s{i}": q[i - 1] for i in (1, 2, 3)}, "forearm": design["forearm"]}
-    if name == "hexapod":  # each leg labelled with its joint: its length q_i by the IK at the drawn pose
-        (q,) = [s.values for s in mech.inverse_kinematics(design, options, (0.0, 0.0, 0.8))]
-        return {f"q{i}": q[i - 1] for i in range(1, 7)}
-    if name == "hexa":  # each arm labelled with its joint, the six rods alike
-        return {**{f"arm, theta{i}": design["arm"] for i in range(1, 7)}, "rod": design["rod"]}
+        return {"link": design["c"], "leg1": q[0], "leg2": q[1], "leg3": q[2]}
+    if name == "delta":  # each arm and each bar of the parallelogram forearms
+        return {**{f"upper_arm{i}": design["upper_arm"] for i in (1, 2, 3)},
+                **{f"forearm{i}{s}": design["forearm"] for i in (1, 2, 3) for s in "ab"}}
+    if name == "linear-delta":  # the rails over the stroke, the forearms' bars
+        lo, hi = options["stroke"]
+        return {**{f"rail{i}": hi - lo for i in (1, 2, 3)},
+                **{f"forearm{i}{s}": design["forearm"] for i in (1, 2, 3) for s in "ab"}}
+    if name == "hexapod":  # each leg as long as its joint value
+        return {f"leg{i}": q[i - 1] for i in range(1, 7)}
+    if name == "hexa":
+        return {**{f"upper_arm{i}": design["arm"] for i in range(1, 7)},
+                **{f"rod{i}": design["rod"] for i in range(1, 7)}}
     raise AssertionError(f"no expected lengths for {name}")
 
 
 @pytest.mark.parametrize("name", available())
 def test_drawing_is_the_kinematics_not_a_sketch(name):
-    """Every labelled link of the figure has the length of its design parameter or of its joint value from the
-    inverse kinematics at the drawn pose (a link labelled twice, e.g. both l2 links, is checked each time)."""
+    """The figure draws the mechanism's own link geometry at the drawn pose, in the kernel's branch: its segments
+    have the lengths of their design parameters or of the inverse kinematics' joint values."""
     dm = _draw_module()
     mech = get(name)
-    design = mech.resolve_design({"m": 0.857, "n": 0.706, "l1": 1.499, "l2": 1.5, "c": 0.1}
-                                 if name == "2pauu-ppap" else {})
+    design = mech.resolve_design(dm.DESIGNS.get(name, {}))
     options = mech.resolve_options({})
-    lk = dm.LINKAGES[name](mech, design, options)
-    expected = _expected_lengths(name, mech, design, options)
-    labelled = [(label, float(np.linalg.norm(end - start))) for start, end, label in lk.links if label in expected]
-    assert {label for label, _ in labelled} == set(expected)
-    for label, length in labelled:
-        assert length == pytest.approx(expected[label], rel=1e-9), label
+    dr = dm.drawing(mech, design, options)
+    sols = {s.label: s.values for s in mech.inverse_kinematics(design, options, dr.pose)}
+    np.testing.assert_array_equal(dr.q, sols[mech.kernel_branch(options)])
+    own = mech.link_geometry(design, options, dr.pose, dr.q)
+    assert [s.name for s in dr.geometry.segments] == [s.name for s in own.segments]
+    for s, t in zip(dr.geometry.segments, own.segments, strict=True):
+        np.testing.assert_array_equal([s.a, s.b], [t.a, t.b])
+    expected = _expected_lengths(name, mech, design, options, dr.pose, dr.q)
+    lengths = {s.name: float(np.linalg.norm(s.b - s.a)) for s in dr.geometry.segments}
+    assert set(expected) <= set(lengths)
+    for label, length in expected.items():
+        assert lengths[label] == pytest.approx(length, rel=1e-9), label
 
 
 def test_figure_script_draws_every_mechanism(tmp_path):
-    assert set(_draw_module().LINKAGES) == set(available())
     r = subprocess.run([sys.executable, str(ROOT / "scripts" / "draw_mechanisms.py"), str(tmp_path)],
                        capture_output=True, text=True, timeout=600, env={**_env(), "MPLBACKEND": "Agg"})
     assert r.returncode == 0, r.stderr

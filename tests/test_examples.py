@@ -66,6 +66,7 @@ def test_example_default_file_name_and_bad_names(tmp_path, monkeypatch):
     res = runner.invoke(app, ["example", "nope"])
     assert res.exit_code == 2 and len(res.stderr.strip().splitlines()) == 1
     assert res.stderr.startswith("error: example: unknown example 'nope' (available: delta, delta_picks, "
+                                 "fivebar_described, "
                                  "fivebar_packing, ")
     res = runner.invoke(app, ["example"])
     assert res.exit_code == 2 and "give an example name" in res.stderr

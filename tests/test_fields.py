@@ -31,6 +31,7 @@ TWINS = {
     "hexapod": hexapod_fields,
     "linear-delta": linear_delta_fields,
     "planar-fivebar": lambda d, o, x, y, z: fivebar_fields(d, o, x, y),
+    "planar-fivebar-described": lambda d, o, x, y, z: fivebar_fields(d, o, x, y),  # mode "+-", its legs' branches
     "pprs-rprs": pprs_fields,
     "rps-upu": rps_upu_fields,
     "rps-upu-tool": rps_upu_tool_fields,

@@ -87,7 +87,7 @@ DELTA_TEXT = (ROOT / "src" / "scalesynth" / "mechanisms" / "delta.yaml").read_te
 @pytest.mark.parametrize(("edit", "message"), [
     (("type: R-Pa", "type: R-Px"),
      "error: mechanism.description (my_robot.yaml): legs[0] (arm).type: unknown leg type 'R-Px' (did you mean "
-     "'R-Pa'?; library: R-Pa, P-Pa, RUS, R-SS, UPS, SPS)"),
+     "'R-Pa'?; library: R-Pa, P-Pa, RUS, R-SS, UPS, SPS, RR, PR)"),
     (("platform: [platform_radius, 0, 0]", "platform: [platform_radus, 0, 0]"),
      "error: mechanism.description (my_robot.yaml): legs[0] (arm).platform.x: unknown parameter "
      "'platform_radus' (did you mean 'platform_radius'?; known: base_radius, platform_radius, upper_arm, forearm)"),

@@ -41,6 +41,7 @@ import numpy as np
 from scalesynth.errors import InvalidParameter
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.describe import kernel as _k
+from scalesynth.mechanisms.describe import kernel2 as _k2
 from scalesynth.mechanisms.describe import kernel6 as _k6
 
 # capsule radii (m) when link_radius does not give them: illustrative, a mid-size Delta's
@@ -61,6 +62,8 @@ def leg_bodies(code: float, i: int) -> tuple[str, ...]:
         return (f"upper_arm{i}", f"rod{i}")
     if code == _k6.UPS:
         return (f"leg{i}",)
+    if code == _k2.RR:
+        return (f"arm{i}", f"forearm{i}")
     return (f"rail{i}", f"carriage{i}", f"forearm{i}")
 
 
@@ -83,12 +86,14 @@ def check_link_radius(options: dict[str, Any], codes: Sequence[float]) -> None:
     links.check_radius_option(options, tuple(dict.fromkeys(tuple(map(group_of, bodies)) + bodies)))
 
 
-def radii(options: Mapping[str, Any], codes: Sequence[float], length_unit: str) -> dict[str, float]:
-    """Capsule radius per body (length unit): the defaults, then link_radius's groups, then its bodies."""
+def radii(options: Mapping[str, Any], codes: Sequence[float], length_unit: str,
+          defaults_m: Mapping[str, float] = DEFAULT_RADII_M) -> dict[str, float]:
+    """Capsule radius per body (length unit): the defaults (m, by group), then link_radius's groups, then its
+    bodies."""
     scale = UNITS_PER_M[length_unit]
     bodies = body_names(codes)
     value = options.get("link_radius")
-    out = {b: DEFAULT_RADII_M[group_of(b)] * scale for b in bodies}
+    out = {b: defaults_m[group_of(b)] * scale for b in bodies}
     if value is None:
         return out
     if not isinstance(value, Mapping):

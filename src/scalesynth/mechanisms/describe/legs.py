@@ -13,6 +13,12 @@ mechanism frame, what ``DescribedMechanism.pack`` writes into the kernel's block
   of the 6-DOF kinematics are in sixdof.py, its kernel in kernel6.py.
 * ``UPS`` (alias ``SPS``), motion 6DOF: a prismatic leg of variable length between a base joint and a platform
   joint: the hexapod's (Gough-Stewart) leg. Joint: the leg length (length).
+* ``RR``, motion 2T (planar, z = 0): a rotary crank (``arm``) then a link (``forearm``) pinned to the platform
+  point: a five-bar's leg. Joint: the crank angle (rad). Branches "+" / "-": the crank turned towards
+  ``arm_positive`` from the line base -> platform joint, or away from it (the five-bar's working modes).
+* ``PR``, motion 2T: a carriage on a straight rail then a link (``forearm``) pinned to the platform point. Joint: the
+  carriage position along the rail (length). Branches "far" / "near" as P-Pa's.
+  Their NumPy twin and the rest of the planar kinematics are in planar.py, their kernel in kernel2.py.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from scalesynth.mechanisms.describe import kernel as _k
+from scalesynth.mechanisms.describe import kernel2 as _k2
 from scalesynth.mechanisms.describe import kernel6 as _k6
 
 
@@ -62,6 +69,15 @@ for _name, _doc, _kw in (
         ("UPS", "prismatic leg of variable length between a base and a platform joint (hexapod leg)", _UPS),
         ("SPS", "UPS with a spherical base joint (same kinematics)", _UPS)):
     LEG_TYPES[_name] = LegType(_name, _k6.RUS if _kw is _RUS else _k6.UPS, _doc, **_kw)
+LEG_TYPES["RR"] = LegType(
+    "RR", _k2.RR, "rotary crank + link pinned to the platform point (planar five-bar leg)", "alpha", "angle",
+    ("arm", "forearm"), {"+": 1.0, "-": -1.0}, {"arm_zero": (1.0, 0.0, 0.0), "arm_positive": (0.0, 1.0, 0.0)},
+    motion="2T",
+)
+LEG_TYPES["PR"] = LegType(
+    "PR", _k2.PR, "prismatic carriage + link pinned to the platform point (planar biglide leg)", "s", "length",
+    ("forearm",), {"far": 1.0, "near": -1.0}, {"rail": (1.0, 0.0, 0.0)}, motion="2T",
+)
 
 
 @dataclass(frozen=True)

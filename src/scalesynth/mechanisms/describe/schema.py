@@ -27,8 +27,8 @@ from scalesynth.names import hint
 MOBILITY_CHECK = None
 
 Expr = float | str
-MOTIONS = ("3T", "6DOF")  # motion types a kernel template handles (kernel.py, kernel6.py)
-LEG_COUNT = {"3T": 3, "6DOF": 6}  # actuated legs each motion needs (a square Jacobian)
+MOTIONS = ("2T", "3T", "6DOF")  # motion types a kernel template handles (kernel2.py, kernel.py, kernel6.py)
+LEG_COUNT = {"2T": 2, "3T": 3, "6DOF": 6}  # actuated legs each motion needs (a square Jacobian)
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
 
@@ -174,6 +174,8 @@ def _check(desc: Description) -> None:
         for field, values in (("base", leg.base), ("platform", leg.platform)):
             for axis, value in zip("xyz", values, strict=True):
                 _expression(f"{where}.{field}.{axis}", value, names)
+            if desc.motion == "2T" and values[2] not in (0, 0.0):
+                raise ConfigError(f"{where}.{field}.z: motion 2T is planar, in the plane z = 0: give z as 0")
         _expression(f"{where}.width", leg.width, names)
         missing = [k for k in lt.links if k not in leg.links]
         if missing:
@@ -193,6 +195,9 @@ def _check(desc: Description) -> None:
         for field, vec in frame.items():
             if not 0.5 < math.sqrt(sum(v * v for v in vec)) < 2.0:
                 raise ConfigError(f"{where}.{field}: expected a unit vector, got {list(vec)}")
+            if desc.motion == "2T" and vec[2] != 0.0:
+                raise ConfigError(f"{where}.{field}: motion 2T is planar: the direction must lie in the plane "
+                                  f"z = 0, got {list(vec)}")
         if "arm_zero" in frame:
             u, w = frame["arm_zero"], frame["arm_positive"]
             if abs(sum(a * b for a, b in zip(u, w, strict=True))) > 1e-9:
@@ -209,7 +214,10 @@ def _check(desc: Description) -> None:
         count += leg.pattern.count if leg.pattern else 1
     from scalesynth.mechanisms.describe.frame import check_spec
 
-    check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].code)
+    if desc.motion == "2T" and desc.stiffness is not None:
+        raise ConfigError("stiffness: motion 2T has no stiffness frame yet (leave the block out)")
+    if desc.motion != "2T":
+        check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].code)
     need = LEG_COUNT[desc.motion]
     if count != need:
         raise ConfigError(f"legs: motion {desc.motion} needs {need} actuated legs (a square Jacobian), these give "
