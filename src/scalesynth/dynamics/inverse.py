@@ -52,8 +52,9 @@ def endpoints(mech, design, options, poses: np.ndarray, q: np.ndarray) -> Segmen
     mechanism's vectorised ``link_endpoints`` where it has one, else link_geometry per pose (every end its own
     moving point). NaN points where q is not finite."""
     bad = ~np.all(np.isfinite(q), axis=1)
-    if hasattr(mech, "link_endpoints"):
-        out = mech.link_endpoints(design, options, poses, q)
+    vectorised = getattr(mech, "link_endpoints", None)
+    if vectorised is not None:
+        out = vectorised(design, options, poses, q)
         out.points[..., bad] = np.nan
         return out
     ends = None

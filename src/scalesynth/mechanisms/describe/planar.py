@@ -111,6 +111,8 @@ class PlanarLeg:
 class PlanarMechanism(DescribedMechanism):
     """A described 2T mechanism (module docstring); poses are (x, y)."""
 
+    link_endpoints = None  # no vectorised twin of the Pa legs' (the dynamics takes link_geometry per pose)
+
     # ----- options, legs and packing ----------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
         bodies.check_link_radius(options, self._codes())

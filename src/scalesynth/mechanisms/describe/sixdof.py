@@ -157,6 +157,8 @@ class SixDofMechanism(DescribedMechanism):
     """A described 6-DOF mechanism (module docstring). Poses given to IK, jacobians, lci are the platform centre
     (x, y, z) at the orientation of the option ``orientation``; FK returns full poses (x, y, z, roll, pitch, yaw)."""
 
+    link_endpoints = None  # no vectorised twin of the Pa legs' (the dynamics takes link_geometry per pose)
+
     @property
     def pose_axes(self) -> tuple[str, ...]:
         return POSE_AXES
