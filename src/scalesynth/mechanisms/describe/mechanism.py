@@ -91,8 +91,9 @@ class DescribedMechanism(Mechanism):
 
     # ----- options and packing ------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
-        bodies.check_link_radius(options, self._codes())
-        check_stiffness_options(options, 3, frame.link_groups(self._codes()[0] == _k.R_PA))
+        if self.description.motion == "3T":  # the bodies and stiffness frame of Pa legs (bodies.py, frame.py)
+            bodies.check_link_radius(options, self._codes())
+            check_stiffness_options(options, 3, frame.link_groups(self._codes()[0] == _k.R_PA))
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":
