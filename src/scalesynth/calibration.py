@@ -1,0 +1,111 @@
+"""Automatic calibration of the tolerance form for a mechanism with no hand-calibrated plan (issue 28).
+
+The seed mechanisms' evaluation plans were searched by hand against 3x finer grids (evaluate.ADAPTIVE_PLAN_OF,
+INTERVAL_PLAN_OF, UNIFORM_PLAN_OF). A described mechanism (or any other without an entry there) gets no such
+table; instead every design climbs a ladder of adaptive-evaluator plans (``LADDER``: each rung 1.5x the columns
+per cross axis of the one before) until two consecutive rungs agree within the tolerance (Richardson-style: the
+change from the coarser rung bounds the finer rung's error when the results converge). The finer rung's statistics
+are reported, with that change as ``error_volume`` (relative) and ``error_gci`` (absolute); a design that still
+disagrees at the last rung reports the last rung and its (larger than tolerated) change, never a silent pass.
+
+Per design, so the result of a design does not depend on the other designs of the call (reproducible: the same
+design evaluates the same alone or in a population of 200). The ladder's first rung and growth were chosen on the
+rotary Delta (configs/delta.yaml, benchmarks/described.py and docs/describing.md give the numbers); nothing in it is
+specific to one mechanism.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from scalesynth.kernels import grid as _grid
+
+# columns per cross axis of each rung (each 1.5x the one before, rounded to even for the mirror halves); every rung
+# has 8 z-cells doubled up to twice where the column's fields change (z-levels), 5 bisections, 2 refinement levels
+LADDER_COLUMNS = (8, 12, 18, 28, 42)
+FIRST_COMPARED = 1  # the first rung whose change from the rung before may accept a design
+
+
+def ladder_plan(rung: int):
+    """The evaluate.ColumnPlan of ``rung`` (0-based) of the ladder."""
+    from scalesynth.evaluate import ColumnPlan
+
+    return ColumnPlan(LADDER_COLUMNS[rung], 8, 5, 2, beta=1.0, zlevels=2, zconfirm=1)
+
+
+def has_plan(mech) -> bool:
+    """Whether ``mech`` has a hand-calibrated plan (then the tolerance form uses it, not this ladder)."""
+    from scalesynth.evaluate import ADAPTIVE_PLAN_OF, INTERVAL_PLAN_OF, UNIFORM_PLAN_OF
+
+    return mech.name in ADAPTIVE_PLAN_OF or mech.name in INTERVAL_PLAN_OF or mech.name in UNIFORM_PLAN_OF \
+        or len(mech.task_axes) != 3
+
+
+def _volume_gci(stats: np.ndarray, cell: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(measure, GCI) per statistics row; GCI 0 over an empty set (the catalogue's empty value)."""
+    count = stats[:, _grid.COL_COUNT]
+    gci = np.where(count > 0, stats[:, _grid.field_column(0, _grid.STAT_SUM)] / np.where(count > 0, count, 1.0), 0.0)
+    return count * cell, gci
+
+
+def _change(v0: np.ndarray, g0: np.ndarray, v1: np.ndarray, g1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(relative measure change, absolute GCI change) from a coarser (v0, g0) to a finer (v1, g1) rung; relative
+    to the finer measure; nothing reachable on the finer rung: 0, or 1 if the coarser found something."""
+    ev = np.where(v1 > 0.0, np.abs(v1 - v0) / np.where(v1 > 0.0, v1, 1.0), np.where(v0 > 0.0, 1.0, 0.0))
+    return ev, np.abs(g1 - g0)
+
+
+def calibrated_population_stats(
+    mech,
+    designs: Sequence[Mapping[str, float]],
+    options: Mapping[str, Any],
+    packed: np.ndarray,
+    tolerance,
+    edges: np.ndarray,
+    region: Mapping[str, Sequence[float]] | None = None,
+    lci_only: bool = False,
+):
+    """evaluate.AdaptiveResult of every design by the ladder (module docstring): statistics in the first rung's
+    coarse-cell units (``cell``), ``levels`` the rung each design was accepted at (or the last), ``evaluations``
+    the kernel calls of every rung the design ran."""
+    from scalesynth.evaluate import AdaptiveResult, adaptive_population_stats
+
+    n = len(designs)
+    ndim = len(mech.task_axes)
+    first = ladder_plan(0)
+    stats = cell = None
+    err_v = np.full(n, np.inf)
+    err_g = np.full(n, np.inf)
+    rung_of = np.zeros(n, dtype=np.int64)
+    calls = np.zeros(n)
+    active = np.arange(n)
+    prev_v = prev_g = None
+    for rung in range(len(LADDER_COLUMNS)):
+        sub = [designs[i] for i in active]
+        ad = adaptive_population_stats(mech, sub, options, packed[active], tolerance, edges, region,
+                                       plan=ladder_plan(rung), lci_only=lci_only)
+        calls[active] += ad.evaluations
+        if stats is None:  # rung 0: every design; the unit of the rows (its coarse cell)
+            stats, cell = ad.stats.copy(), ad.cell.copy()
+        else:
+            # rows of this rung in the first rung's coarse-cell units (extensive columns scaled by the cell ratio)
+            for j, i in enumerate(active):
+                stats[i] = _grid.scale_extensive(ad.stats[j : j + 1], mech.n_fields, ad.cell[j] / cell[i]
+                                                 if cell[i] > 0.0 else 1.0)[0]
+        rung_of[active] = rung
+        v, g = _volume_gci(ad.stats, ad.cell)
+        if prev_v is not None:
+            ev, eg = _change(prev_v, prev_g, v, g)
+            err_v[active], err_g[active] = ev, eg
+            done = (ev <= tolerance.volume) & (eg <= tolerance.gci)
+        else:
+            done = np.zeros(len(active), dtype=bool)
+        if rung < FIRST_COMPARED:
+            done[:] = False
+        active, prev_v, prev_g = active[~done], v[~done], g[~done]
+        if len(active) == 0:
+            break
+    return AdaptiveResult(stats, cell, err_v, err_g, rung_of, calls, first.coarse_cells(ndim))
