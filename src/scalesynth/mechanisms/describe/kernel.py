@@ -29,7 +29,6 @@ unchanged and keeps every product far from overflow.
 import math
 
 import numpy as np
-
 from numba import njit
 
 from scalesynth.kernels import grid as _grid
