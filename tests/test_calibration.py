@@ -123,9 +123,9 @@ def test_described_mechanism_is_calibrated_automatically_and_seed_mechanisms_kee
 def test_calibrated_delta_meets_the_configs_tolerance_against_a_finer_uniform_grid():
     """configs/delta.yaml states volume within 1 % and GCI within 0.002. The reference: the uniform N = 96 grid (field
     kernel at 884 736 cell centres, no column intervals, no refinement), itself within 0.1 % and 2e-4 of N = 192 on
-    such designs (benchmarks/results/described.json); the ladder's finest accepted rung has at most 18 x 18
-    coarse columns, so N = 96 is more than 3x finer across. Every design must be within the tolerance of it, and
-    report error estimates within the tolerance (the rung was accepted) that are finite."""
+    such designs (benchmarks/results/described.json), and at least 3x finer across than the coarse columns of the
+    rung each design is accepted at (checked). Every design must be within the tolerance of it, and report finite
+    error estimates within the tolerance (the rung was accepted)."""
     cfg = load_config(ROOT / "configs" / "delta.yaml")
     mech, options, region = cfg.mech, cfg.resolved_options(), cfg.grid.region
     tol = config_tolerance(cfg)
@@ -133,6 +133,10 @@ def test_calibrated_delta_meets_the_configs_tolerance_against_a_finer_uniform_gr
     designs = _designs(cfg, 3, seed=5)
     got = evaluate_population(mech, designs, options, region=region, tolerance=tol)
     ref = evaluate_population(mech, designs, options, region=region, resolution=96)
+    packed = np.stack([mech.pack(mech.resolve_design(d), options) for d in designs])
+    ladder = calibration.calibrated_population_stats(mech, designs, options, packed, tol,
+                                                     np.asarray(cfg.dexterity.band_edges), region)
+    assert all(3 * calibration.LADDER_COLUMNS[r] <= 96 for r in ladder.levels), ladder.levels
     assert np.all(ref["volume_m3"] > 0.0)
     rel = np.abs(got["volume_m3"] - ref["volume_m3"]) / ref["volume_m3"]
     assert np.all(rel <= tol.volume), rel
