@@ -42,6 +42,7 @@ import adaptive as adaptive_bench  # noqa: E402  (benchmarks/adaptive.py: issue-
 import compile_once  # noqa: E402  (benchmarks/compile_once.py: issue 15, compile once per command)
 import cpu_target  # noqa: E402  (benchmarks/cpu_target.py: issue 27, what reproducible bits cost)
 import cycle_dynamics  # noqa: E402  (benchmarks/cycle_dynamics.py: issue 29, link dynamics in the search)
+import described  # noqa: E402  (benchmarks/described.py: issue 28, the described mechanisms' performance)
 import show_speed  # noqa: E402  (benchmarks/show_speed.py: issue 14, show of a 3-D design)
 import synthesis  # noqa: E402  (benchmarks/synthesis.py: issue 15, per-config paper-scale table and memory)
 import task_accuracy  # noqa: E402  (benchmarks/task_accuracy.py: issue 15, the uniform task grids' accuracy)
@@ -387,7 +388,8 @@ PARTS = {"evaluator": bench_evaluator, "accuracy": bench_accuracy, "paper": benc
          "adaptive": adaptive_bench.bench_adaptive, "compile_all": adaptive_bench.bench_compile_all,
          "compile_commands": compile_once.bench_compile_commands, "synthesis": synthesis.bench_synthesis,
          "task_accuracy": task_accuracy.bench_task_accuracy, "show": show_speed.bench_show,
-         "cpu_target": cpu_target.bench_cpu_target, "cycle_dynamics": cycle_dynamics.bench_cycle_dynamics}
+         "cpu_target": cpu_target.bench_cpu_target, "cycle_dynamics": cycle_dynamics.bench_cycle_dynamics,
+         "described": described.bench_described}
 
 
 def write_results_md() -> None:
@@ -416,7 +418,9 @@ def write_results_md() -> None:
             ("cpu_target", "Issue 27: what reproducible bits cost (IEEE arithmetic, the pinned CPU target)",
              cpu_target),
             ("cycle_dynamics", "Issue 29: link dynamics in the search's cycle metrics (target: at most 2x massless)",
-             cycle_dynamics)):
+             cycle_dynamics),
+            ("described", "Issue 28: described mechanisms (Delta, hexapod): calibrated accuracy, paper-scale search, "
+             "voxels/s, first process, memory", described)):
         if part in data and "result" in data[part]:
             lines += _header(title, data[part]) + module.markdown(data[part])
     if "evaluator" in data:

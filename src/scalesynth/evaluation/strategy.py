@@ -34,6 +34,11 @@ def tolerance_population_stats(
     estimates are the change to the grid twice as fine (relative for the measure, absolute for the GCI), computed
     only with ``estimates`` (NaN without); the adaptive evaluator's come with its statistics."""
     n_uniform = uniform_resolution(mech, tolerance)
+    from scalesynth import calibration  # no hand-calibrated plan: the per-design ladder (calibration.py)
+
+    if n_uniform is None and not calibration.has_plan(mech):
+        return calibration.calibrated_population_stats(mech, designs, options, packed, tolerance, edges, region,
+                                                       lci_only=lci_only)
     if n_uniform is None:
         return adaptive_population_stats(mech, designs, options, packed, tolerance, edges, region, lci_only=lci_only)
     ndim = len(mech.task_axes)

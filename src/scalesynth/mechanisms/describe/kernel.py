@@ -28,6 +28,7 @@ unchanged and keeps every product far from overflow.
 
 import math
 
+import numpy as np
 from numba import njit
 
 from scalesynth.kernels import grid as _grid
@@ -198,3 +199,171 @@ def leg_values(p, x, y, z, out):
         out[i, 3] = fz
         out[i, 4] = jq
         out[i, 5] = q
+
+
+# ----- column intervals (Mechanism.interval_kernel): the reachable set of a z-column in closed form ---------------
+# Along a column (x, y fixed, z varying) each leg's reach and limits can change only where a closed-form condition
+# holds with equality, each a root of a polynomial of degree <= 2 in z:
+# * R-Pa whose actuated axis a = u x w is horizontal (a_z = 0; every Delta): the leg reaches Q iff the distance
+#   rho of D = Q - B from the axis, in the arm's plane, lies in [|L - h|, L + h], h = sqrt(l^2 - gamma^2) with
+#   gamma = D . a constant along the column; rho^2 is quadratic in z. The limits change where q = lo or q = hi
+#   (|D - L (cos q u + sin q w)| = l, quadratic), the branch's root flips where b = 2 L D . w changes sign (linear).
+#   The cone bounds f . a = gamma: constant along the column. A tilted axis (a_z != 0): -1 (nodes and bisection).
+# * P-Pa: the perpendicular distance from the rail (quadratic), q = lo or hi (quadratic), and the cone's
+#   D . axis = +-l sin(cone) (linear; f . axis = D . axis since the rail is perpendicular to the axis).
+# Between consecutive breakpoints every leg's predicate is constant, so one reach test at each segment's midpoint
+# (the reach kernel's own legs, branches and limits) decides the segment. Extra breakpoints only split segments.
+MAX_BREAKS = 2 + N_LEGS * 9
+AXIS_TILT = 1e-12  # |a_z| above this: the axis is not horizontal, the column is not handled in closed form
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _roots(a, b, c, zlo, zhi, br, nb):
+    """Append the real roots of a z^2 + b z + c = 0 inside (zlo, zhi) to br[nb:]; the new count. a may be 0 (linear);
+    a near-degenerate quadratic may add spurious roots, which only split segments."""
+    if a != 0.0:
+        disc = b * b - 4.0 * a * c
+        if disc < 0.0:
+            return nb
+        s = math.sqrt(disc)
+        # the stable pair: q = -(b + sign(b) s) / 2, roots q / a and c / q
+        qq = -0.5 * (b + s) if b >= 0.0 else -0.5 * (b - s)
+        r1 = qq / a
+        if zlo < r1 < zhi:
+            br[nb] = r1
+            nb += 1
+        if qq != 0.0:
+            r2 = c / qq
+            if zlo < r2 < zhi:
+                br[nb] = r2
+                nb += 1
+        return nb
+    if b != 0.0:
+        r = -c / b
+        if zlo < r < zhi:
+            br[nb] = r
+            nb += 1
+    return nb
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _offset_roots(d0x, d0y, d0z, ox, oy, oz, lf, zlo, zhi, br, nb):
+    """Roots in z of |D0 + z e_z - o| = l (the leg's sphere of radius l about offset o): z^2 + 2 (d0z - oz) z +
+    |D0 - o|^2 - l^2 = 0."""
+    ex = d0x - ox
+    ey = d0y - oy
+    ez = d0z - oz
+    return _roots(1.0, 2.0 * ez, ex * ex + ey * ey + ez * ez - lf * lf, zlo, zhi, br, nb)
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _leg_breaks(p, k, x, y, zlo, zhi, br, nb):
+    """Append leg k's breakpoints along the column at (x, y) (comment above); -1 when the leg is not handled."""
+    d0x = x + p[k + PLAT] - p[k + BASE]
+    d0y = y + p[k + PLAT + 1] - p[k + BASE + 1]
+    d0z = p[k + PLAT + 2] - p[k + BASE + 2]  # D at z = 0
+    ux = p[k + U]
+    uy = p[k + U + 1]
+    uz = p[k + U + 2]
+    lf = p[k + FOREARM]
+    if p[k + TYPE] == R_PA:
+        ax = p[k + AXIS]
+        ay = p[k + AXIS + 1]
+        az = p[k + AXIS + 2]
+        if abs(az) > AXIS_TILT:
+            return -1
+        la = p[k + ARM]
+        wx = p[k + W]
+        wy = p[k + W + 1]
+        wz = p[k + W + 2]
+        gamma = d0x * ax + d0y * ay + d0z * az
+        h2 = lf * lf - gamma * gamma
+        if h2 > 0.0:
+            h = math.sqrt(h2)
+            al0 = d0x * ux + d0y * uy + d0z * uz
+            be0 = d0x * wx + d0y * wy + d0z * wz
+            a2 = uz * uz + wz * wz
+            a1 = 2.0 * (al0 * uz + be0 * wz)
+            a0 = al0 * al0 + be0 * be0
+            nb = _roots(a2, a1, a0 - (la + h) * (la + h), zlo, zhi, br, nb)
+            nb = _roots(a2, a1, a0 - (la - h) * (la - h), zlo, zhi, br, nb)
+            nb = _roots(0.0, wz, be0, zlo, zhi, br, nb)  # b = 0: the branch's root flips
+            if p[k + HAS_LIMITS] > 0.0:
+                for q in (p[k + LO], p[k + HI]):
+                    c = la * math.cos(q)
+                    s = la * math.sin(q)
+                    nb = _offset_roots(d0x, d0y, d0z, c * ux + s * wx, c * uy + s * wy, c * uz + s * wz, lf, zlo,
+                                       zhi, br, nb)
+        # h2 <= 0: the leg reaches no point of the column (a single point at most); no breakpoint needed
+    else:  # P-Pa
+        de0 = d0x * ux + d0y * uy + d0z * uz
+        nb = _roots(1.0 - uz * uz, 2.0 * (d0z - de0 * uz), d0x * d0x + d0y * d0y + d0z * d0z - de0 * de0 - lf * lf,
+                    zlo, zhi, br, nb)
+        if p[k + HAS_LIMITS] > 0.0:
+            for q in (p[k + LO], p[k + HI]):
+                nb = _offset_roots(d0x, d0y, d0z, q * ux, q * uy, q * uz, lf, zlo, zhi, br, nb)
+        if p[k + HAS_CONE] > 0.0:
+            nx = p[k + AXIS]
+            ny = p[k + AXIS + 1]
+            nz = p[k + AXIS + 2]
+            if abs(nx * ux + ny * uy + nz * uz) > AXIS_TILT:
+                return -1
+            dn0 = d0x * nx + d0y * ny + d0z * nz
+            bound = lf * p[k + SIN_CONE]
+            nb = _roots(0.0, nz, dn0 - bound, zlo, zhi, br, nb)
+            nb = _roots(0.0, nz, dn0 + bound, zlo, zhi, br, nb)
+    return nb
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _reaches(p, x, y, z):
+    """Whether every leg reaches P = (x, y, z) in its branch and limits (point_reach's slot 0 >= 0)."""
+    for i in range(N_LEGS):
+        ok, _, _, _, _, _ = _leg(p, HEAD + i * STRIDE, x, y, z)
+        if not ok:
+            return False
+    return True
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def column_intervals(p, x, y, zlo, zhi, out):
+    """The interval kernel (Mechanism.interval_kernel): the reachable set of the column at (x, y) over [zlo, zhi] as
+    k sorted, disjoint intervals in out[:k] (out: (K, 2)); -1 when a leg is not handled in closed form (a tilted
+    R-Pa axis) or more than K intervals are needed."""
+    br = np.empty(MAX_BREAKS)
+    br[0] = zlo
+    nb = 1
+    for i in range(N_LEGS):
+        nb = _leg_breaks(p, HEAD + i * STRIDE, x, y, zlo, zhi, br, nb)
+        if nb < 0:
+            return -1
+    br[nb] = zhi
+    nb += 1
+    # insertion sort (a few dozen values)
+    for i in range(2, nb - 1):
+        v = br[i]
+        j = i - 1
+        while j >= 1 and br[j] > v:
+            br[j + 1] = br[j]
+            j -= 1
+        br[j + 1] = v
+    k = 0
+    open_ = False
+    for i in range(nb - 1):
+        a = br[i]
+        b = br[i + 1]
+        if not b > a:
+            continue
+        if _reaches(p, x, y, 0.5 * (a + b)):
+            if open_:
+                out[k - 1, 1] = b
+            else:
+                if k >= out.shape[0]:
+                    return -1
+                out[k, 0] = a
+                out[k, 1] = b
+                k += 1
+                open_ = True
+        else:
+            open_ = False
+    return k

@@ -171,6 +171,12 @@ class DescribedMechanism(Mechanism):
     def reach_kernel(self):
         return _k.point_reach
 
+    @property
+    def interval_kernel(self):
+        """The z-columns' reachable intervals in closed form (kernel.column_intervals; -1 for a leg it does not
+        handle, e.g. a tilted rotary axis); 3T only (6-DOF: nodes and bisection)."""
+        return _k.column_intervals if self.motion == "3T" else None
+
     def kernel_branch(self, options) -> str:
         return "/".join(plan.branch for plan in self.plans)
 
