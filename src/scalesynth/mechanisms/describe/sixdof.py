@@ -333,8 +333,6 @@ class SixDofMechanism(DescribedMechanism):
         Rod(theta_j e_j) R, the omega of velocity_map's last three columns), by central differences of ``step``
         rad. The inverse dynamics needs it for the moments the actuators apply to hold the orientation
         (dynamics.inverse); NaN where the branch does not reach."""
-        from scalesynth.dynamics.inverse import link_points
-
         rot = self.rotation(options)
         sides = []
         for j in range(3):
@@ -342,9 +340,23 @@ class SixDofMechanism(DescribedMechanism):
                 w = np.zeros(3)
                 w[j] = sign * step
                 turned = dict(options, **{ORIENTATION: list(roll_pitch_yaw(_rodrigues(w) @ rot))})
-                sides.append(link_points(self, design, turned, poses, label))
+                sides.append(self._segment_ends(design, turned, poses, label))
         e = np.stack(sides, axis=1)  # (n, 6, s, 2, 3)
         return (e[:, 0::2] - e[:, 1::2]) / (2.0 * step)
+
+    def _segment_ends(self, design, options, poses, label: str) -> np.ndarray:
+        """link_geometry's segment endpoints (n, s, 2, 3) at poses (n, 3) in branch ``label``; NaN where it does
+        not reach."""
+        q, _ = self.cycle_kinematics(design, options, poses, label)
+        out = None
+        for s, pose in enumerate(poses):
+            if not np.all(np.isfinite(q[s])):
+                continue
+            a, b, _ = self.link_geometry(design, options, pose, q[s]).as_arrays()
+            if out is None:
+                out = np.full((len(poses), len(a), 2, 3), np.nan)
+            out[s, :, 0], out[s, :, 1] = a, b
+        return np.full((len(poses), 0, 2, 3), np.nan) if out is None else out
 
     # ----- NumPy kinematics --------------------------------------------------------------------------------
     def inverse_kinematics(self, design, options, pose) -> list[Solution]:
