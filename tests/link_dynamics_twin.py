@@ -11,7 +11,7 @@ import numpy as np
 
 from scalesynth.cycle import config as ccfg
 from scalesynth.dynamics import bodies
-from scalesynth.dynamics.inverse import JACOBIAN_STEP, SECOND_STEP, actuator_forces, frame_gravity
+from scalesynth.dynamics.inverse import JACOBIAN_STEP, SECOND_STEP, actuator_forces, frame_gravity, held_forces
 
 
 def link_points_by_ik(mech, design, options, poses: np.ndarray, label: str) -> np.ndarray:
@@ -73,5 +73,11 @@ def link_forces_by_ik(mech, design, options, cyc, traj, label: str, size: float,
     ref = mech.link_geometry(design, options, traj.p[0], q0[0])
     masses = bodies.segment_masses(ref, options, dyn, length_unit, mech.name)
     _, jac, _, acc = endpoint_motion_by_ik(mech, design, options, traj.p, traj.pd, traj.pdd, label, size)
-    F, F_g = generalised_forces(mech, jac, acc, masses, frame_gravity(cyc, mech), length_unit)
-    return actuator_forces(mech, A_si, F), actuator_forces(mech, A_si, F_g), F
+    g3 = frame_gravity(cyc, mech)
+    F, F_g = generalised_forces(mech, jac, acc, masses, g3, length_unit)
+    # held axes (pprs-rprs: the platform orientation): the moments M = (de/dtheta)^T f from the mechanism's
+    # held_link_jacobian with this twin's own endpoint accelerations (held_link_jacobian itself is checked against
+    # dV/dq in tests/test_pprs_rprs_held.py and tests/test_sixdof_bodies.py)
+    M, M_g = held_forces(mech, design, options, traj.p, acc, masses, g3, label, length_unit)
+    F_all, F_g_all = np.hstack([F, M]), np.hstack([F_g, M_g])
+    return actuator_forces(mech, A_si, F_all), actuator_forces(mech, A_si, F_g_all), F

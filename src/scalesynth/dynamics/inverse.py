@@ -20,8 +20,8 @@ together on every mechanism.
 A mechanism whose task holds degrees of freedom constant (the platform orientation of pprs-rprs and the 6-DOF
 described mechanisms; velocity_map has columns past the task axes) needs the endpoints' derivatives along those
 too: the generalised force on held axis j is M_j = sum_e (de/dtheta_j) . f_e (virtual work of a virtual turn at
-fixed position), from the mechanism's ``held_link_jacobian`` where it has one (the 6-DOF ones), and A^T tau =
-[F; M]; without it M is taken as 0 (pprs-rprs, docs/cycles.md).
+fixed position), from the mechanism's ``held_link_jacobian`` (pprs-rprs, hexa, hexapod: the platform turned by
++-1e-5 rad about frame axis j, the IK re-solved in the branch), and A^T tau = [F; M] (docs/cycles.md).
 """
 
 from __future__ import annotations

@@ -769,6 +769,22 @@ def rotation(phi, theta, psi) -> np.ndarray:
     )
 
 
+def euler_angles(rot: np.ndarray) -> tuple[float, float, float]:
+    """(phi, theta, psi) rad with rotation(phi, theta, psi) = rot (3, 3), theta in [-pi/2, pi/2]."""
+    theta = -math.asin(max(-1.0, min(1.0, float(rot[2, 0]))))
+    return math.atan2(rot[1, 0], rot[0, 0]), theta, math.atan2(rot[2, 1], rot[2, 2])
+
+
+def _rodrigues(w: np.ndarray) -> np.ndarray:
+    """Rotation matrix (3, 3) of the rotation vector w (3,) rad (Rodrigues' formula)."""
+    angle = float(np.linalg.norm(w))
+    if angle == 0.0:
+        return np.eye(3)
+    k = np.asarray(w, dtype=float) / angle
+    kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * kx + (1.0 - math.cos(angle)) * (kx @ kx)
+
+
 @dataclass(frozen=True)
 class Geometry:
     """Resolved geometry (mm, rad): rails u_i and normals e_i = z x u_i (rows), body vectors c_i' (rows)."""
@@ -1313,6 +1329,26 @@ class PprsRprs(Mechanism):
             jt = twist_jacobian(geo, st)
         ok = np.asarray(st.ok, dtype=bool)
         return np.where(ok[:, None], st.q, np.nan), np.where(ok[:, None, None], jt, np.nan)
+
+    def held_link_jacobian(self, design, options, poses, label: str, step: float = 1e-5) -> np.ndarray:
+        """d(segment endpoints)/d(theta_j) (n, 3, s, 2, 3), mm per rad: link_geometry's endpoints as the platform
+        turns by a small angle theta_j about the fixed frame's axis j at fixed O1 (R -> Rod(theta_j e_j) R, the
+        omega of velocity_map's last three columns: J_t's row [g, r_k x g] is the twist of C_k about fixed axes),
+        the IK of branch ``label`` re-solved at the turned orientation; central differences of ``step`` rad. The
+        inverse dynamics needs it for the moments the actuators apply to hold the orientation
+        (dynamics.inverse); NaN where the branch does not reach."""
+        pts = np.asarray(poses, dtype=float)
+        rot = rotation(*np.asarray(options["orientation"], dtype=float))
+        sides = []
+        for j in range(3):
+            for sign in (1.0, -1.0):
+                w = np.zeros(3)
+                w[j] = sign * step
+                turned = dict(options, orientation=list(euler_angles(_rodrigues(w) @ rot)))
+                q, _ = self.cycle_kinematics(design, turned, pts, label)
+                sides.append(np.moveaxis(self.link_endpoints(design, turned, pts, q).segments(), -1, 0))
+        e = np.stack(sides, axis=1)  # (n, 6, s, 2, 3)
+        return (e[:, 0::2] - e[:, 1::2]) / (2.0 * step)
 
     def joint_limits(self, options: Mapping[str, Any]) -> np.ndarray:
         """Limits (6, 2) of (w1, w2, beta, s1, s2, s3), mm and rad."""
