@@ -67,6 +67,9 @@ def test_searched_gear_ratio_is_a_column_and_each_row_uses_its_own(tmp_path):
     # select writes the row's ratio as motors.gear_ratio
     res = CliRunner().invoke(app, ["select", str(tmp_path / "run"), "--out", str(tmp_path / "sel.yaml")])
     assert res.exit_code == 0, res.output
+    chosen = yaml.safe_load((tmp_path / "sel.yaml").read_text())
+    match = front[front["r"] == chosen["design"]["r"]]
+    assert len(match) >= 1 and chosen["motors"]["gear_ratio"] == pytest.approx(match["gear_ratio"].iloc[0], rel=1e-12)
 
 
 @pytest.mark.parametrize("changes, message", [
