@@ -28,6 +28,7 @@ from pydantic import (
 
 from scalesynth.cycle import config as cycle_config
 from scalesynth.dynamics import config as dynamics_config
+from scalesynth.dynamics.config import GEAR_RATIO
 from scalesynth.errors import ConfigError, ScalesynthError
 from scalesynth.names import hint
 from scalesynth.yamlfile import MAX_YAML_BYTES, _quote, read_limited, safe_yaml  # noqa: F401 (re-exported)
@@ -314,6 +315,12 @@ class RunConfig(_Strict):
                 raise ValueError(f"references.{label}: {err}") from None
         params = {p.name: p for p in mech.parameters}
         for key, (lo, _) in self.bounds.items():
+            if key == GEAR_RATIO and key not in params:  # the motors' shared gear ratio searched (issue 29)
+                if self.motors is None:
+                    raise ValueError(f"bounds.{key}: needs a motors section (the gear ratio searched is the motors')")
+                if lo <= 0:
+                    raise ValueError(f"bounds.{key}: lower bound must be > 0 for a gear ratio, got {lo}")
+                continue
             if key not in params:
                 raise ValueError(f"bounds.{key}: unknown parameter of {mech.name} " + hint(str(key), params))
             if params[key].positive and lo <= 0:

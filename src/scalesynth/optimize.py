@@ -176,7 +176,7 @@ def _pareto_frame(problem: SynthesisProblem, algorithm) -> tuple[pd.DataFrame, p
             rank[idx[front]] = r
     rows = []
     for i, design in enumerate(problem.designs(X)):
-        row: dict[str, Any] = {k: design[k] for k in problem.var_names}
+        row: dict[str, Any] = dict(zip(problem.var_names, map(float, X[i]), strict=True))  # with a gear ratio
         row.update(cfg.mech.derived_columns(design))
         row.update({k: M[i, j] for j, k in enumerate(problem.metric_columns)})
         row["voxels"] = int(round(row["voxels"]))

@@ -11,12 +11,14 @@ every metric.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Mapping
 
 import numpy as np
 from pymoo.core.problem import Problem
 
 from scalesynth import metrics as _metrics
 from scalesynth.config import ConstraintConfig, ObjectiveConfig, RunConfig
+from scalesynth.dynamics.config import GEAR_RATIO
 from scalesynth.evaluate import evaluate_config_population
 
 
@@ -46,7 +48,8 @@ def objective_label(cfg: RunConfig, obj: ObjectiveConfig) -> str:
 
 class SynthesisProblem(Problem):
     """Design variables = the config's ``bounds`` keys, in the mechanism's parameter order (so YAML key order cannot
-    change a result); other parameters stay at ``design``."""
+    change a result); other parameters stay at ``design``. ``bounds.gear_ratio`` (with motors) adds the motors'
+    shared gear ratio as the last variable: ``var_names`` ends with it, ``design_names`` are the mechanism's."""
 
     def __init__(self, cfg: RunConfig):
         if not cfg.bounds:
@@ -54,7 +57,9 @@ class SynthesisProblem(Problem):
 
             raise ConfigError("bounds: at least one design variable needs bounds to optimise")
         self.cfg = cfg
-        self.var_names = [p for p in cfg.mech.parameter_names if p in cfg.bounds]
+        self.design_names = [p for p in cfg.mech.parameter_names if p in cfg.bounds]
+        self.searches_gear_ratio = GEAR_RATIO in cfg.bounds and GEAR_RATIO not in cfg.mech.parameter_names
+        self.var_names = [*self.design_names, *([GEAR_RATIO] if self.searches_gear_ratio else [])]
         self.base_design = cfg.resolved_design()
         self.objective_keys = [metric_key(cfg, o) for o in cfg.objectives]
         self.signs = np.array([-1.0 if o.sense == "max" else 1.0 for o in cfg.objectives])
@@ -73,17 +78,40 @@ class SynthesisProblem(Problem):
         super().__init__(n_var=len(xl), n_obj=len(cfg.objectives), n_ieq_constr=n_constr, xl=xl, xu=xu)
 
     def designs(self, X: np.ndarray) -> list[dict[str, float]]:
+        """The mechanism's designs of the rows of X (a searched gear ratio is not a design parameter:
+        ``config_of``)."""
         out = []
         for row in np.atleast_2d(X):
             d = dict(self.base_design)
-            d.update({k: float(v) for k, v in zip(self.var_names, row, strict=True)})
+            d.update({k: float(v) for k, v in zip(self.design_names, row, strict=False)})
             out.append(d)
         return out
+
+    def config_of(self, values: Mapping[str, float]) -> RunConfig:
+        """The config of one row (a results row or a design vector as a name -> value mapping): the run's config
+        with motors.gear_ratio set to the row's gear ratio when the search varies it, else the run's config."""
+        if not self.searches_gear_ratio:
+            return self.cfg
+        from scalesynth.config import config_from_dict
+
+        data = self.cfg.model_dump(mode="json")
+        data["motors"] = {**data["motors"], GEAR_RATIO: float(values[GEAR_RATIO])}
+        return config_from_dict(data, base_dir=getattr(self.cfg.cycle, "_base_dir", None))
+
+    def _evaluate_population(self, X: np.ndarray, families, fields=None) -> dict[str, np.ndarray]:
+        """evaluate_config_population of the rows of X; with a searched gear ratio, each design's cycle uses its
+        own (a copy of the cycle carries the ratios to cycle.population)."""
+        cfg = self.cfg
+        if self.searches_gear_ratio and cfg.cycle is not None:
+            cycle = cfg.cycle.model_copy()
+            cycle._gear_ratios = np.atleast_2d(X)[:, len(self.design_names)].astype(float)
+            cfg = cfg.model_copy(update={"cycle": cycle})
+        return evaluate_config_population(cfg, self.designs(X), families, fields)
 
     def metrics(self, X: np.ndarray) -> np.ndarray:
         """Metrics of the designs X (n, n_var), shape (n, len(metric_columns)): the searched families' columns,
         NaN in the others (``complete_metrics``)."""
-        values = evaluate_config_population(self.cfg, self.designs(X), self.searched_families, self.searched_fields)
+        values = self._evaluate_population(X, self.searched_families, self.searched_fields)
         n = np.atleast_2d(X).shape[0]
         return np.column_stack([np.asarray(values[k], dtype=float) if k in values else np.full(n, np.nan)
                                 for k in self.metric_columns])
@@ -118,7 +146,7 @@ class SynthesisProblem(Problem):
         if not missing or not len(M):
             return M
         family_of = self._family_of()
-        values = evaluate_config_population(self.cfg, self.designs(X), frozenset(family_of[k] for k in missing))
+        values = self._evaluate_population(X, frozenset(family_of[k] for k in missing))
         out = np.array(M, dtype=float, copy=True)
         for k in missing:
             out[:, self.metric_columns.index(k)] = np.asarray(values[k], dtype=float)
@@ -191,7 +219,7 @@ class SynthesisProblem(Problem):
                 ref.append(-float(m.range[0]) if m.range[0] != 0 else 0.0)
             elif m.worst == _metrics.WORST_BOUNDING_BOX:
                 upper = dict(self.base_design)
-                upper.update({k: self.cfg.bounds[k][1] for k in self.var_names})
+                upper.update({k: self.cfg.bounds[k][1] for k in self.design_names})
                 lo, hi = self.cfg.mech.bounding_box(upper, self.cfg.resolved_options())
                 n = len(self.cfg.mech.task_axes)
                 ref.append(float(np.prod((hi - lo)[:n])))
@@ -204,9 +232,9 @@ class SynthesisProblem(Problem):
     def _corner_context(self) -> _metrics.EvalContext:
         """The designs at every corner of the optimisation bounds, for design-level worst values."""
         corners = []
-        for combo in itertools.product(*[self.cfg.bounds[k] for k in self.var_names]):
+        for combo in itertools.product(*[self.cfg.bounds[k] for k in self.design_names]):
             d = dict(self.base_design)
-            d.update({k: float(v) for k, v in zip(self.var_names, combo, strict=True)})
+            d.update({k: float(v) for k, v in zip(self.design_names, combo, strict=True)})
             corners.append(d)
         options = self.cfg.resolved_options()
         packed = np.stack([self.cfg.mech.pack(d, options) for d in corners])
@@ -222,4 +250,6 @@ class SynthesisProblem(Problem):
         items = [*self.cfg.objectives, *self.cfg.constraints]
         if any(metric_entry(self.cfg, item).family == "design" for item in items):
             return np.asarray(X, dtype=float)
-        return self.cfg.mech.canonical_vectors(self.var_names, X)
+        nd = len(self.design_names)
+        canonical = self.cfg.mech.canonical_vectors(self.design_names, X[:, :nd])
+        return np.column_stack([canonical, X[:, nd:]]) if X.shape[1] > nd else canonical

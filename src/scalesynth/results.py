@@ -62,8 +62,12 @@ class RunResult:
     def design_of(self, row: pd.Series) -> dict[str, float]:
         """The full design of a results row (design variables over the config's fixed parameters)."""
         d = dict(self.problem.base_design)
-        d.update({k: float(row[k]) for k in self.problem.var_names})
+        d.update({k: float(row[k]) for k in self.problem.design_names})
         return d
+
+    def config_of(self, row: pd.Series) -> RunConfig:
+        """The run's config with a results row's searched gear ratio (bounds.gear_ratio) as motors.gear_ratio."""
+        return self.problem.config_of({k: float(row[k]) for k in self.problem.var_names})
 
 
 def expected_pareto_columns(problem: SynthesisProblem) -> list[str]:

@@ -100,7 +100,7 @@ def select_design(run_dir, method: str = "knee", weights: Sequence[float] | None
     row = pareto.iloc[i]
     design = result.design_of(row)
     metrics = {k: float(row[k]) for k in problem.metric_columns if k in row.index}
-    data = cfg.model_dump(mode="json")
+    data = result.config_of(row).model_dump(mode="json")  # with the row's gear ratio, when the search varies it
     data["design"] = design
     data["name"] = f"{cfg.name}-{method}"
     header = f"# {method} design of {run_dir} (row {i} of pareto.csv), {SIGNATURE}\n"
@@ -233,7 +233,7 @@ def load_design(source: str | Path, design: str | None = None, sets: Sequence[st
         mech = result.cfg.mech
         row, label = choose_row(result, design or "knee")
         chosen = result.design_of(result.pareto.iloc[row])
-        cfg = result.cfg
+        cfg = result.config_of(result.pareto.iloc[row])  # the row's gear ratio, when the search varies it
         if sets:
             cfg = config_from_dict(cfg.model_dump(mode="json"), sets)
             changed = apply_overrides({}, sets, set(mech.parameter_names)).get("design") or {}

@@ -75,6 +75,9 @@ class CycleConfig(BaseModel):
     _dynamics: Any = PrivateAttr(None)
     _motors: Any = PrivateAttr(None)
     _base_dir: Any = PrivateAttr(None)  # where a relative motors.catalogue is read from
+    # (n_designs,) the gear ratio of each design of a population (a search over bounds.gear_ratio), else None:
+    # replaces motors.gear_ratio in cycle.population (set by problem.SynthesisProblem on a copy of the cycle)
+    _gear_ratios: Any = PrivateAttr(None)
 
     @field_validator("path")
     @classmethod

@@ -16,6 +16,7 @@ clearance (``CycleResult.min_clearance_pair``; no metric uses it).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any
 
@@ -225,6 +226,10 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
     if limited:
         cols["max_cycles_per_minute"] = 60.0 / cyc.cycle_time * scale
     mot = motors.of_cycle(cyc, nj)
+    ratios = getattr(cyc, "_gear_ratios", None)
+    if mot is not None and ratios is not None:  # each design's own (shared) gear ratio, (D, 1, nj)
+        mot = replace(mot, gear_ratio=np.broadcast_to(np.asarray(ratios, dtype=float)[live][:, None, None],
+                                                      (nd, 1, nj)))
     if mot is not None:
         cols.update(motors.cycle_motor_metrics(mot, traj, cyc, mech.joint_units, length_unit, qd, qdd, force,
                                                force_gravity)[0])

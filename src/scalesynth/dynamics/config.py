@@ -56,6 +56,11 @@ class DynamicsConfig(BaseModel):
         return v
 
 
+# the bounds key of a searched gear ratio (``bounds: {gear_ratio: [lo, hi]}``): one ratio shared by every actuator, a
+# design variable of the optimisation that replaces motors.gear_ratio in each design's cycle (issue 29)
+GEAR_RATIO = "gear_ratio"
+
+
 class MotorsConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
