@@ -67,8 +67,9 @@ def test_candidates_follow_the_zone_and_the_motion():
     run, skipped = sizing.candidates(three_d)
     assert {"delta", "linear-delta", "2pauu-ppap"} <= set(run)
     assert "planar-fivebar" not in run and "2T" in skipped["planar-fivebar"]
-    run2, _ = sizing.candidates(spec_from_dict({**PLANAR, "mechanisms": None}))
-    assert run2 == ["planar-fivebar"]
+    run2, skipped2 = sizing.candidates(spec_from_dict({**PLANAR, "mechanisms": None}))
+    assert run2 == ["planar-fivebar"]  # not also its description twin, planar-fivebar-described
+    assert skipped2["planar-fivebar-described"].startswith("the same robot as planar-fivebar")
 
 
 def test_fivebar_rule_reproduces_the_packing_examples_bounds():

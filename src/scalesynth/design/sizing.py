@@ -70,13 +70,16 @@ def candidates(spec: DesignSpec) -> tuple[list[str], dict[str, str]]:
     names = spec.mechanisms or available()
     run, skipped = [], {}
     for name in names:
-        why = can_do(get(name), spec)
+        mech = get(name)
+        twin_of = getattr(getattr(mech, "description", None), "reproduces", None)
+        if spec.mechanisms is None and twin_of in names:
+            skipped[name] = f"the same robot as {twin_of} (its description); name it under mechanisms to run it too"
+            continue
+        why = can_do(mech, spec)
         if why is None:
             run.append(name)
         else:
             skipped[name] = why
-    if spec.mechanisms is None:
-        skipped = {k: v for k, v in skipped.items()}
     return run, skipped
 
 

@@ -93,6 +93,9 @@ class Description(_Strict):
     options: dict[str, OptionSpec] = {}
     legs: list[LegSpec] = Field(min_length=1)
     stiffness: StiffnessSpec | None = None  # defaults of the stiffness options (frame.py)
+    # the registered mechanism this description reproduces (a twin for tests; `design` runs only the original
+    # unless the spec names the twin)
+    reproduces: str | None = None
 
 
 def _one_line(text: str, limit: int = 200) -> str:
