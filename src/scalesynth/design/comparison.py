@@ -48,7 +48,7 @@ def _why_not(req: str, spec: DesignSpec, cfg_data: dict[str, Any], notes: list[s
     if req == "deflection":
         if spec.stiffness is None:
             return "the spec states no stiffness requirement"
-        return f"{mech.name} has no stiffness model yet (no task_max_deflection in its catalogue)"
+        return f"{mech.name} has no per-voxel stiffness field yet (no task_max_deflection in its catalogue)"
     return "not evaluated"
 
 
