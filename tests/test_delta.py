@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from fd_checks import assembly_error, fk_jacobian, reachable_points
 from naive_delta import delta_fields, delta_jacobian, delta_thetas
 from scalesynth.config import load_config
 from scalesynth.errors import ConfigError, InvalidParameter
@@ -33,21 +34,9 @@ def _random_designs(rng, k):
 
 def _reachable_points(design, options, rng, k):
     """k random platform centres that the kernel finds reachable, below the base."""
-    pts = []
     reach = design["upper_arm"] + design["forearm"]
-    out = np.zeros(3)
-    packed = DELTA.pack(design, options)
-    while len(pts) < k:
-        p = rng.uniform([-reach, -reach, -reach], [reach, reach, -0.05])
-        kernel.point_fields(packed, *p, out)
-        if out[0] > 1e-3:
-            pts.append(p)
-    return pts
-
-
-def _nearest(solutions, p):
-    """The FK assembly nearest to p (the one a small joint step from p's inputs lands on)."""
-    return min((s.values for s in solutions), key=lambda v: np.abs(v - p).max())
+    return reachable_points(kernel.point_fields, DELTA.pack(design, options), [-reach, -reach, -reach],
+                            [reach, reach, -0.05], rng, k)
 
 
 def test_the_delta_follows_the_issue_conventions():
@@ -98,12 +87,7 @@ def test_jacobian_equals_finite_differences_of_the_forward_kinematics_and_the_tw
         for p in _reachable_points(design, options, rng, 4):
             q = {s.label: s.values for s in DELTA.inverse_kinematics(design, options, p)}["out/out/out"]
             jac = DELTA.jacobians(design, options, p, q)["J"]
-            fd = np.zeros((3, 3))
-            for i in range(3):
-                dq = np.zeros(3)
-                dq[i] = h
-                plus, minus = (_nearest(DELTA.forward_kinematics(design, options, q + s * dq), p) for s in (1, -1))
-                fd[:, i] = (plus - minus) / (2 * h)
+            fd = fk_jacobian(DELTA, design, options, p, q, h)
             np.testing.assert_allclose(jac, fd, rtol=1e-6, atol=1e-6 * np.abs(jac).max())
             np.testing.assert_allclose(jac, delta_jacobian(design, p, q)[2], rtol=1e-9, atol=1e-12)
             a = DELTA.velocity_map(design, options, p, q)
@@ -116,8 +100,7 @@ def test_forward_kinematics_round_trips_the_inverse():
         options = DELTA.resolve_options({})
         for p in _reachable_points(design, options, rng, 5):
             for sol in DELTA.inverse_kinematics(design, options, p):
-                fk = DELTA.forward_kinematics(design, options, sol.values)
-                assert min(np.abs(s.values - p).max() for s in fk) <= 1e-9
+                assert assembly_error(DELTA.forward_kinematics(design, options, sol.values), p) <= 1e-9
 
 
 def test_kernel_fields_equal_the_numpy_twin_on_random_designs_and_points():
@@ -230,12 +213,7 @@ def test_the_linear_delta_leg_and_its_jacobian():
                 assert np.linalg.norm(p + leg.platform - leg.actuated_point(q)) == pytest.approx(0.5, rel=1e-12)
         q = {s.label: s.values for s in mech.inverse_kinematics(design, options, p)}["far/far/far"]
         jac = mech.jacobians(design, options, p, q)["J"]
-        fd = np.zeros((3, 3))
-        for i in range(3):
-            dq = np.zeros(3)
-            dq[i] = h
-            plus, minus = (_nearest(mech.forward_kinematics(design, options, q + s * dq), p) for s in (1, -1))
-            fd[:, i] = (plus - minus) / (2 * h)
+        fd = fk_jacobian(mech, design, options, p, q, h)
         np.testing.assert_allclose(jac, fd, rtol=1e-6, atol=1e-7)
         kernel.point_fields(packed, *p, out)
         sv = np.linalg.svd(jac, compute_uv=False)

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+from fd_checks import assembly_error, fk_jacobian, reachable_points
 from naive_delta import linear_delta_fields
 from scalesynth.config import load_config
 from scalesynth.evaluate import evaluate_config
@@ -29,18 +30,7 @@ def _random_designs(rng, k):
 
 
 def _reachable_points(design, options, rng, k):
-    pts, out, packed = [], np.zeros(3), LIN.pack(design, options)
-    lo, hi = LIN.bounding_box(design, options)
-    while len(pts) < k:
-        p = rng.uniform(lo, hi)
-        kernel.point_fields(packed, *p, out)
-        if out[0] > 1e-3:
-            pts.append(p)
-    return pts
-
-
-def _nearest(solutions, p):
-    return min((s.values for s in solutions), key=lambda v: np.abs(v - p).max())
+    return reachable_points(kernel.point_fields, LIN.pack(design, options), *LIN.bounding_box(design, options), rng, k)
 
 
 def test_the_linear_delta_follows_the_delta_conventions():
@@ -74,16 +64,10 @@ def test_jacobian_equals_finite_differences_of_the_forward_kinematics():
             sols = LIN.inverse_kinematics(design, options, p)
             q = {s.label: s.values for s in sols}["near/near/near"]
             jac = LIN.jacobians(design, options, p, q)["J"]
-            fd = np.zeros((3, 3))
-            for i in range(3):
-                dq = np.zeros(3)
-                dq[i] = step
-                plus, minus = (_nearest(LIN.forward_kinematics(design, options, q + s * dq), p) for s in (1, -1))
-                fd[:, i] = (plus - minus) / (2 * step)
+            fd = fk_jacobian(LIN, design, options, p, q, step)
             np.testing.assert_allclose(jac, fd, rtol=1e-6, atol=1e-6 * np.abs(jac).max())
             for sol in sols:
-                fk = LIN.forward_kinematics(design, options, sol.values)
-                assert min(np.abs(s.values - p).max() for s in fk) <= 1e-9
+                assert assembly_error(LIN.forward_kinematics(design, options, sol.values), p) <= 1e-9
 
 
 def test_kernel_fields_equal_the_numpy_twin_on_random_designs_and_points():

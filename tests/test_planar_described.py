@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import naive_planar
+from fd_checks import assembly_error, fk_jacobian, reachable_points
 from scalesynth.config import config_from_dict
 from scalesynth.errors import ConfigError
 from scalesynth.evaluate import evaluate_config
@@ -73,15 +74,14 @@ def _box_points(mech, design, options, rng, k):
     return rng.uniform(lo[:2], hi[:2], size=(k, 2))
 
 
+def _point_fields_2t(packed, x, y, out):
+    kernel2.point_fields(packed, x, y, 0.0, out)
+
+
 def _reachable(mech, design, options, rng, k):
     """k random points where the kernel's LCI exceeds 1e-2 (away from singularities, for finite differences)."""
-    packed, out, pts = mech.pack(design, options), np.zeros(3), []
-    while len(pts) < k:
-        p = _box_points(mech, design, options, rng, 1)[0]
-        kernel2.point_fields(packed, p[0], p[1], 0.0, out)
-        if out[0] > 1e-2:
-            pts.append(p)
-    return pts
+    lo, hi = mech.bounding_box(design, options)
+    return reachable_points(_point_fields_2t, mech.pack(design, options), lo[:2], hi[:2], rng, k, min_lci=1e-2)
 
 
 @pytest.mark.parametrize("name", ["fivebar", "offset-rr", "biglide"])
@@ -101,18 +101,9 @@ def test_ik_fk_and_jacobian_against_finite_differences(name):
                 assert np.linalg.norm(p + leg.platform - leg.actuated_point(qi)) == pytest.approx(leg.forearm,
                                                                                                    rel=1e-9)
         q = sols[mech.kernel_branch(options)]
-        fk = [s.values for s in mech.forward_kinematics(design, options, q)]
-        assert min(np.abs(v - p).max() for v in fk) <= 1e-9 * scale
+        assert assembly_error(mech.forward_kinematics(design, options, q), p) <= 1e-9 * scale
         h = 1e-6 * (1.0 if legs[0].rotary else scale)
-        fd = np.zeros((2, 2))
-        for j in range(2):
-            dq = np.zeros(2)
-            dq[j] = h
-            plus = min((s.values for s in mech.forward_kinematics(design, options, q + dq)),
-                       key=lambda v: np.abs(v - p).max())
-            minus = min((s.values for s in mech.forward_kinematics(design, options, q - dq)),
-                        key=lambda v: np.abs(v - p).max())
-            fd[:, j] = (plus - minus) / (2 * h)
+        fd = fk_jacobian(mech, design, options, p, q, h)
         j_an = mech.jacobians(design, options, p, q)["J"]
         np.testing.assert_allclose(j_an, fd, rtol=1e-6, atol=1e-6 * np.abs(j_an).max())
 

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
+from fd_checks import assembly_error, fk_jacobian
 from scalesynth.cli import app
 from scalesynth.config import load_config
 from scalesynth.errors import InvalidParameter, InvalidPose
@@ -401,8 +402,7 @@ def test_fk_then_ik_round_trip(raw, q):
         for b in sols:
             if M.singularity(design, OPT, s.values, b.values, tol=1e-6) != "none":
                 continue
-            fk = M.forward_kinematics(design, OPT, b.values)
-            assert min(np.abs(f.values - s.values).max() for f in fk) < 1e-9 * scale
+            assert assembly_error(M.forward_kinematics(design, OPT, b.values), s.values) < 1e-9 * scale
         # the kernel's working mode is one of the labelled branches: same LCI as the NumPy reference
         label = next(b.label for b in sols if _angle_err(b.values, q) < 1e-9)
         p = M.pack(design, M.resolve_options({"mode": label}))
@@ -421,15 +421,7 @@ def test_jacobian_matches_central_differences_of_fk(raw, q):
             continue  # FK is ill-conditioned next to singular poses; finite differences say nothing there
         jac = M.jacobians(design, OPT, s.values, q)["J"]
         h = 1e-5  # truncation error grows near singular poses; rounding stays ~1e-8 mm here
-        num = np.zeros((2, 2))
-        for k in range(2):
-            vals = {}
-            for step in (-2, -1, 1, 2):
-                qq = np.array(q, dtype=float)
-                qq[k] += step * h
-                fk = M.forward_kinematics(design, OPT, qq)
-                vals[step] = min((f.values for f in fk), key=lambda v: np.abs(v - s.values).max())
-            num[:, k] = (vals[-2] - 8 * vals[-1] + 8 * vals[1] - vals[2]) / (12 * h)  # fourth-order central
+        num = fk_jacobian(M, design, OPT, s.values, q, h, order=4)
         assert np.abs(num - jac).max() < 1e-6 * np.abs(jac).max()
 
 

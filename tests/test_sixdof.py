@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from cli_main import run_main
+from fd_checks import reachable_points
 from naive_sixdof import hexa_fields, hexa_thetas, hexapod_fields
 from scalesynth.config import load_config
 from scalesynth.errors import ConfigError, InvalidParameter
@@ -39,17 +40,9 @@ def _random_design(mech, rng):
 def _reachable(mech, design, options, rng, k, min_lci=1e-3):
     """k random platform centres the kernel finds reachable with LCI above min_lci."""
     lo, hi = mech.bounding_box(design, options)
-    packed, out, pts = mech.pack(design, options), np.zeros(3), []
     lo = np.where(np.arange(3) == 2, np.maximum(lo, 0.0) if mech.name == "hexapod" else lo, lo)
     hi = np.where(np.arange(3) == 2, np.minimum(hi, 0.0) if mech.name == "hexa" else hi, hi)
-    for _ in range(200000):
-        p = rng.uniform(lo, hi)
-        kernel6.point_fields(packed, *p, out)
-        if out[0] > min_lci:
-            pts.append(p)
-            if len(pts) == k:
-                return pts
-    raise AssertionError("too few reachable points")
+    return reachable_points(kernel6.point_fields, mech.pack(design, options), lo, hi, rng, k, min_lci=min_lci)
 
 
 @pytest.mark.parametrize("name", ["hexapod", "hexa"])
