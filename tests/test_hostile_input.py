@@ -20,8 +20,9 @@ import yaml
 
 import scalesynth as ss
 from cli_main import run_main as _run_main
-from scalesynth.config import MAX_YAML_BYTES, config_from_dict, load_config
+from scalesynth.config import config_from_dict, load_config
 from scalesynth.errors import ConfigError, InvalidParameter, RunError
+from scalesynth.yamlfile import MAX_YAML_BYTES
 
 from conftest import SMALL
 

@@ -31,7 +31,7 @@ from scalesynth.dynamics import config as dynamics_config
 from scalesynth.dynamics.config import GEAR_RATIO
 from scalesynth.errors import ConfigError, ScalesynthError
 from scalesynth.names import hint
-from scalesynth.yamlfile import MAX_YAML_BYTES, _quote, read_limited, safe_yaml  # noqa: F401 (re-exported)
+from scalesynth.yamlfile import MAX_YAML_BYTES, quoted, read_limited, safe_yaml
 
 LENGTH_UNITS = ("m", "mm", "cm", "dm")
 
@@ -477,7 +477,7 @@ def apply_overrides(data: dict, overrides: list[str] | None, design_keys: set[st
         value = _parse_scalar(raw.strip())
         path = key.split(".")
         if any(not part.strip() for part in path):
-            raise ConfigError(f"--set {_quote(key)}: empty field name in the dotted path")
+            raise ConfigError(f"--set {quoted(key)}: empty field name in the dotted path")
         if len(path) == 1:
             if design_keys is not None and key in design_keys:
                 path = ["design", key]
@@ -565,9 +565,9 @@ def check_grid_arguments(mech, resolution: Any, region: Any, band_edges: Any, le
         try:
             region = dict(region)
         except (TypeError, ValueError):
-            raise ConfigError(f"region: expected {{task axis: [lo, hi]}}, got {_quote(region)}") from None
+            raise ConfigError(f"region: expected {{task axis: [lo, hi]}}, got {quoted(region)}") from None
     if length_unit is not None and length_unit not in LENGTH_UNITS:
-        raise ConfigError(f"length_unit: must be one of {', '.join(LENGTH_UNITS)}, got {_quote(length_unit)}")
+        raise ConfigError(f"length_unit: must be one of {', '.join(LENGTH_UNITS)}, got {quoted(length_unit)}")
     try:
         GridConfig.model_validate({"resolution": resolution, "region": region})
         DexterityConfig.model_validate({"band_edges": band_edges if isinstance(band_edges, list)
@@ -577,4 +577,4 @@ def check_grid_arguments(mech, resolution: Any, region: Any, band_edges: Any, le
     axes = ", ".join(mech.task_axes)
     for axis in region or {}:
         if axis not in mech.task_axes:
-            raise ConfigError(f"region.{_quote(axis)[1:-1]}: not a task axis of {mech.name} ({axes})")
+            raise ConfigError(f"region.{quoted(axis)[1:-1]}: not a task axis of {mech.name} ({axes})")

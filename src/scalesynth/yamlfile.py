@@ -47,7 +47,7 @@ def _mapping_without_duplicates(loader: yaml.SafeLoader, node: yaml.MappingNode,
         except TypeError:  # an unhashable key: SafeLoader refuses it below
             break
         if duplicate:
-            raise ConfigError(f"line {key_node.start_mark.line + 1}: duplicate key {_quote(key)}")
+            raise ConfigError(f"line {key_node.start_mark.line + 1}: duplicate key {quoted(key)}")
         seen.add(key)
     return loader.construct_mapping(node, deep=deep)
 
@@ -98,7 +98,7 @@ def safe_yaml(text: str, what: str) -> Any:
         loader.dispose()
 
 
-def _quote(value: Any) -> str:
+def quoted(value: Any) -> str:
     """repr of a key or value for an error message, cut to MAX_QUOTED characters."""
     text = repr(value) if not isinstance(value, str) or len(value) <= MAX_QUOTED else repr(value[:MAX_QUOTED])
     return text if len(text) <= MAX_QUOTED + 2 else text[:MAX_QUOTED] + "..."
