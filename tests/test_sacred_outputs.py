@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 from cli_main import run_main as _main
+from sacred_checks import fail_on, refused, snapshot
 from scalesynth import rundir
 from scalesynth.config import config_from_dict
 from scalesynth.optimize import run
@@ -25,33 +26,6 @@ from conftest import ROOT, SMALL
 
 QUICK = ROOT / "configs" / "quick.yaml"
 FIVEBAR = ROOT / "configs" / "fivebar_packing.yaml"  # planar five-bar with a cycle section: the cheapest views
-
-
-def _snapshot(directory: Path) -> dict[str, bytes]:
-    """Every entry under ``directory`` (hidden ones too) with its bytes; links by their target."""
-    out = {}
-    for p in sorted(directory.rglob("*")):
-        key = str(p.relative_to(directory))
-        if p.is_symlink():
-            out[key] = b"-> " + os.readlink(p).encode()
-        else:
-            out[key] = p.read_bytes() if p.is_file() else b"<dir>"
-    return out
-
-
-
-def _refused(argv, needle, workdir, capsys, monkeypatch, code=2) -> str:
-    """Run argv in ``workdir``: exit ``code``, exactly one stderr line naming --out and ``needle``, nothing written
-    anywhere under ``workdir`` (hidden lock and staging paths included)."""
-    monkeypatch.chdir(workdir)
-    before = _snapshot(workdir)
-    got, out, err = _main(argv, capsys)
-    lines = err.strip().splitlines()
-    assert got == code, (argv, got, err)
-    assert len(lines) == 1 and lines[0].startswith("error: --out: ") and needle in lines[0], err
-    assert len(lines[0]) <= 200 and "Traceback" not in err and out == ""
-    assert _snapshot(workdir) == before, "something was written"
-    return lines[0]
 
 
 def _no_work(monkeypatch):
@@ -90,8 +64,8 @@ def test_optimize_into_the_current_directory_keeps_the_users_files(tmp_path, cap
     work = _users_directory(tmp_path / "w")
     (work / "config.yaml").write_text(QUICK.read_text())  # the user's own config, run from where it lives
     _no_work(monkeypatch)
-    line = _refused(["optimize", "config.yaml", "--out", ".", "-q"], "not a scalesynth run directory", work, capsys,
-                    monkeypatch)
+    line = refused(["optimize", "config.yaml", "--out", ".", "-q"], "not a scalesynth run directory", work, capsys,
+                   monkeypatch)
     assert "--force" in line and "manifest.json" in line
 
 
@@ -106,7 +80,7 @@ def test_a_foreign_directory_is_refused_before_any_work(command, needle, tmp_pat
     with exit 2 and one line; before, each command replaced or deleted the files it found there."""
     _users_directory(tmp_path / "mine")
     _no_work(monkeypatch)
-    _refused([*command, "--out", "mine"], needle, tmp_path, capsys, monkeypatch)
+    refused([*command, "--out", "mine"], needle, tmp_path, capsys, monkeypatch)
 
 
 def test_another_commands_output_is_not_own(tmp_path, capsys, monkeypatch):
@@ -115,9 +89,9 @@ def test_another_commands_output_is_not_own(tmp_path, capsys, monkeypatch):
     other.mkdir()
     (other / "cycle.json").write_text(json.dumps({"cycle": {}, "metrics": {}, "units": {}, "files": []}))
     _no_work(monkeypatch)
-    _refused(["show", FIVEBAR, "--resolution", "8", "--out", "c"], "not a scalesynth show directory", tmp_path, capsys,
-             monkeypatch)
-    _refused(["optimize", QUICK, "-q", "--out", "c"], "not a scalesynth run directory", tmp_path, capsys, monkeypatch)
+    refused(["show", FIVEBAR, "--resolution", "8", "--out", "c"], "not a scalesynth show directory", tmp_path, capsys,
+            monkeypatch)
+    refused(["optimize", QUICK, "-q", "--out", "c"], "not a scalesynth run directory", tmp_path, capsys, monkeypatch)
 
 
 def _bad_out(tmp_path: Path) -> dict[str, tuple[Path, str]]:
@@ -154,7 +128,7 @@ def test_a_bad_out_is_refused_before_computing(command, case, tmp_path, capsys, 
     target, needle = _bad_out(work)[case]
     _no_work(monkeypatch)
     for force in ([], ["--force"]):
-        _refused([*command, "--out", target, *force], needle, work, capsys, monkeypatch)
+        refused([*command, "--out", target, *force], needle, work, capsys, monkeypatch)
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root may write anywhere: the mode restricts nothing")
@@ -164,8 +138,8 @@ def test_an_unwritable_parent_is_refused_before_computing(tmp_path, capsys, monk
     locked.chmod(0o555)
     try:
         _no_work(monkeypatch)
-        _refused(["optimize", QUICK, "-q", "--out", locked / "run"], "is not writable", tmp_path, capsys,
-                 monkeypatch)
+        refused(["optimize", QUICK, "-q", "--out", locked / "run"], "is not writable", tmp_path, capsys,
+                monkeypatch)
     finally:
         locked.chmod(0o755)
 
@@ -184,7 +158,7 @@ def test_cycle_reuses_its_own_directory_and_keeps_the_users_notes(tmp_path, caps
     out = tmp_path / "c"
     out.mkdir()
     assert _cycle(capsys, "--out", out) == 0
-    first = _snapshot(out)
+    first = snapshot(out)
     assert sorted(first) == ["actuators.png", "cycle.csv", "cycle.json", "path.png", "quality.png"]
     files = json.loads((out / "cycle.json").read_text())["files"]
     assert sorted(files) == sorted(first)  # the manifest lists its directory
@@ -199,35 +173,21 @@ def test_force_into_a_foreign_directory_touches_only_the_files_it_writes(tmp_pat
     """`cycle --force` into the user's directory: cycle.csv (a name cycle writes) is replaced, every other file,
     plots/front.png and the user's config.yaml and report.md included, stays byte for byte."""
     mine = _users_directory(tmp_path / "mine")
-    before = _snapshot(mine)
+    before = snapshot(mine)
     assert _cycle(capsys, "--out", mine, "--force") == 0
-    after = _snapshot(mine)
+    after = snapshot(mine)
     written = {"actuators.png", "cycle.csv", "cycle.json", "path.png", "quality.png"}
     assert {k: v for k, v in after.items() if k not in written} == {k: v for k, v in before.items()
                                                                      if k not in written}
     assert after["cycle.csv"] != before["cycle.csv"] and written <= set(after)
     # the directory now holds a cycle output: a second cycle needs no --force and still keeps the user's files
     assert _cycle(capsys, "--out", mine, "--set", "cycle.payload=2.0") == 0
-    again = _snapshot(mine)
+    again = snapshot(mine)
     assert {k: v for k, v in again.items() if k not in written} == {k: v for k, v in before.items()
                                                                      if k not in written}
 
 
 # ----- staged and swapped whole: a failure or an interrupt leaves the previous output as it was -----------------
-
-def _fail_on(monkeypatch, name: str, exc: BaseException):
-    """Make the atomic write of the file called ``name`` raise ``exc`` (a full disk, an interrupt)."""
-    import scalesynth.io as rio
-
-    real = os.replace
-
-    def replace(src, dst, *a, **k):
-        if Path(dst).name == name:
-            raise exc
-        return real(src, dst, *a, **k)
-
-    monkeypatch.setattr(rio.os, "replace", replace)
-
 
 @pytest.mark.parametrize(("failure", "code", "needle"), [
     (OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)), 1, "quality.png: cannot write (No space left on device)"),
@@ -239,11 +199,11 @@ def test_a_failed_cycle_leaves_the_previous_one_whole(failure, code, needle, tmp
     out = tmp_path / "c"
     assert _cycle(capsys, "--out", out) == 0
     (out / "notes.txt").write_text("mine\n")
-    before = _snapshot(tmp_path)
-    _fail_on(monkeypatch, "quality.png", failure)
+    before = snapshot(tmp_path)
+    fail_on(monkeypatch, "quality.png", failure)
     got, _, err = _main(["cycle", FIVEBAR, "--out", out, "--set", "cycle.payload=2.0"], capsys)
     assert got == code and needle in err and len(err.strip().splitlines()) == 1, err
-    assert _snapshot(tmp_path) == before  # the old cycle, whole, and no staging directory left beside it
+    assert snapshot(tmp_path) == before  # the old cycle, whole, and no staging directory left beside it
 
 
 @pytest.mark.parametrize(("failure", "code", "needle"), [
@@ -256,11 +216,11 @@ def test_a_failed_show_leaves_the_previous_one_whole(failure, code, needle, tmp_
     out = tmp_path / "s"
     got, _, err = _main(["show", FIVEBAR, "--resolution", "12", "--out", out], capsys)
     assert got == 0, err
-    before = _snapshot(tmp_path)
-    _fail_on(monkeypatch, "robot.png", failure)
+    before = snapshot(tmp_path)
+    fail_on(monkeypatch, "robot.png", failure)
     got, _, err = _main(["show", FIVEBAR, "--resolution", "16", "--field", "lci", "--out", out], capsys)
     assert got == code and needle in err and len(err.strip().splitlines()) == 1, err
-    assert _snapshot(tmp_path) == before
+    assert snapshot(tmp_path) == before
 
 
 # os.replace is the last step of every file's atomic write: signal ourselves there, once `name` is complete
@@ -293,7 +253,7 @@ def test_a_signal_mid_write_leaves_the_previous_output_whole(first, second, name
     out = tmp_path / "o"
     got, _, err = _main([*first, "--out", out], capsys)
     assert got == 0, err
-    before = _snapshot(out)
+    before = snapshot(out)
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.run([sys.executable, "-c", _SIGNAL_AT, name, sig, *map(str, second), "--out", str(out)],
                           capture_output=True, text=True, env=env, timeout=600)
@@ -302,10 +262,10 @@ def test_a_signal_mid_write_leaves_the_previous_output_whole(first, second, name
     else:
         assert proc.returncode == 1 and proc.stderr.strip() == "error: interrupted", proc.stderr
         assert not rundir.staging_path(out).exists()
-    assert _snapshot(out) == before
+    assert snapshot(out) == before
     got, _, err = _main([*second, "--out", out], capsys)  # the next run: whole, nothing of the killed one left
     assert got == 0, err
-    assert not rundir.staging_path(out).exists() and _snapshot(out) != before
+    assert not rundir.staging_path(out).exists() and snapshot(out) != before
 
 
 def test_show_reuses_its_own_directory_and_drops_the_old_views(tmp_path, capsys):
@@ -342,11 +302,11 @@ def test_compare_writes_its_manifest_reuses_its_directory_and_leaves_it_whole_on
     assert manifest["runs"] == [str(d) for d in two_runs]
     assert _main([*args, "--format", "svg"], capsys)[0] == 0  # its own directory: no --force needed
     assert sorted(p.name for p in out.iterdir()) == ["compare.csv", "compare.json", "compare.svg"]
-    before = _snapshot(tmp_path)
-    _fail_on(monkeypatch, "compare.png", OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)))
+    before = snapshot(tmp_path)
+    fail_on(monkeypatch, "compare.png", OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)))
     got, _, err = _main(args, capsys)
     assert got == 1 and "compare.png: cannot write" in err, err
-    assert _snapshot(tmp_path) == before
+    assert snapshot(tmp_path) == before
 
 
 def test_select_replaces_only_its_own_files(two_runs, tmp_path, capsys, monkeypatch):
@@ -355,8 +315,8 @@ def test_select_replaces_only_its_own_files(two_runs, tmp_path, capsys, monkeypa
     monkeypatch.chdir(tmp_path)
     mine = tmp_path / "design.yaml"
     mine.write_text("# my hand-made design\nname: mine\n")
-    _refused(["select", two_runs[0], "--out", mine], "was not written by select", tmp_path, capsys, monkeypatch)
-    _refused(["select", two_runs[0], "--out", tmp_path], "is a directory", tmp_path, capsys, monkeypatch)
+    refused(["select", two_runs[0], "--out", mine], "was not written by select", tmp_path, capsys, monkeypatch)
+    refused(["select", two_runs[0], "--out", tmp_path], "is a directory", tmp_path, capsys, monkeypatch)
     got, _, err = _main(["select", two_runs[0], "--out", mine, "--force"], capsys)
     assert got == 0, err
     written = yaml.safe_load(mine.read_text())
@@ -395,7 +355,7 @@ def test_the_swap_replaces_the_previous_outputs_files_and_carries_the_users_down
         work = rd.fresh()
         _fake_run(work, {"pareto.csv": "new\n"})
         rd.commit()
-    got = _snapshot(out)
+    got = snapshot(out)
     expected = {"pareto.csv": b"new\n", "notes": b"<dir>", "notes/n.txt": b"mine\n"}
     if listed:
         expected.update({"plots": b"<dir>", "plots/mine.png": b"mine\n"})
@@ -409,14 +369,14 @@ def test_force_merge_refuses_a_type_clash_before_moving_anything(tmp_path):
     out = tmp_path / "mine"
     (out / "pareto.csv").mkdir(parents=True)
     (out / "keep.txt").write_text("mine\n")
-    before = _snapshot(out)
+    before = snapshot(out)
     with rundir.claim(out, force=True) as rd:
         assert rd.merge
         work = rd.fresh()
         _fake_run(work, {"history.csv": "new\n", "pareto.csv": "new\n"})
         with pytest.raises(RunError, match="pareto.csv: cannot replace a directory"):
             rd.commit()
-    assert _snapshot(out) == before
+    assert snapshot(out) == before
 
 
 def test_resuming_a_forced_run_needs_force_again_and_keeps_the_users_files(tmp_path):
@@ -425,15 +385,15 @@ def test_resuming_a_forced_run_needs_force_again_and_keeps_the_users_files(tmp_p
     from scalesynth.errors import ConfigError, RunError
 
     mine = _users_directory(tmp_path / "mine")
-    before = _snapshot(mine)
+    before = snapshot(mine)
     cfg = config_from_dict(copy.deepcopy(SMALL))
     with pytest.raises(RunError, match="stopped after 2 generations"):
         run(cfg, mine, plots=False, stop_after=2, force=True)
     with pytest.raises(ConfigError, match="not a scalesynth run directory"):
         run(cfg, mine, plots=False, resume=True)
-    assert _snapshot(mine) == before
+    assert snapshot(mine) == before
     run(cfg, mine, plots=False, resume=True, force=True)
-    after = _snapshot(mine)
+    after = snapshot(mine)
     written = set(json.loads(after["manifest.json"])["files"])
     assert written == {"pareto.csv", "population.csv", "history.csv", "config.yaml", "manifest.json"}
     assert {k: v for k, v in after.items() if k not in written} == {k: v for k, v in before.items()

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from cli_main import run_main as _main
+from sacred_checks import fail_on, refused, snapshot
 from scalesynth import rundir
 from scalesynth.config import load_config
 from scalesynth.optimize import run
@@ -30,38 +31,10 @@ TASK = ["--resolution", "12"]
 DRIVES = ["--samples", "41"]
 
 
-def _snapshot(directory: Path) -> dict[str, bytes]:
-    """Every entry under ``directory`` (hidden ones too) with its bytes; links by their target."""
-    out = {}
-    for p in sorted(directory.rglob("*")):
-        key = str(p.relative_to(directory))
-        if p.is_symlink():
-            out[key] = b"-> " + os.readlink(p).encode()
-        else:
-            out[key] = p.read_bytes() if p.is_file() else b"<dir>"
-    return out
-
-
-
-
 def _ok(argv, capsys) -> str:
     code, out, err = _main(argv, capsys)
     assert code == 0, err
     return out
-
-
-def _refused(argv, needle, workdir, capsys, monkeypatch, code=2) -> str:
-    """Run argv in ``workdir``: exit ``code``, one stderr line naming --out and ``needle``, nothing written under
-    ``workdir`` (hidden lock and staging paths included)."""
-    monkeypatch.chdir(workdir)
-    before = _snapshot(workdir)
-    got, out, err = _main(argv, capsys)
-    lines = err.strip().splitlines()
-    assert got == code, (argv, got, err)
-    assert len(lines) == 1 and lines[0].startswith("error: --out: ") and needle in lines[0], err
-    assert len(lines[0]) <= 200 and "Traceback" not in err and out == ""
-    assert _snapshot(workdir) == before, "something was written"
-    return lines[0]
 
 
 def _no_work(monkeypatch):
@@ -77,20 +50,6 @@ def _no_work(monkeypatch):
     monkeypatch.setattr(report, "band_sections", reached)  # plot-bands'
     monkeypatch.setattr(fivebar, "task_map", reached)  # plot-task's
     monkeypatch.setattr(analysis, "analyse", reached)  # drives'
-
-
-def _fail_on(monkeypatch, name: str, exc: BaseException):
-    """Make the atomic write of the file called ``name`` raise ``exc`` (a full disk, an interrupt)."""
-    import scalesynth.io as rio
-
-    real = os.replace
-
-    def replace(src, dst, *a, **k):
-        if Path(dst).name == name:
-            raise exc
-        return real(src, dst, *a, **k)
-
-    monkeypatch.setattr(rio.os, "replace", replace)
 
 
 def _users_directory(path: Path) -> Path:
@@ -147,7 +106,7 @@ def test_a_foreign_directory_is_refused_before_any_work(command, a_run, tmp_path
     drives.csv; now exit 2 with one line before any evaluation, and nothing changes."""
     _users_directory(tmp_path / "mine")
     _no_work(monkeypatch)
-    line = _refused([*_commands(a_run)[command], "--out", "mine"], NEEDLES[command], tmp_path, capsys, monkeypatch)
+    line = refused([*_commands(a_run)[command], "--out", "mine"], NEEDLES[command], tmp_path, capsys, monkeypatch)
     assert "--force" in line
 
 
@@ -160,9 +119,9 @@ def test_force_touches_only_the_files_the_command_writes(command, written, a_run
     """With --force the user's directory gets the command's files (the user's front.png, task_lci.png or
     drives.csv of that name replaced: the user asked for it) and every other file stays byte for byte."""
     mine = _users_directory(tmp_path / "mine")
-    before = _snapshot(mine)
+    before = snapshot(mine)
     _ok([*_commands(a_run)[command], "--out", mine, "--force"], capsys)
-    after = _snapshot(mine)
+    after = snapshot(mine)
     assert written <= set(after)
     assert {k: v for k, v in after.items() if k not in written} == {k: v for k, v in before.items()
                                                                      if k not in written}
@@ -193,7 +152,7 @@ def test_a_bad_out_is_refused_before_computing(command, case, a_run, tmp_path, c
     target, needle = _bad_out(work)[case]
     _no_work(monkeypatch)
     for force in ([], ["--force"]):
-        _refused([*_commands(a_run)[command], "--out", target, *force], needle, work, capsys, monkeypatch)
+        refused([*_commands(a_run)[command], "--out", target, *force], needle, work, capsys, monkeypatch)
 
 
 def test_plot_task_file_form_replaces_only_its_own_file(tmp_path, capsys, monkeypatch):
@@ -201,8 +160,8 @@ def test_plot_task_file_form_replaces_only_its_own_file(tmp_path, capsys, monkey
     map (exit 2) unless --force, and one it wrote (marked in its metadata) is replaced."""
     mine = tmp_path / "map.png"
     mine.write_bytes(b"\x89PNG my own picture")
-    _refused(["plot-task", FIVEBAR, *TASK, "--out", mine], "exists and was not written by plot-task", tmp_path,
-             capsys, monkeypatch)
+    refused(["plot-task", FIVEBAR, *TASK, "--out", mine], "exists and was not written by plot-task", tmp_path,
+            capsys, monkeypatch)
     _ok(["plot-task", FIVEBAR, *TASK, "--out", mine, "--force"], capsys)
     first = mine.read_bytes()
     assert first[:8] == b"\x89PNG\r\n\x1a\n" and b"scalesynth plot-task" in first
@@ -224,12 +183,12 @@ def test_a_failed_plot_into_the_run_leaves_the_run_whole(command, fails_at, fail
     """Before, plot-front wrote plots/front.png in place and then failed at hypervolume.png (plot-bands: bands/
     and bands_front.png before band_shares.png), leaving a run with half its new figures. Now the run directory
     and its surroundings are byte-identical to before: exit 1, one line."""
-    before = _snapshot(tmp_path)
-    _fail_on(monkeypatch, fails_at, failure)
+    before = snapshot(tmp_path)
+    fail_on(monkeypatch, fails_at, failure)
     code, _, err = _main([command, my_run], capsys)
     assert code == 1 and len(err.strip().splitlines()) == 1, err
     assert (f"{fails_at}: cannot write" in err) if isinstance(failure, OSError) else err.strip() == "error: interrupted"
-    assert _snapshot(tmp_path) == before
+    assert snapshot(tmp_path) == before
 
 
 def test_figures_in_the_run_join_its_manifest_and_the_next_run_replaces_them(my_run, capsys):
@@ -280,11 +239,11 @@ def test_a_failed_drives_leaves_the_previous_one_whole(tmp_path, capsys, monkeyp
     _ok(["drives", PPRS, *DRIVES, "--out", out], capsys)
     assert len((out / "drives.csv").read_text().splitlines()) == 1 + 41
     (out / "notes.md").write_text("mine\n")
-    before = _snapshot(tmp_path)
-    _fail_on(monkeypatch, "drives.png", OSError(errno.EIO, os.strerror(errno.EIO)))
+    before = snapshot(tmp_path)
+    fail_on(monkeypatch, "drives.png", OSError(errno.EIO, os.strerror(errno.EIO)))
     code, _, err = _main(["drives", PPRS, "--samples", "81", "--out", out], capsys)
     assert code == 1 and "drives.png: cannot write (Input/output error)" in err, err
-    assert _snapshot(tmp_path) == before
+    assert snapshot(tmp_path) == before
     monkeypatch.undo()
     _ok(["drives", PPRS, "--samples", "81", "--out", out], capsys)  # its own directory: no --force needed
     assert len((out / "drives.csv").read_text().splitlines()) == 1 + 81
@@ -319,8 +278,8 @@ def test_batch_refuses_a_foreign_task_directory_before_any_task_runs(tmp_path, c
     out = tmp_path / "out"
     _users_directory(out / "quick" / "seed2")
     monkeypatch.setattr(batch, "dask_client", reached)
-    line = _refused(["batch", cfg, "--seeds", "2", "--out", "out"], "not a scalesynth run directory", tmp_path,
-                    capsys, monkeypatch)
+    line = refused(["batch", cfg, "--seeds", "2", "--out", "out"], "not a scalesynth run directory", tmp_path,
+                   capsys, monkeypatch)
     assert "seed2" in line and "--force" in line
     # with --force, or with only a run's or an unfinished task's directories, the batch goes on to the scheduler
     for args in (["--force"], []):
@@ -342,12 +301,12 @@ def test_batch_force_moves_only_its_files_into_the_users_directory(tmp_path, mon
     out = tmp_path / "out"
     tasks = batch.plan([("quick.yaml", cfg)], 1, out)
     mine = _users_directory(tasks[0].out_dir)
-    before = _snapshot(mine)
+    before = snapshot(mine)
     batch.check_targets(tasks, out, force=True)
     use_inline_dask(monkeypatch)
     records = batch.run_tasks(tasks, InlineClient(), force=True)
     assert [r.status for r in records] == ["finished"], records[0].error
-    after = _snapshot(mine)
+    after = snapshot(mine)
     written = set(json.loads(after["manifest.json"])["files"])
     assert {"pareto.csv", "history.csv", "manifest.json"} <= written
     assert {k: v for k, v in after.items() if k not in written} == before
