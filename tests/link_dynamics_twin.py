@@ -15,7 +15,8 @@ from scalesynth.dynamics.inverse import JACOBIAN_STEP, SECOND_STEP, actuator_for
 
 
 def link_points_by_ik(mech, design, options, poses: np.ndarray, label: str) -> np.ndarray:
-    """Endpoints (m, s, 2, 3) at poses (m, k): IK per pose set, link_geometry per pose; NaN where out of reach."""
+    """Endpoints (m, s, 2, 3) at poses (m, k): IK per pose set, link_geometry per pose; NaN where out of reach.
+    Written out here, not links.segment_ends: the twin shares no code with the path it checks."""
     q, _ = mech.cycle_kinematics(design, options, poses, label)
     out = None
     for s, pose in enumerate(poses):

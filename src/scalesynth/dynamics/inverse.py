@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from scalesynth.cycle import config as ccfg
-from scalesynth.mechanisms.links import SegmentPoints
+from scalesynth.mechanisms.links import SegmentPoints, segment_ends
 
 JACOBIAN_STEP = 1e-5
 SECOND_STEP = 1e-4
@@ -57,18 +57,12 @@ def endpoints(mech, design, options, poses: np.ndarray, q: np.ndarray) -> Segmen
         out = vectorised(design, options, poses, q)
         out.points[..., bad] = np.nan
         return out
-    ends = None
-    for s, pose in enumerate(poses):
-        if bad[s]:
-            continue
-        a, b, _ = mech.link_geometry(design, options, pose, q[s]).as_arrays()
-        if ends is None:
-            ends = np.full((len(a), 2, 3, len(poses)), np.nan)
-        ends[:, 0, :, s], ends[:, 1, :, s] = a, b
+    ends = segment_ends(mech, design, options, poses, q)  # (m, s, 2, 3)
     if ends is None:
         raise ValueError("no pose of the cycle is reachable")
-    s = ends.shape[0]
-    return SegmentPoints(ends.reshape(2 * s, 3, -1), np.arange(2 * s).reshape(s, 2), np.full((s, 2, 3), np.nan))
+    s = ends.shape[1]
+    points = np.moveaxis(ends, 0, -1).reshape(2 * s, 3, -1)  # every end its own point, coordinate-major
+    return SegmentPoints(points, np.arange(2 * s).reshape(s, 2), np.full((s, 2, 3), np.nan))
 
 
 def link_points(mech, design, options, poses: np.ndarray, label: str) -> np.ndarray:

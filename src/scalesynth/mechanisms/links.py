@@ -152,6 +152,21 @@ def segment_points(ends: Sequence[tuple[Any, Any]], m: int) -> SegmentPoints:
     return SegmentPoints(points, index, fixed)
 
 
+def segment_ends(mech, design, options, poses: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+    """link_geometry's segment endpoints (m, s, 2, 3), length unit, at poses (m, k) with joint values q
+    (m, n_joints), one ``mech.link_geometry`` per pose: the plain path beside a mechanism's vectorised
+    ``link_endpoints``. NaN rows where q is not finite; None where no row is (the segment count is then unknown)."""
+    out = None
+    for s, pose in enumerate(poses):
+        if not np.all(np.isfinite(q[s])):
+            continue
+        a, b, _ = mech.link_geometry(design, options, pose, q[s]).as_arrays()
+        if out is None:
+            out = np.full((len(poses), len(a), 2, 3), np.nan)
+        out[s, :, 0], out[s, :, 1] = a, b
+    return out
+
+
 def point(*coords: float) -> np.ndarray:
     """A 3-D point from 2 or 3 coordinates (planar points get z = 0)."""
     c = [float(v) for v in coords]

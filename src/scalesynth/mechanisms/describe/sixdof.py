@@ -36,6 +36,7 @@ from scalesynth.mechanisms.describe import kernel6 as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, LegType
 from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, _footprint, _plans, _turn, _unit
 from scalesynth.mechanisms.describe.schema import Description
+from scalesynth.mechanisms.links import segment_ends
 
 ORIENTATION = "orientation"
 CHARACTERISTIC_LENGTH = "characteristic_length"
@@ -348,14 +349,7 @@ class SixDofMechanism(DescribedMechanism):
         """link_geometry's segment endpoints (n, s, 2, 3) at poses (n, 3) in branch ``label``; NaN where it does
         not reach."""
         q, _ = self.cycle_kinematics(design, options, poses, label)
-        out = None
-        for s, pose in enumerate(poses):
-            if not np.all(np.isfinite(q[s])):
-                continue
-            a, b, _ = self.link_geometry(design, options, pose, q[s]).as_arrays()
-            if out is None:
-                out = np.full((len(poses), len(a), 2, 3), np.nan)
-            out[s, :, 0], out[s, :, 1] = a, b
+        out = segment_ends(self, design, options, poses, q)
         return np.full((len(poses), 0, 2, 3), np.nan) if out is None else out
 
     # ----- NumPy kinematics --------------------------------------------------------------------------------
