@@ -126,6 +126,23 @@ def grid_metrics(lci, cell_measure, edges):
     return out
 
 
+def assert_report_equals_grid_metrics(rep, ref, gci_rel=1e-9, fci=False, bands=0):
+    """The evaluator's report ``rep`` against ``ref = grid_metrics(twin, ...)`` on the same grid: the same voxel
+    count, measure to 1e-12 and GCI to ``gci_rel`` relative, min and max LCI to 1e-7 (a wrong min/max sentinel or
+    reduction passes every other check); with ``fci`` the FCI to 1e-7, and the first ``bands`` band shares to 1e-12."""
+    import pytest
+
+    assert rep.metrics["voxels"] == ref["count"]
+    assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
+    assert rep.gci == pytest.approx(ref["gci"], rel=gci_rel)
+    if fci:
+        assert rep.metrics["fci"] == pytest.approx(ref["fci"], rel=1e-7)
+    for b in range(bands):
+        assert rep.metrics[f"band{b}_share"] == pytest.approx(ref["shares"][b], abs=1e-12)
+    assert rep.metrics["min_lci"] == pytest.approx(ref["min_lci"], rel=1e-7, abs=1e-10)
+    assert rep.metrics["max_lci"] == pytest.approx(ref["max_lci"], rel=1e-7, abs=1e-10)
+
+
 def fivebar_arm_angles(design, options, x, y):
     """Seed 004, spec §2.2: arm angles (alpha1, alpha2) of the working mode options['mode'] at arrays of points,
     from alpha(sigma) = atan2(E, D) - sigma arccos(-F / sqrt(D^2 + E^2)); NaN where a chain cannot reach."""

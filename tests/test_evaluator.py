@@ -10,7 +10,7 @@ from scalesynth.mechanisms import get
 from scalesynth.metrics import nullable_columns
 
 from conftest import EXACT_VOLUME, SPEC_GCI, TABLE4
-from naive import grid_metrics, grid_nodes, pauu_fields, pauu_lci
+from naive import assert_report_equals_grid_metrics, grid_metrics, grid_nodes, pauu_fields, pauu_lci
 
 M = get("2pauu-ppap")
 EDGES = (0.0, 0.1, 0.3, 1.0)
@@ -60,15 +60,7 @@ def test_kernel_matches_numpy_twin(group, options, resolution):
     assert (fields[reach & ~regular][:, 2] >= 1e9).all() and (twin[reach & ~regular][:, 2] >= 1e9).all()
     assert (fields[~reach][:, 1:] == 0).all()
     rep = evaluate(M, design, opts, resolution=resolution, band_edges=EDGES)
-    assert rep.metrics["voxels"] == ref["count"]
-    assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
-    assert rep.gci == pytest.approx(ref["gci"], rel=1e-9)
-    assert rep.metrics["fci"] == pytest.approx(ref["fci"], rel=1e-7)
-    for b in range(3):
-        assert rep.metrics[f"band{b}_share"] == pytest.approx(ref["shares"][b], abs=1e-12)
-    # min and max LCI too (a wrong min/max sentinel or reduction passes every other check)
-    assert rep.metrics["min_lci"] == pytest.approx(ref["min_lci"], rel=1e-7, abs=1e-10)
-    assert rep.metrics["max_lci"] == pytest.approx(ref["max_lci"], rel=1e-7, abs=1e-10)
+    assert_report_equals_grid_metrics(rep, ref, fci=True, bands=3)
 
 
 def test_population_call_equals_single_calls():
@@ -168,6 +160,19 @@ def test_cos_third_acos_equals_the_trigonometric_form():
     assert kernel(-1.0 - 1e-15) == 0.5
 
 
+def _random_population(rng, opts, resolution):
+    """16 random seed-000 designs (m, l1, l2 in [0.5, 1.5], n in [0.2, 1], c in [0.1, 0.5]) under ``opts``: packed
+    (16, P), each design's grid lo and step (16, 3) at ``resolution``, and the grid shape."""
+    designs = [
+        M.resolve_design(dict(m=rng.uniform(0.5, 1.5), n=rng.uniform(0.2, 1), l1=rng.uniform(0.5, 1.5),
+                              l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)))
+        for _ in range(16)
+    ]
+    packed = np.stack([M.pack(d, opts) for d in designs])
+    grids = [make_grid(M, d, opts, resolution) for d in designs]
+    return packed, np.stack([g.lo for g in grids]), np.stack([g.step for g in grids]), grids[0].shape
+
+
 @pytest.mark.parametrize(
     "options",
     [{}, {"mode": "+-"}, {"mode": "--", "z_min": 0.3}, {"theta1_limits": [-1.5, 0.2], "theta2_limits": [-1.5, 0.2]},
@@ -178,20 +183,11 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     """The column-interval/symmetry kernel counts exactly the generic kernel's voxels, with the same sums."""
     from scalesynth.mechanisms.pauu_ppap import population_stats_fast
 
-    rng = np.random.default_rng(resolution)
     opts = M.resolve_options(options)
-    designs = [
-        M.resolve_design(dict(m=rng.uniform(0.5, 1.5), n=rng.uniform(0.2, 1), l1=rng.uniform(0.5, 1.5),
-                              l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)))
-        for _ in range(16)
-    ]
-    packed = np.stack([M.pack(d, opts) for d in designs])
-    grids = [make_grid(M, d, opts, resolution) for d in designs]
-    lo = np.stack([g.lo for g in grids])
-    step = np.stack([g.step for g in grids])
+    packed, lo, step, shape = _random_population(np.random.default_rng(resolution), opts, resolution)
     edges = np.array(EDGES)
-    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
-    fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, shape, edges)
+    fast = population_stats_fast(packed, lo, step, shape, edges)
     # the fast path has the three fields lci, sigma_min, sigma_max; the field kernel adds clearance (slot 3),
     # stiffness_min and deflection (slots 4, 5)
     assert M.field_names[3:] == ("clearance", "stiffness_min", "deflection")
@@ -201,7 +197,7 @@ def test_fast_seed000_evaluator_equals_generic_kernel(options, resolution):
     assert fast.shape == generic.shape == (16, kgrid.stat_columns(3, 3))
     # what the evaluator gets (options without link_radius or stiffness_metrics): the fast rows in the six-field
     # layout
-    widened = M.grid_stats(packed, lo, step, grids[0].shape, edges)
+    widened = M.grid_stats(packed, lo, step, shape, edges)
     assert widened.shape == full.shape
     assert np.array_equal(widened[:, :head], fast[:, :head])
     assert np.array_equal(widened[:, kgrid.band_column(6, 0):], fast[:, head:])
@@ -236,21 +232,13 @@ def test_fast_seed000_cells_computed_like_the_generic_kernel_give_bitwise_equal_
     coordinate's rounding by about 1/LCI near singular surfaces) and from the vectorised passes' algebraic form."""
     from scalesynth.mechanisms.pauu_ppap import population_stats_fast
 
-    rng = np.random.default_rng(resolution)
     opts = M.resolve_options({"theta1_limits": [-1.5, 0.2], "theta2_limits": [-1.5, 0.2]})
-    designs = [
-        M.resolve_design(dict(m=rng.uniform(0.5, 1.5), n=rng.uniform(0.2, 1), l1=rng.uniform(0.5, 1.5),
-                              l2=rng.uniform(0.5, 1.5), c=rng.uniform(0.1, 0.5)))
-        for _ in range(16)
-    ]
-    packed = np.stack([M.pack(d, opts) for d in designs])
-    grids = [make_grid(M, d, opts, resolution) for d in designs]
-    step = np.stack([g.step for g in grids])
-    lo = np.stack([g.lo for g in grids]) - np.array([1e-3, 1e-3, 0.0]) * step
+    packed, lo, step, shape = _random_population(np.random.default_rng(resolution), opts, resolution)
+    lo = lo - np.array([1e-3, 1e-3, 0.0]) * step
     edges = np.array(EDGES)
-    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, grids[0].shape, edges)
+    full = kgrid.population_stats(M.field_kernel, M.n_fields, packed, lo, step, shape, edges)
     generic = np.hstack([full[:, : kgrid.band_column(3, 0)], full[:, kgrid.band_column(6, 0):]])
-    fast = population_stats_fast(packed, lo, step, grids[0].shape, edges)
+    fast = population_stats_fast(packed, lo, step, shape, edges)
     assert (generic[:, kgrid.COL_COUNT] > 0).sum() >= 8
     assert (generic[:, kgrid.field_column(2, kgrid.STAT_MAX)] > 1e3).any()  # ill-conditioned designs included
     assert np.array_equal(fast, generic)

@@ -19,7 +19,7 @@ from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import get
 
 from conftest import ROOT
-from naive import fivebar_arm_angles, fivebar_lci, grid_metrics, grid_nodes
+from naive import assert_report_equals_grid_metrics, fivebar_arm_angles, fivebar_lci, grid_metrics, grid_nodes
 from refdata import seed004_points
 
 M = get("planar-fivebar")
@@ -237,13 +237,7 @@ def test_kernel_matches_numpy_twin(design, options):
     np.testing.assert_allclose(lci[lci >= 0], twin[twin >= 0], rtol=1e-7, atol=1e-10)
     ref = grid_metrics(twin, g.cell_measure, (0.0, 0.1, 0.3, 1.0))
     rep = evaluate(M, design, opts, resolution=61)
-    assert rep.metrics["voxels"] == ref["count"]
-    assert rep.measure == pytest.approx(ref["measure"], rel=1e-12)
-    assert rep.gci == pytest.approx(ref["gci"], rel=1e-9)
-    assert rep.metrics["fci"] == pytest.approx(ref["fci"], rel=1e-7)
-    # min and max LCI too (a wrong min/max sentinel or reduction passes every other check)
-    assert rep.metrics["min_lci"] == pytest.approx(ref["min_lci"], rel=1e-7, abs=1e-10)
-    assert rep.metrics["max_lci"] == pytest.approx(ref["max_lci"], rel=1e-7, abs=1e-10)
+    assert_report_equals_grid_metrics(rep, ref, fci=True)
 
 
 @settings(max_examples=60, deadline=None)
