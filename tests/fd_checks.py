@@ -48,3 +48,17 @@ def fk_jacobian(mech, design, options, p, q, h, order=2):
         vals = {s: nearest_assembly(mech.forward_kinematics(design, options, q + s * dq), p) for s, _ in stencil}
         fd[:, i] = sum(w * vals[s] for s, w in stencil) / (denominator * h)
     return fd
+
+
+def central_differences(f, x, steps):
+    """df/dx at x by central differences: column k is (f(x + h_k e_k) - f(x - h_k e_k)) / (2 h_k), ``steps`` the
+    h_k (one number for every axis, or one per axis); f maps an array like x to an array (m,). Shape (m, len(x))."""
+    x = np.asarray(x, dtype=float)
+    steps = np.broadcast_to(np.asarray(steps, dtype=float), x.shape)
+    cols = []
+    for k in range(len(x)):
+        h = float(steps[k])
+        e = np.zeros(len(x))
+        e[k] = h
+        cols.append((np.asarray(f(x + e)) - np.asarray(f(x - e))) / (2 * h))
+    return np.stack(cols, axis=1)

@@ -14,6 +14,7 @@ import pytest
 from scipy.optimize import brentq
 from typer.testing import CliRunner
 
+from fd_checks import central_differences
 from scalesynth.cli import app
 from scalesynth.cycle.clearance import segment_distance
 from scalesynth.errors import InvalidParameter
@@ -193,12 +194,7 @@ def test_link_radius_by_group_and_by_body():
 
 def _finite_difference_velocity_map(solve, pose, h=1e-6):
     """dq/dx (3x3) by central differences of an independent IK ``solve(pose) -> q``."""
-    a = np.zeros((3, 3))
-    for k in range(3):
-        dp = np.zeros(3)
-        dp[k] = h
-        a[:, k] = (np.array(solve(pose + dp)) - np.array(solve(pose - dp))) / (2 * h)
-    return a
+    return central_differences(solve, pose, h)
 
 
 @pytest.mark.parametrize("config, solve", [

@@ -10,6 +10,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
+from fd_checks import central_differences
 from scalesynth.cli import app
 from scalesynth.config import load_config
 from scalesynth.errors import InvalidParameter, InvalidPose
@@ -117,17 +118,18 @@ def test_home_pose_jacobian_printed():
     assert 1.0 / M.lci(D, OPT, HOME, q_of(HOME)) == pytest.approx(6.68, abs=5e-3)
 
 
+def _ik_jacobian(geo, X, sig):
+    """dq/dX (6x6) by central differences of the chain IK: steps 1e-4 along the position coordinates of X, 1e-6
+    along its orientation coordinates."""
+    return central_differences(lambda x: chain_state(geo, x, sig).q, X, [1e-4] * 3 + [1e-6] * 3)
+
+
 def test_jacobian_matches_central_differences_on_ref_cases():
     geo = Geometry.of(D, OPT)
     sig = sigma_vector("+++")
     for case in REF["cases"]:
         X = np.array(case["X"])
-        num = np.empty((6, 6))
-        for k in range(6):
-            h = 1e-4 if k < 3 else 1e-6
-            e = np.zeros(6)
-            e[k] = h
-            num[:, k] = (chain_state(geo, X + e, sig).q - chain_state(geo, X - e, sig).q) / (2 * h)
+        num = _ik_jacobian(geo, X, sig)
         jac = M.jacobians(D, OPT, X, case["q"])["J"]
         np.testing.assert_allclose(num, jac, rtol=0, atol=2e-7 * np.abs(jac).max())
 
@@ -545,12 +547,7 @@ def test_pose_jacobian_matches_central_differences(pose, branch):
     sig = sigma_vector(branch)
     st_ = chain_state(geo, X, sig)
     assume(st_.ok and not np.any(st_.kappa < 1.0))
-    num = np.empty((6, 6))
-    for k in range(6):
-        h = 1e-4 if k < 3 else 1e-6
-        e = np.zeros(6)
-        e[k] = h
-        num[:, k] = (chain_state(geo, X + e, sig).q - chain_state(geo, X - e, sig).q) / (2 * h)
+    num = _ik_jacobian(geo, X, sig)
     jac = M.jacobians(D, OPT, X, st_.q)["J"]
     # central-difference truncation grows as kappa shrinks; 1e-6 of the largest entry is ample here
     np.testing.assert_allclose(num, jac, rtol=0, atol=1e-6 * np.abs(jac).max())
