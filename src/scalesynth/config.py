@@ -62,14 +62,7 @@ class GridConfig(_Strict):
     @field_validator("region")
     @classmethod
     def _region_ok(cls, v):
-        if v is None:
-            return v
-        for axis, (lo, hi) in v.items():
-            if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
-                raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
-            _magnitude(axis, lo, hi)
-            _width(axis, lo, hi)
-        return v
+        return v if v is None else _axis_ranges(v)
 
     @property
     def adaptive(self) -> bool:
@@ -116,6 +109,17 @@ def _width(key: str, lo: float, hi: float) -> None:
                          f"at least {MIN_RANGE_ULPS} float steps, {MIN_RANGE_ULPS * ulp:.3g}, are needed)")
 
 
+def _axis_ranges(ranges: dict[str, tuple[float, float]]) -> dict[str, tuple[float, float]]:
+    """``ranges`` (axis -> [lo, hi], a grid region or a task box) unchanged, or ValueError naming the axis: each
+    range finite with lo < hi, within MAX_MAGNITUDE and wide enough to compute in."""
+    for axis, (lo, hi) in ranges.items():
+        if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
+            raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
+        _magnitude(axis, lo, hi)
+        _width(axis, lo, hi)
+    return ranges
+
+
 class DexterityConfig(_Strict):
     band_edges: list[float] = Field(default_factory=lambda: [0.0, 0.1, 0.3, 1.0])
 
@@ -142,12 +146,7 @@ class TaskConfig(_Strict):
     @field_validator("box")
     @classmethod
     def _box_ok(cls, v):
-        for axis, (lo, hi) in v.items():
-            if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
-                raise ValueError(f"{axis}: need finite lo < hi, got [{lo}, {hi}]")
-            _magnitude(axis, lo, hi)
-            _width(axis, lo, hi)
-        return v
+        return _axis_ranges(v)
 
     @field_validator("path")
     @classmethod
