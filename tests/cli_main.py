@@ -13,3 +13,9 @@ def run_main(argv, capsys) -> tuple[int, str, str]:
     out, err = capsys.readouterr()
     code = exc.value.code
     return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
+
+
+def error_lines(err: str) -> list[str]:
+    """stderr's lines without the one-time "note: compiling ..." line, which a process prints when its first
+    compilation starts (whether a test sees it depends on which tests ran in its process before)."""
+    return [line for line in err.strip().splitlines() if not line.startswith("note: compiling")]

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from cli_main import error_lines
 from cli_main import run_main as _main
 from sacred_checks import fail_on, refused, snapshot
 from scalesynth import rundir
@@ -186,8 +187,10 @@ def test_a_failed_plot_into_the_run_leaves_the_run_whole(command, fails_at, fail
     before = snapshot(tmp_path)
     fail_on(monkeypatch, fails_at, failure)
     code, _, err = _main([command, my_run], capsys)
-    assert code == 1 and len(err.strip().splitlines()) == 1, err
-    assert (f"{fails_at}: cannot write" in err) if isinstance(failure, OSError) else err.strip() == "error: interrupted"
+    lines = error_lines(err)
+    assert code == 1 and len(lines) == 1, err
+    want = f"{fails_at}: cannot write"
+    assert (want in lines[0]) if isinstance(failure, OSError) else lines == ["error: interrupted"]
     assert snapshot(tmp_path) == before
 
 
