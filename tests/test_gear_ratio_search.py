@@ -119,6 +119,22 @@ def test_datasheet_uses_the_rows_searched_gear_ratio(gear_run, tmp_path):
         assert _cell(text, f"{name} margin") == _fmt(expected, "%")
 
 
+def test_report_datasheet_uses_the_rows_searched_gear_ratio(gear_run):
+    """The run report's datasheet (cycle.datasheet.of_featured) of a row of a gear-ratio search: that row's ratio,
+    and at the cycle's own payload the row's picks_per_minute from the search."""
+    from scalesynth import results
+    from scalesynth.cycle.datasheet import of_featured
+
+    _, run = gear_run
+    result = results.load(run)
+    row = result.pareto.iloc[0]
+    label, sheet = of_featured(result, [("knee", 0)])
+    assert label == "knee" and isinstance(sheet, dict), sheet
+    assert sheet["gear_ratio"] == pytest.approx([float(row["gear_ratio"])] * 2, rel=1e-12)
+    (rated,) = [r for r in sheet["rows"] if r["payload_kg"] == result.cfg.cycle.payload]
+    assert rated["picks_per_minute"] == pytest.approx(float(row["picks_per_minute"]), rel=1e-9)
+
+
 @pytest.mark.parametrize("changes, message", [
     ({"motors": None}, "bounds.gear_ratio: needs a motors section"),
     ({"bounds": {"r": [50, 400], "gear_ratio": [0.0, 60.0]}}, "bounds.gear_ratio: lower bound must be > 0"),
