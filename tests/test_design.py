@@ -311,3 +311,25 @@ def test_datasheet_when_the_browser_fails(planar_design, tmp_path, capsys, monke
     code, out, err = run_main(["datasheet", run, "--out", tmp_path / "b.html"], capsys)
     assert code == 0 and "warning: no print of the datasheet: --print pdf: the browser wrote no PDF" in err
     assert (tmp_path / "b.html").is_file() and not (tmp_path / "b.pdf").exists() and "print:" not in out
+
+
+def test_design_keeps_its_results_when_an_asked_for_print_fails(tmp_path, capsys, monkeypatch):
+    """`design --print pdf` with a browser that writes nothing: the synthesis, comparison and datasheet are kept
+    (swapped in whole), then one line says the print failed, exit 1."""
+    from scalesynth import html_print
+
+    broken = tmp_path / "broken-chromium"
+    broken.write_text("#!/bin/sh\nexit 0\n")
+    broken.chmod(0o755)
+    monkeypatch.setenv(html_print.BROWSER_ENV, str(broken))
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(yaml.safe_dump(PLANAR))
+    code, out, err = run_main(["design", spec, "--out", tmp_path / "out", "--print", "pdf"], capsys)
+    comparison = json.loads((tmp_path / "out/comparison.json").read_text())
+    if comparison["recommendation"]["mechanism"] is None:
+        pytest.skip("no feasible design at this budget (no datasheet to print)")
+    assert code == 1 and out == ""
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error: --print pdf: the browser wrote no PDF") and "everything else is written" in last
+    assert (tmp_path / "out/chosen/datasheet.html").is_file() and not (tmp_path / "out/chosen/datasheet.pdf").exists()
+    assert json.loads((tmp_path / "out/design.json").read_text())["status"] == "finished"
