@@ -78,8 +78,8 @@ def plan(option: str | None, flag: str = "--print") -> PrintPlan:
     browser = find_browser()
     if option is None:
         if browser is None:
-            return PrintPlan(None, note=f"no print of the datasheet: no Chromium found ({INSTALL_HINT}; "
-                                        f"{flag} none hides this note)")
+            return PrintPlan(None, note=f"no print of the datasheet: no Chromium found; {INSTALL_HINT} (or "
+                                        f"{flag} none: no print, no note)")
         return PrintPlan("pdf", browser)
     if browser is None:
         raise ConfigError(f"{flag} {option}: no Chromium found; {INSTALL_HINT}")
