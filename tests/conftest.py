@@ -37,3 +37,14 @@ SMALL = {
     "algorithm": {"pop_size": 16, "n_gen": 6, "seed": 3},
     "output": {"checkpoint_every": 2},
 }
+
+
+@pytest.fixture
+def no_browser(tmp_path, monkeypatch):
+    """PATH without any browser and no $SCALESYNTH_CHROMIUM (scalesynth.html_print finds no Chromium)."""
+    from scalesynth import html_print
+
+    empty = tmp_path / "empty-bin"
+    empty.mkdir()
+    monkeypatch.setenv("PATH", str(empty))
+    monkeypatch.delenv(html_print.BROWSER_ENV, raising=False)

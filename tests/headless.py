@@ -39,6 +39,16 @@ def chromium() -> str | None:
     return None
 
 
+def need_chromium() -> None:
+    """Skip the calling test where Chromium is missing; fail it under CI=true (CI installs Debian's chromium)."""
+    import pytest
+
+    if chromium() is None:
+        if os.environ.get("CI") == "true":
+            pytest.fail("chromium is not installed (CI must install Debian's chromium package)")
+        pytest.skip("chromium not installed (apt-get install chromium)")
+
+
 def _run(exe: str, args: list[str], profile: str, timeout: float) -> subprocess.CompletedProcess:
     return subprocess.run([exe, *FLAGS, f"--user-data-dir={profile}", *args], capture_output=True, text=True,
                           timeout=timeout, env=dict(os.environ, HOME=profile))

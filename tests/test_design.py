@@ -1,7 +1,7 @@
 """`scalesynth design` (spec sheet -> comparison, recommendation, datasheet, exports), `datasheet` and `export`."""
 
 import json
-import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +12,7 @@ from cli_main import run_main
 from scalesynth.design import export, sizing
 from scalesynth.design.spec import SpecError, load_spec, spec_from_dict
 
-from headless import chromium, open_page
+from headless import need_chromium, open_page
 
 ROOT = Path(__file__).resolve().parents[1]
 PLANAR = {"name": "packer2d", "envelope": {"box": {"x": 1000, "y": 250}, "depth": 600},
@@ -208,12 +208,128 @@ def test_datasheet_and_export_of_a_run(planar_design, tmp_path, capsys):
     assert code == 0, err
     code, _, err = run_main(["export", run, "--description", tmp_path / "d.yaml"], capsys)
     assert code == 2 and "written in Python" in err
-    if chromium() is None:
-        if os.environ.get("CI") == "true":
-            pytest.fail("chromium is not installed")
-        pytest.skip("chromium not installed")
+    need_chromium()
     r = open_page(page, tmp_path / "ds.png")
     assert r["loaded"] and r["errors"] == []
     assert r["dom"].count("<svg") >= 1 and "Picks per minute against payload" in r["dom"]
     grey = r["pixels"].astype(float).mean(axis=2)
     assert grey.std() > 10 and np.mean(grey < 250) > 0.03
+
+
+# ----- the datasheet's print (headless Chromium; scalesynth.html_print) ----------------------------------------
+A4_PT = (595.28, 841.89)  # ISO 216 A4, 210 x 297 mm, in PDF points (1/72 inch)
+
+
+def _front_run(planar_design) -> Path:
+    run = planar_design / "runs" / "packer2d-planar-fivebar" / "seed1"
+    if len((run / "pareto.csv").read_text().strip().splitlines()) < 2:
+        pytest.skip("no feasible design at this budget")
+    return run
+
+
+def test_datasheet_without_a_browser(planar_design, tmp_path, capsys, no_browser):
+    """Asked for, a print without a browser is one line naming the flag, exit 2, nothing written; by default the
+    HTML is written and a note says how to get the print."""
+    run = _front_run(planar_design)
+    code, _, err = run_main(["datasheet", run, "--out", tmp_path / "a.html", "--print", "pdf"], capsys)
+    assert code == 2 and err.startswith("error: --print pdf: no Chromium found") and err.count("\n") == 1, err
+    assert not (tmp_path / "a.html").exists()
+    code, out, err = run_main(["datasheet", run, "--out", tmp_path / "b.html"], capsys)
+    assert code == 0, err
+    assert (tmp_path / "b.html").is_file() and not (tmp_path / "b.pdf").exists()
+    assert "no Chromium found" in err and "apt-get install chromium" in err and "print:" not in out
+    code, _, err = run_main(["datasheet", run, "--out", tmp_path / "c.html", "--print", "tiff"], capsys)
+    assert code == 2 and "--print: expected one of pdf, png, none, got 'tiff'" in err
+    code, _, err = run_main(["datasheet", run, "--out", tmp_path / "d.html", "--print", "none"], capsys)
+    assert code == 0 and err == "" and (tmp_path / "d.html").is_file()
+
+
+def test_design_refuses_an_asked_for_print_without_a_browser_before_any_work(tmp_path, capsys, no_browser):
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(yaml.safe_dump(PLANAR))
+    code, _, err = run_main(["design", spec, "--out", tmp_path / "out", "--print", "png"], capsys)
+    assert code == 2 and err.startswith("error: --print png: no Chromium found") and err.count("\n") == 1, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_datasheet_prints_an_a4_vector_pdf_and_a_png(planar_design, tmp_path, capsys):
+    from scalesynth.html_print import PNG_SCALE, PNG_WIDTH_PX, pdf_pages, png_size
+
+    run = _front_run(planar_design)
+    need_chromium()
+    code, out, err = run_main(["datasheet", run, "--out", tmp_path / "ds.html", "--print", "pdf"], capsys)
+    assert code == 0, err
+    assert f"print: {tmp_path / 'ds.pdf'}" in out
+    data = (tmp_path / "ds.pdf").read_bytes()
+    assert data.startswith(b"%PDF-") and pdf_pages(data) >= 1
+    boxes = re.findall(rb"/MediaBox\s*\[\s*0\s+0\s+([\d.]+)\s+([\d.]+)\s*\]", data)
+    assert boxes and all(abs(float(w) - A4_PT[0]) < 1 and abs(float(h) - A4_PT[1]) < 1 for w, h in boxes), boxes
+    assert b"/Subtype /Image" not in data  # the drawings are SVG: printed as vector paths, no raster image
+    # a print file the user has is not replaced without --force (and then nothing is written)
+    (tmp_path / "mine.pdf").write_bytes(b"the user's")
+    code, _, err = run_main(["datasheet", run, "--out", tmp_path / "mine.html", "--print", "pdf"], capsys)
+    assert code == 2 and "mine.pdf exists" in err
+    assert (tmp_path / "mine.pdf").read_bytes() == b"the user's" and not (tmp_path / "mine.html").exists()
+    code, _, err = run_main(["datasheet", run, "--out", tmp_path / "same.pdf", "--print", "pdf"], capsys)
+    assert code == 2 and "give a .html name" in err
+    code, out, err = run_main(["datasheet", run, "--out", tmp_path / "p.html", "--print", "png"], capsys)
+    assert code == 0, err
+    size = png_size((tmp_path / "p.png").read_bytes())
+    import matplotlib.image as mpimg
+
+    pixels = mpimg.imread(tmp_path / "p.png")
+    assert size is not None and pixels.shape[:2] == (size[1], size[0]) and size[0] == PNG_WIDTH_PX * PNG_SCALE
+    grey = pixels[..., :3].mean(axis=2)
+    assert grey.std() > 0.04 and np.mean(grey < 0.98) > 0.03  # drawn on, not a blank page
+
+
+def test_design_writes_the_datasheets_print(planar_design):
+    from scalesynth.html_print import pdf_pages
+
+    need_chromium()  # the fixture ran with a browser: the default print is a PDF
+    rec = json.loads((planar_design / "comparison.json").read_text())["recommendation"]
+    if rec["mechanism"] is None:
+        pytest.skip("no feasible design at this budget")
+    assert pdf_pages((planar_design / "chosen/datasheet.pdf").read_bytes()) >= 1
+    assert "chosen/datasheet.pdf" in rec["files"]
+    assert "chosen/datasheet.pdf" in json.loads((planar_design / "design.json").read_text())["files"]
+
+
+def test_datasheet_when_the_browser_fails(planar_design, tmp_path, capsys, monkeypatch):
+    """A browser that writes nothing: an asked-for print is exit 1 and nothing written; the default print is a
+    warning and the HTML is written."""
+    from scalesynth import html_print
+
+    run = _front_run(planar_design)
+    broken = tmp_path / "broken-chromium"
+    broken.write_text("#!/bin/sh\nexit 0\n")
+    broken.chmod(0o755)
+    monkeypatch.setenv(html_print.BROWSER_ENV, str(broken))
+    code, _, err = run_main(["datasheet", run, "--out", tmp_path / "a.html", "--print", "pdf"], capsys)
+    assert code == 1 and err.startswith("error: --print pdf: the browser wrote no PDF") and err.count("\n") == 1
+    assert not (tmp_path / "a.html").exists() and not (tmp_path / "a.pdf").exists()
+    code, out, err = run_main(["datasheet", run, "--out", tmp_path / "b.html"], capsys)
+    assert code == 0 and "warning: no print of the datasheet: --print pdf: the browser wrote no PDF" in err
+    assert (tmp_path / "b.html").is_file() and not (tmp_path / "b.pdf").exists() and "print:" not in out
+
+
+def test_design_keeps_its_results_when_an_asked_for_print_fails(tmp_path, capsys, monkeypatch):
+    """`design --print pdf` with a browser that writes nothing: the synthesis, comparison and datasheet are kept
+    (swapped in whole), then one line says the print failed, exit 1."""
+    from scalesynth import html_print
+
+    broken = tmp_path / "broken-chromium"
+    broken.write_text("#!/bin/sh\nexit 0\n")
+    broken.chmod(0o755)
+    monkeypatch.setenv(html_print.BROWSER_ENV, str(broken))
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(yaml.safe_dump(PLANAR))
+    code, out, err = run_main(["design", spec, "--out", tmp_path / "out", "--print", "pdf"], capsys)
+    comparison = json.loads((tmp_path / "out/comparison.json").read_text())
+    if comparison["recommendation"]["mechanism"] is None:
+        pytest.skip("no feasible design at this budget (no datasheet to print)")
+    assert code == 1 and out == ""
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error: --print pdf: the browser wrote no PDF") and "everything else is written" in last
+    assert (tmp_path / "out/chosen/datasheet.html").is_file() and not (tmp_path / "out/chosen/datasheet.pdf").exists()
+    assert json.loads((tmp_path / "out/design.json").read_text())["status"] == "finished"

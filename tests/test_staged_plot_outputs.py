@@ -156,6 +156,41 @@ def test_a_bad_out_is_refused_before_computing(command, case, a_run, tmp_path, c
         refused([*_commands(a_run)[command], "--out", target, *force], needle, work, capsys, monkeypatch)
 
 
+def _drop_column(path: Path, column: str) -> None:
+    import csv
+
+    rows = list(csv.reader(path.open(newline="")))
+    k = rows[0].index(column)
+    with path.open("w", newline="") as fh:
+        csv.writer(fh).writerows([r[:k] + r[k + 1:] for r in rows])
+
+
+# a damage of the run directory, and what the one-line refusal names
+DAMAGES = {
+    "no history": (lambda run: (run / "history.csv").unlink(), "(missing history.csv)"),
+    "empty history": (lambda run: (run / "history.csv").write_text("generation,evaluations,hypervolume\n"),
+                      "history.csv: no generations"),
+    "no band share": (lambda run: _drop_column(run / "pareto.csv", "band0_share"),
+                      "pareto.csv: column 'band0_share' is missing"),
+    "damaged population": (lambda run: (run / "population.csv").write_text("a,b\n1,2\n"),
+                           "population.csv: column "),
+    "damaged manifest": (lambda run: (run / "manifest.json").write_text("{"), "manifest.json: not valid JSON"),
+}
+
+
+@pytest.mark.parametrize("damage", list(DAMAGES))
+def test_plot_bands_refuses_a_damaged_run_before_evaluating(damage, my_run, tmp_path, capsys, monkeypatch):
+    """plot-bands evaluates its sections from config.yaml and pareto.csv read without pandas; a run directory
+    that results.load refuses (another table missing or damaged) is refused before that evaluation, exit 2."""
+    spoil, needle = DAMAGES[damage]
+    spoil(my_run)
+    _no_work(monkeypatch)
+    code, out, err = _main(["plot-bands", my_run, "--out", tmp_path / "figs"], capsys)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and needle in lines[0], err
+    assert not (tmp_path / "figs").exists()
+
+
 def test_plot_task_file_form_replaces_only_its_own_file(tmp_path, capsys, monkeypatch):
     """`plot-task --out FILE.png` overwrote any file; now a file plot-task did not write is refused before the
     map (exit 2) unless --force, and one it wrote (marked in its metadata) is replaced."""

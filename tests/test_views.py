@@ -1,7 +1,6 @@
 """Views of results: report.html (opened in headless Chromium), per-band Pareto sets, `show`, `compare`, plot fixes."""
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +16,7 @@ from scalesynth.report_html import has_remote_scripts
 from scalesynth.workspace_view import connected_regions, sample_fields, sample_plane
 
 from conftest import ROOT, SMALL, TABLE4
-from headless import chromium, open_page
+from headless import need_chromium, open_page
 
 runner = CliRunner()
 CONFIGS = sorted((ROOT / "configs").glob("*.yaml"))
@@ -84,13 +83,6 @@ def test_remote_script_check_can_fail():
     assert not has_remote_scripts('<script type="text/javascript">var u = "https://plot.ly";</script>')
 
 
-def _need_chromium():
-    if chromium() is None:
-        if os.environ.get("CI") == "true":
-            pytest.fail("chromium is not installed (CI must install Debian's chromium package)")
-        pytest.skip("chromium not installed (apt-get install chromium)")
-
-
 def _not_blank(pixels) -> None:
     assert pixels is not None, "no screenshot"
     grey = pixels.astype(float).mean(axis=2)
@@ -100,7 +92,7 @@ def _not_blank(pixels) -> None:
 
 def test_headless_harness_sees_script_errors(tmp_path):
     """Check the checker: a page whose script fails reports the error, and a white page is blank."""
-    _need_chromium()
+    need_chromium()
     bad = tmp_path / "bad.html"
     bad.write_text("<!DOCTYPE html><html><head><meta charset='utf-8'></head><body><p>x</p>"
                    "<script>console.error('boom'); undefinedFunction();</script></body></html>")
@@ -112,7 +104,7 @@ def test_headless_harness_sees_script_errors(tmp_path):
 
 
 def test_report_html_renders_in_headless_chromium(small_run, tmp_path):
-    _need_chromium()
+    need_chromium()
     r = open_page(small_run / "report.html", tmp_path / "report.png")
     assert r["loaded"] and r["errors"] == []
     assert r["dom"].count('class="main-svg"') >= 4  # plotly drew its figures (front, parcoords, HV, 3-D views)
@@ -120,7 +112,7 @@ def test_report_html_renders_in_headless_chromium(small_run, tmp_path):
 
 
 def test_show_html_renders_in_headless_chromium(small_run, tmp_path):
-    _need_chromium()
+    need_chromium()
     res = runner.invoke(app, ["show", str(small_run), "--format", "html", "--resolution", "16",
                               "--out", str(tmp_path / "h")])
     assert res.exit_code == 0, res.output

@@ -229,6 +229,33 @@ def read_csv_columns(path: Path, columns: tuple[str, ...] | list[str]):
     return {c: values[:, k] for k, c in enumerate(columns)}
 
 
+def csv_rows_conform(path: Path, required, nullable=frozenset()) -> int | None:
+    """The number of data rows of a results CSV whose ``required`` columns each hold a finite number in every row
+    (in ``nullable`` columns also an empty cell or nan), read without pandas; None where the file is missing, not
+    CSV, lacks a column or holds another value: :func:`read_results_csv` then says what is wrong (this check only
+    ever accepts less than it does)."""
+    import csv
+    import math
+
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = [r for r in csv.reader(fh) if r]
+        header = rows[0]
+        idx = [(header.index(c), c in nullable) for c in required]
+        for r in rows[1:]:
+            if len(r) != len(header):
+                return None
+            for i, can_be_null in idx:
+                if r[i] == "" and can_be_null:
+                    continue
+                v = float(r[i])
+                if not (math.isfinite(v) or (can_be_null and math.isnan(v))):
+                    return None
+    except (OSError, UnicodeDecodeError, csv.Error, ValueError, IndexError):
+        return None
+    return len(rows) - 1
+
+
 def read_manifest(path: Path) -> dict[str, Any]:
     """manifest.json as a dict with its resolved config; ConfigError naming the file if damaged."""
     from scalesynth.errors import ConfigError

@@ -125,20 +125,47 @@ def load(out_dir: Path, *, require_finished: bool = True) -> RunResult:
             raise ConfigError(f"{out}: not a scalesynth results directory (missing {name})")
     cfg = load_config(out / CONFIG)
     problem = SynthesisProblem(cfg)
-    nb = len(cfg.dexterity.band_edges) - 1
-    needed = [*problem.var_names, *problem.objective_keys, cfg.mech.measure_key(cfg.units.length),
-              *(f"band{b}_share" for b in range(nb))]
-    from scalesynth.metrics import nullable_columns
-
-    nullable = nullable_columns(cfg.mech, cfg.units.length, nb)
-    pareto = rio.read_results_csv(out / PARETO, list(dict.fromkeys(needed)), nullable)
-    history = rio.read_results_csv(out / HISTORY, ("generation", "evaluations", "hypervolume"))
+    needed, nullable = _pareto_columns(problem)
+    pareto = rio.read_results_csv(out / PARETO, needed, nullable)
+    history = rio.read_results_csv(out / HISTORY, HISTORY_COLUMNS)
     if not len(history):
         raise ConfigError(f"{out / HISTORY}: no generations")
     population = (rio.read_results_csv(out / POPULATION, problem.objective_keys, nullable)
                   if (out / POPULATION).is_file() else None)
     return RunResult(out_dir=out, cfg=cfg, pareto=pareto, history=history, manifest=manifest or {},
                      population=population, problem=problem)
+
+
+HISTORY_COLUMNS = ("generation", "evaluations", "hypervolume")
+
+
+def _pareto_columns(problem: SynthesisProblem) -> tuple[list[str], set[str]]:
+    """(the columns pareto.csv must have, those of them that may be null) for :func:`load`."""
+    from scalesynth.metrics import nullable_columns
+
+    cfg = problem.cfg
+    nb = len(cfg.dexterity.band_edges) - 1
+    needed = [*problem.var_names, *problem.objective_keys, cfg.mech.measure_key(cfg.units.length),
+              *(f"band{b}_share" for b in range(nb))]
+    return list(dict.fromkeys(needed)), nullable_columns(cfg.mech, cfg.units.length, nb)
+
+
+def _loads(out: Path, problem: SynthesisProblem) -> bool:
+    """Whether :func:`load` (``require_finished=False``) would read ``out`` past its config, checked without
+    pandas: a readable manifest if there is one, pareto.csv's columns, history.csv with a generation,
+    population.csv's objectives if it is there. False where unsure (load then says what is wrong)."""
+    from scalesynth.errors import ScalesynthError
+
+    if (out / MANIFEST).is_file():
+        try:
+            rio.read_manifest(out / MANIFEST)
+        except ScalesynthError:
+            return False
+    needed, nullable = _pareto_columns(problem)
+    return (rio.csv_rows_conform(out / PARETO, needed, nullable) is not None
+            and bool(rio.csv_rows_conform(out / HISTORY, HISTORY_COLUMNS))
+            and (not (out / POPULATION).is_file()
+                 or rio.csv_rows_conform(out / POPULATION, problem.objective_keys, nullable) is not None))
 
 
 @dataclass
@@ -158,7 +185,8 @@ class Front:
 
 def read_front(out_dir: Path) -> Front | None:
     """config.yaml and pareto.csv's design variables and objectives, read without pandas (a command can evaluate
-    before importing it); None where either is missing or damaged: :func:`load` then says what is wrong."""
+    before importing it); None where the directory is not one :func:`load` reads (a table missing or damaged, not
+    only these two): :func:`load` then says what is wrong, before the command evaluates anything."""
     from scalesynth.errors import ScalesynthError
 
     out = Path(out_dir)
@@ -170,7 +198,7 @@ def read_front(out_dir: Path) -> Front | None:
     except ScalesynthError:
         return None
     cols = rio.read_csv_columns(out / PARETO, list(dict.fromkeys([*problem.var_names, *problem.objective_keys])))
-    if cols is None:
+    if cols is None or not _loads(out, problem):
         return None
     X = np.column_stack([cols[k] for k in problem.var_names])
     F = problem.minimisation_form(np.column_stack([cols[k] for k in problem.objective_keys]))

@@ -11,6 +11,9 @@ import typer
 from scalesynth.cliapp import DesignOpt, ForceOpt, app, handles_errors
 
 OutFile = Annotated[Path, typer.Option("--out", help="output file (an existing one only with --force)")]
+PrintOpt = Annotated[str | None, typer.Option(
+    "--print", help="a print of the datasheet beside it, through headless Chromium: pdf (A4), png or none "
+    "(default: pdf when Chromium is found, else none with a note)")]
 
 
 def _check_new_file(out: Path, force: bool) -> Path:
@@ -34,6 +37,7 @@ def design_cmd(
     scheduler: Annotated[str | None, typer.Option(
         "--scheduler", help="address of a running dask scheduler (default: a local cluster sized to this machine)")]
     = None,
+    print_as: PrintOpt = None,
     force: ForceOpt = False,
 ) -> None:
     """Size every candidate mechanism for the spec, run their syntheses, compare them, recommend one with its
@@ -48,7 +52,8 @@ def design_cmd(
         check_protocol(scheduler)
     s = load_spec(spec)
     target = out if out is not None else Path("results") / f"design-{s.name}"
-    comparison = design(s, target, scheduler=scheduler, force=force, echo=lambda line: typer.echo(line, err=True))
+    comparison = design(s, target, scheduler=scheduler, force=force, print_as=print_as,
+                        echo=lambda line: typer.echo(line, err=True))
     rec = comparison["recommendation"]
     typer.echo(f"recommendation: {rec['mechanism'] or 'none'}")
     for reason in rec["reasons"]:
@@ -56,6 +61,9 @@ def design_cmd(
     typer.echo(f"comparison: {target / 'comparison.md'}")
     if rec["mechanism"]:
         typer.echo(f"datasheet: {target / 'chosen' / 'datasheet.html'}")
+        for kind in ("pdf", "png"):
+            if f"chosen/datasheet.{kind}" in rec.get("files", []):
+                typer.echo(f"print: {target / 'chosen' / f'datasheet.{kind}'}")
 
 
 @app.command("datasheet")
@@ -64,17 +72,41 @@ def datasheet_cmd(
     run: Annotated[Path, typer.Argument(help="results directory")],
     out: OutFile,
     design: DesignOpt = None,
+    print_as: PrintOpt = None,
     force: ForceOpt = False,
 ) -> None:
-    """Write the datasheet (self-contained HTML) of a design of a run's front."""
+    """Write the datasheet (self-contained HTML) of a design of a run's front, and its print (PDF or PNG, same
+    name) beside it."""
+    from scalesynth import html_print
     from scalesynth import io as rio
+    from scalesynth.cliapp import _warn
     from scalesynth.design import datasheet
+    from scalesynth.errors import ConfigError, RunError
     from scalesynth.selection import load_design
 
+    printing = html_print.plan(print_as)
+    shown = html_print.print_target(out, printing.kind) if printing.kind else None
+    if shown is not None and shown.name == Path(out).name:
+        raise ConfigError(f"--out: {Path(out).name[:60]}: the datasheet is HTML; give a .html name (its print goes "
+                          f"beside it as .{printing.kind})")
     chosen = load_design(run, design or "knee")
     target = _check_new_file(out, force)
-    rio.write_text(target, datasheet.build(chosen.result, chosen.row, label=chosen.label))
+    print_file = _check_new_file(shown, force) if shown is not None else None
+    page = datasheet.build(chosen.result, chosen.row, label=chosen.label)
+    if printing.note:
+        _warn(printing.note)
+    if print_file is not None:  # printed first: an asked-for print that fails leaves nothing written
+        try:
+            html_print.print_html(page, print_file, printing.kind, printing.browser)
+        except RunError as err:
+            if printing.explicit:
+                raise
+            _warn(f"no print of the datasheet: {err}")
+            shown = None
+    rio.write_text(target, page)
     typer.echo(f"datasheet: {out}")
+    if shown is not None:
+        typer.echo(f"print: {shown}")
 
 
 @app.command("export")

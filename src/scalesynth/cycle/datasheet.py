@@ -144,11 +144,12 @@ def of_featured(result, featured: list[tuple[str, int]]) -> tuple[str, dict[str,
     from scalesynth.cycle.analysis import analyse
     from scalesynth.errors import ScalesynthError
 
-    cfg = result.cfg
-    if cfg.cycle is None or getattr(cfg.cycle, "_motors", None) is None or not featured:
+    if result.cfg.cycle is None or getattr(result.cfg.cycle, "_motors", None) is None or not featured:
         return None
     label, row = next((f for f in featured if f[0] == "knee"), featured[0])
-    design = result.design_of(result.pareto.iloc[row])
+    rec = result.pareto.iloc[row]
+    cfg = result.config_of(rec)  # the row's own gear ratio when the search varies it (bounds.gear_ratio)
+    design = result.design_of(rec)
     options = cfg.resolved_options()
     try:
         res = analyse(cfg.mech, design, options, cfg.cycle, cfg.units.length)

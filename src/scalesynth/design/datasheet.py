@@ -13,7 +13,21 @@ import math
 import numpy as np
 
 DATASHEET_PAYLOADS = (0.1, 1.0, 3.0)  # kg, besides the rated payload
+MOTOR_UNITS = {"peak_torque": "N m", "rated_torque": "N m", "max_speed": "rad/s", "rotor_inertia": "kg m^2"}
 GRID = 90  # points per axis of the working-range sections
+# the page's style; its print (scalesynth.html_print, a browser's print dialog) is A4 with 12 mm margins, the two
+# views side by side scaled to the page's width, a section's heading kept with its table, no table row split
+# across pages, the headings' colour kept
+STYLE = ("body{font-family:sans-serif;max-width:980px;margin:1.5em auto}"
+         "table{border-collapse:collapse;width:100%;margin-bottom:.8em}th,td{border-bottom:1px solid #ddd;"
+         "text-align:left;padding:3px 8px;font-size:13px}th{width:45%;font-weight:normal;color:#444}"
+         "h1{margin-bottom:0}h2{font-size:15px;background:#1f5fbf;color:#fff;padding:3px 8px}"
+         ".views{display:flex;gap:12px;flex-wrap:wrap}"
+         "@page{size:A4;margin:12mm}"
+         "@media print{body{max-width:none;margin:0;-webkit-print-color-adjust:exact;print-color-adjust:exact}"
+         ".views{flex-wrap:nowrap;gap:2%;break-inside:avoid}.views svg{width:49%;height:auto}"
+         "h2{break-after:avoid;page-break-after:avoid}tr{break-inside:avoid;page-break-inside:avoid}"
+         "table{break-inside:avoid;page-break-inside:avoid}th,td{font-size:10.5pt}}")
 
 
 def _fmt(v, unit: str = "", digits: int = 4) -> str:
@@ -52,7 +66,7 @@ def _svg_view(reach, lo, hi, axes, names, zone, segments, unit, title, base_plan
         return H - pad - (y - y0) * s
 
     cw, ch = (x1 - x0) / (GRID - 1) * s, (y1 - y0) / (GRID - 1) * s
-    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" class="view">',
+    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" class="view">',
              f'<text x="{W / 2}" y="16" text-anchor="middle" font-size="13">{h.escape(title)}</text>']
     ys, xs = np.nonzero(reach)
     u = np.linspace(x0, x1, GRID)
@@ -87,6 +101,13 @@ def _svg_view(reach, lo, hi, axes, names, zone, segments, unit, title, base_plan
     return "".join(parts)
 
 
+def _motor_text(motor) -> str:
+    """The motors section without its gear ratio, e.g. 'peak torque 4.46 N m, ...' or 'catalogue builtin, model X'."""
+    named = motor.model_dump(mode="json", exclude={"gear_ratio"}, exclude_none=True)
+    return ", ".join(f"{k.replace('_', ' ')} {v}" + (f" {MOTOR_UNITS[k]}" if k in MOTOR_UNITS else "")
+                     for k, v in named.items())
+
+
 def _rate_rows(cfg, design) -> list[tuple[str, str]]:
     """(payload, picks per minute) rows: evaluated through the cycle analysis when the catalogue has the motor
     metrics and the config has a cycle and motors; else one row saying why not."""
@@ -111,12 +132,13 @@ def _rate_rows(cfg, design) -> list[tuple[str, str]]:
 def build(result, row: int, spec=None, label: str | None = None) -> str:
     """The datasheet page (HTML text) of row ``row`` of a run's front."""
     from scalesynth.design.export import default_pose, geometry_at
+    from scalesynth.errors import InvalidPose
     from scalesynth.metrics import DATASHEET_DEXTERITY, catalogue
 
-    cfg = result.cfg
+    rec = result.pareto.iloc[row]
+    cfg = result.config_of(rec)  # the row's own gear ratio when the search varies it (bounds.gear_ratio)
     mech = cfg.mech
     unit = cfg.units.length
-    rec = result.pareto.iloc[row]
     design = mech.resolve_design(result.design_of(rec))
     options = cfg.resolved_options()
     cat = catalogue(mech, unit)
@@ -134,7 +156,10 @@ def build(result, row: int, spec=None, label: str | None = None) -> str:
     packed = np.asarray(mech.pack(design, options), dtype=float)
     lo, hi = (np.asarray(v, dtype=float) for v in mech.bounding_box(design, options))
     pose = default_pose(cfg)
-    geometry = geometry_at(mech, design, options, pose)
+    try:
+        geometry = geometry_at(mech, design, options, pose)
+    except InvalidPose:  # no task box and the bounding box's centre out of reach: the views show no robot
+        geometry = None
     segs = [] if geometry is None else [(s.a, s.b) for s in geometry.segments]
     box = cfg.task.box if cfg.task is not None else {ax: (lo[i], hi[i]) for i, ax in enumerate(mech.task_axes)}
     axes_names = mech.task_axes
@@ -161,7 +186,9 @@ def build(result, row: int, spec=None, label: str | None = None) -> str:
                   else [("motor and gear", f"{not_eval}: " + ("the run names no motors" if "picks_per_minute" in cat
                                                                else "this scalesynth has no motor model"))])
     if motor is not None:
-        motor_rows.insert(0, ("motor", str(motor.model_dump(mode="json", exclude_none=True))))
+        searched = " (searched: this design's own)" if result.problem.searches_gear_ratio else ""
+        motor_rows[:0] = [("motor", _motor_text(motor)),
+                          ("gear ratio" + searched, ", ".join(_fmt(float(n)) for n in np.atleast_1d(motor.gear_ratio)))]
     peaks = [(n.replace("cycle_max_actuator_", "peak actuator ").replace("_", " "), _fmt(value(n), cat[n].unit))
              for n in cat if n.startswith("cycle_max_actuator_") and value(n) is not None]
     if not peaks:
@@ -194,11 +221,7 @@ def build(result, row: int, spec=None, label: str | None = None) -> str:
         + "</table>" for t, rs in rows)
     src = f"spec {h.escape(spec.name)}, " if spec is not None else ""
     return ("<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>Datasheet: "
-            f"{h.escape(mech.name)}</title><style>body{{font-family:sans-serif;max-width:980px;margin:1.5em auto}}"
-            "table{border-collapse:collapse;width:100%;margin-bottom:.8em}th,td{border-bottom:1px solid #ddd;"
-            "text-align:left;padding:3px 8px;font-size:13px}th{width:45%;font-weight:normal;color:#444}"
-            "h1{margin-bottom:0}h2{font-size:15px;background:#1f5fbf;color:#fff;padding:3px 8px}"
-            ".views{display:flex;gap:12px;flex-wrap:wrap}</style></head><body>"
+            f"{h.escape(mech.name)}</title><style>{STYLE}</style></head><body>"
             f"<h1>{h.escape(title)}</h1><p>{h.escape(mech.name)}, design {h.escape(which)} ({src}run "
             f"{h.escape(result.out_dir.name)}); lengths in {h.escape(unit)}. Grey: reachable workspace through the "
             "zone's centre; blue: the working zone; dark: the robot at the zone's centre.</p>"

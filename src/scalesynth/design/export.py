@@ -44,7 +44,7 @@ def pose_joints(mech, design, options, pose) -> np.ndarray:
     """Joint values of the kernel's branch at ``pose`` (InvalidPose if out of reach)."""
     sols = mech.inverse_kinematics(design, options, np.asarray(pose, dtype=float))
     if not sols:
-        raise InvalidPose(f"pose {list(pose)}: out of reach of this design")
+        raise InvalidPose(f"pose {[float(v) for v in pose]}: out of reach of this design")
     branch = mech.kernel_branch(options)
     return next((s.values for s in sols if s.label == branch), sols[0].values)
 

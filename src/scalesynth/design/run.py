@@ -11,6 +11,7 @@ OUT (staged beside it and swapped in whole, ``scalesynth.rundir``)::
     chosen/datasheet.html            the recommended design's datasheet
     chosen/<mechanism>-design.yaml   its mechanism description with the design's numbers (described mechanisms)
     chosen/robot.stl                 a mesh of it at the zone's centre (mechanisms with link geometry)
+    chosen/datasheet.pdf (or .png)   the datasheet's print (headless Chromium; ``print_as``)
 """
 
 from __future__ import annotations
@@ -63,10 +64,17 @@ def _run_all(cands, configs, runs: Path, scheduler: str | None, echo) -> dict[st
 
 
 def design(spec: DesignSpec, out: Path, *, scheduler: str | None = None, force: bool = False,
-           echo: Callable[[str], None] = lambda line: None) -> dict[str, Any]:
-    """Run the design study of ``spec`` into ``out``; returns the comparison (also in OUT/comparison.json)."""
-    from scalesynth.config import config_from_dict, dump_config
+           print_as: str | None = None, echo: Callable[[str], None] = lambda line: None) -> dict[str, Any]:
+    """Run the design study of ``spec`` into ``out``; returns the comparison (also in OUT/comparison.json).
 
+    ``print_as``: the datasheet's print, as ``--print`` (html_print.plan): None prints a PDF when Chromium is
+    found; 'pdf' or 'png' without a browser is refused (ConfigError) before any work. A print that fails after the
+    runs leaves everything else written, then raises RunError when it was asked for."""
+    from scalesynth.config import config_from_dict, dump_config
+    from scalesynth.errors import RunError
+    from scalesynth.html_print import plan
+
+    printing = plan(print_as)
     names, skipped = sizing.candidates(spec)
     cands = [sizing.build(n, spec) for n in names]
     configs = [config_from_dict(c.config) for c in cands]  # every config valid before anything is written
@@ -78,6 +86,9 @@ def design(spec: DesignSpec, out: Path, *, scheduler: str | None = None, force: 
             echo(f"{c.mechanism}: {note}")
     for name, why in skipped.items():
         echo(f"{name}: not a candidate: {why}")
+    if printing.note:
+        echo(printing.note)
+    print_error = None
     with rundir.staged(out, DESIGN, force) as rd:
         work = rd.work
         files: list[str] = []
@@ -103,22 +114,35 @@ def design(spec: DesignSpec, out: Path, *, scheduler: str | None = None, force: 
         link = None
         rec = comparison["recommendation"]
         if rec["mechanism"] is not None:
-            link = _chosen(work, spec, rec, results[rec["mechanism"]], comparison, echo)
+            link, print_error = _chosen(work, spec, rec, results[rec["mechanism"]], comparison, printing, echo)
         files += cmp.write(work, comparison, link)
         rio.write_json(work / MANIFEST, {"spec": spec.model_dump(mode="json"), "status": "finished",
                                          "files": rundir.listing(work)})
+    if print_error is not None and printing.explicit:
+        raise RunError(f"{print_error}; everything else is written in {out}")
     return comparison
 
 
-def _chosen(work: Path, spec, rec, result, comparison, echo) -> str | None:
-    """Write the recommended design's datasheet and exports into chosen/; the datasheet's link (relative)."""
+def _chosen(work: Path, spec, rec, result, comparison, printing, echo) -> tuple[str, str | None]:
+    """Write the recommended design's datasheet, its print and exports into chosen/; (the datasheet's link
+    (relative), why the print failed or None)."""
     from scalesynth.design import datasheet, export
+    from scalesynth.errors import RunError
+    from scalesynth.html_print import print_html
 
     chosen = rio.ensure_dir(work / "chosen")
     row = rec["design"]["row"]
     page = datasheet.build(result, row, spec=spec)
     rio.write_text(chosen / "datasheet.html", page)
     written = ["chosen/datasheet.html"]
+    print_error = None
+    if printing.kind is not None:
+        try:
+            print_html(page, chosen / f"datasheet.{printing.kind}", printing.kind, printing.browser)
+            written.append(f"chosen/datasheet.{printing.kind}")
+        except RunError as err:
+            print_error = str(err)
+            echo(f"no print of the datasheet: {err}")
     desc = export.description_yaml(result.cfg.mech, result.design_of(result.pareto.iloc[row]))
     if desc is not None:
         name, text = desc
@@ -132,4 +156,4 @@ def _chosen(work: Path, spec, rec, result, comparison, echo) -> str | None:
         written.append("(no mesh: the mechanism has no link geometry yet)")
     echo("recommended design: " + ", ".join(written))
     comparison["recommendation"]["files"] = written
-    return "chosen/datasheet.html"
+    return "chosen/datasheet.html", print_error
