@@ -30,7 +30,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     svd_lci,
 )
-from scalesynth.mechanisms.describe import bodies, expressions, frame
+from scalesynth.mechanisms.describe import bodies, expressions, frame, symmetry
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
@@ -67,10 +67,13 @@ def _plans(desc: Description) -> tuple[_LegPlan, ...]:
     for index, leg in enumerate(desc.legs):
         lt = LEG_TYPES[leg.type]
         if leg.pattern:
-            phis = [math.radians(leg.pattern.start_deg + 360.0 * k / leg.pattern.count)
-                    for k in range(leg.pattern.count)]
+            degrees = [leg.pattern.start_deg + 360.0 * k / leg.pattern.count for k in range(leg.pattern.count)]
         else:
-            phis = [math.radians(leg.angle_deg)]
+            degrees = [leg.angle_deg]
+        # in [-180, 180] (math.remainder is exact): legs at +-a then turn by exactly mirrored cos and sin (sin is
+        # odd, cos even), so a mirror-symmetric pattern packs exactly symmetric and its box is symmetric about 0
+        # to the bit (the adaptive evaluator's half box, mirror_axes)
+        phis = [math.radians(math.remainder(d, 360.0)) for d in degrees]
         for phi in phis:
             out.append(_LegPlan(
                 leg.type, leg.joint or lt.joint, phi,
@@ -164,6 +167,19 @@ class DescribedMechanism(Mechanism):
         return p
 
     @property
+    def calibrated_plans(self) -> tuple:
+        """The description's evaluation block as evaluation.plans.CalibratedPlan entries (none without one)."""
+        from scalesynth.evaluation.plans import CalibratedPlan, ColumnPlan, Tolerance
+
+        spec = self.description.evaluation if self.description is not None else None
+        if spec is None:
+            return ()
+        return tuple(CalibratedPlan(Tolerance(p.tolerance["volume"], p.tolerance["gci"]),
+                                    ColumnPlan(p.columns, p.cells, p.bisections, p.levels, p.beta, p.zlevels,
+                                               p.zconfirm, p.faces, p.field_levels, p.gauss_points))
+                     for p in spec.plans)
+
+    @property
     def field_kernel(self):
         return _k.point_fields
 
@@ -179,6 +195,25 @@ class DescribedMechanism(Mechanism):
 
     def kernel_branch(self, options) -> str:
         return "/".join(plan.branch for plan in self.plans)
+
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """x (0) and/or y (1) where the packed legs are a mirror image of themselves in that plane: every leg has a
+        partner (itself, on the plane) of the same type, lengths, branch, limits and cone whose base, platform and
+        arm/rail directions are its own reflected (the plane normal of the cone check up to sign: the kernel reads
+        only |f . axis|). The kernel's fields (reach, LCI, sigma_min, sigma_max) depend on nothing else, and a
+        reflection keeps singular values, so each such plane is a symmetry of every field. Checked on the packed
+        legs of the default design and of two designs with every parameter scaled apart (a description
+        symmetric only at its defaults is not declared). 3T only."""
+        if self.motion != "3T":
+            return ()
+        base = self.resolve_design({})
+        designs = [base] + [{n: v * (1.0 + 0.07 * (k + 1) * (1 + i % 3)) for i, (n, v) in enumerate(base.items())}
+                            for k in range(2)]
+        try:
+            packed = [self.pack(self.resolve_design(d), options) for d in designs]
+        except InvalidParameter:  # a scaled design the legs reject: declare nothing
+            return ()
+        return tuple(a for a in (0, 1) if all(symmetry.mirrored_legs(p, a) for p in packed))
 
     def bounding_box(self, design, options):
         """Intersection over the legs of the box of the set each leg can reach: R-Pa, a ball of radius L + l about
