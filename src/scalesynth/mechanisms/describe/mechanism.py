@@ -8,6 +8,7 @@ of radius l_i about each actuated point minus the platform offset, so FK interse
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Mapping
@@ -125,18 +126,7 @@ class DescribedMechanism(Mechanism):
                 if not v > 0.0:
                     raise InvalidParameter(f"design: leg {i + 1} {k} = {v:g}, must be > 0")
                 check_magnitude(f"design: leg {i + 1} {k}", v)
-            if lt.code == _k.R_PA:
-                u = _unit(_turn(plan.phi, plan.frame["arm_zero"]))
-                w = _unit(_turn(plan.phi, plan.frame["arm_positive"]))
-                normal = np.cross(u, w)
-            else:
-                u = _unit(_turn(plan.phi, plan.frame["rail"]))
-                w = np.zeros(3)
-                radial = _turn(plan.phi, (1.0, 0.0, 0.0))
-                normal = np.cross(u, radial)
-                if np.linalg.norm(normal) < 1e-9:  # a radial rail: the leg's plane is vertical
-                    normal = np.cross(u, (0.0, 0.0, 1.0))
-                normal = _unit(normal)
+            u, w, normal = _leg_directions(lt.code, plan.phi, tuple(sorted(plan.frame.items())))
             cone = options[plan.cone] if plan.cone else None
             out.append(Leg(lt, base, platform, u, w, normal, links.get("upper_arm", 0.0), links["forearm"],
                            lt.branches[plan.branch], options[plan.limits] if plan.limits else None,
@@ -336,6 +326,28 @@ class DescribedMechanism(Mechanism):
         jac = self.jacobians(design, options, pose, q)
         with np.errstate(divide="ignore", invalid="ignore"):
             return jac["Jx"] / np.diag(jac["Jq"])[:, None]
+
+
+@functools.lru_cache(maxsize=256)
+def _leg_directions(code: float, phi: float, frame: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(u, w, normal) of a leg in the mechanism frame: they depend on its type, turn and frame directions only, not
+    on the design, so they are computed once per leg (the NSGA-II loop packs every design). Read-only arrays."""
+    vec = dict(frame)
+    if code == _k.R_PA:
+        u = _unit(_turn(phi, vec["arm_zero"]))
+        w = _unit(_turn(phi, vec["arm_positive"]))
+        normal = np.cross(u, w)
+    else:
+        u = _unit(_turn(phi, vec["rail"]))
+        w = np.zeros(3)
+        radial = _turn(phi, (1.0, 0.0, 0.0))
+        normal = np.cross(u, radial)
+        if np.linalg.norm(normal) < 1e-9:  # a radial rail: the leg's plane is vertical
+            normal = np.cross(u, (0.0, 0.0, 1.0))
+        normal = _unit(normal)
+    for a in (u, w, normal):
+        a.flags.writeable = False
+    return u, w, normal
 
 
 def _unit(v) -> np.ndarray:
