@@ -135,3 +135,27 @@ def test_an_evaluation_block_is_refused_on_a_motion_that_does_not_read_it():
                                      "levels": 2}]}
     with pytest.raises(ConfigError, match=r"^description: evaluation: calibrated plans are read for motion 3T only"):
         parse_description(data)
+
+
+def test_a_description_symmetric_only_at_its_defaults_gets_no_half_box():
+    """The Delta as three single legs, then with a parameter 'offset' (default 0) moving leg 2's base along its arm
+    axis: mirrored at the defaults, not for offset != 0, so no mirror axis is declared (the check shifts every
+    parameter); the built-in Delta is symmetric in y (tests/test_mirror.py checks the fields)."""
+    import yaml
+
+    from scalesynth.mechanisms.describe import from_description
+
+    assert get("delta").mirror_axes(get("delta").resolve_options({})) == (1,)
+    data = yaml.safe_load((BUILTIN_DIR / "delta.yaml").read_text())
+    data["name"] = "offset-delta"
+    data["parameters"]["offset"] = {"default": 0.0, "doc": "leg 2's base shift along its arm axis",
+                                    "positive": False}
+    (arm,) = data["legs"]
+    single = {k: v for k, v in arm.items() if k != "pattern"}
+    data["legs"] = [{**single, "name": f"arm{i + 1}", "angle_deg": 120.0 * i} for i in range(3)]
+    mech = from_description(parse_description(data))
+    assert mech.mirror_axes(mech.resolve_options({})) == (1,)  # three single legs at 0, 120, 240 deg: symmetric
+    data["legs"][1]["base"] = ["base_radius", "offset", 0]
+    data["name"] = "offset-delta-2"
+    mech = from_description(parse_description(data))
+    assert mech.mirror_axes(mech.resolve_options({})) == ()

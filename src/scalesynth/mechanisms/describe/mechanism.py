@@ -192,13 +192,15 @@ class DescribedMechanism(Mechanism):
         arm/rail directions are its own reflected (the plane normal of the cone check up to sign: the kernel reads
         only |f . axis|). The kernel's fields (reach, LCI, sigma_min, sigma_max) depend on nothing else, and a
         reflection keeps singular values, so each such plane is a symmetry of every field. Checked on the packed
-        legs of the default design and of two designs with every parameter scaled apart (a description
-        symmetric only at its defaults is not declared). 3T only."""
+        legs of the default design and of two designs with every parameter scaled and shifted apart (a
+        description symmetric only at its defaults, e.g. through an offset whose default is 0, is not declared).
+        3T only."""
         if self.motion != "3T":
             return ()
         base = self.resolve_design({})
-        designs = [base] + [{n: v * (1.0 + 0.07 * (k + 1) * (1 + i % 3)) for i, (n, v) in enumerate(base.items())}
-                            for k in range(2)]
+        scale = max([abs(v) for v in base.values()] + [1e-3])
+        designs = [base] + [{n: v * (1.0 + 0.07 * (k + 1) * (1 + i % 3)) + 0.013 * scale * (k + 1) * (1 + i % 5)
+                             for i, (n, v) in enumerate(base.items())} for k in range(2)]
         try:
             packed = [self.pack(self.resolve_design(d), options) for d in designs]
         except InvalidParameter:  # a scaled design the legs reject: declare nothing
