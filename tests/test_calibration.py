@@ -120,14 +120,30 @@ def test_described_mechanism_is_calibrated_automatically_and_seed_mechanisms_kee
     assert calibration.has_plan(get("rps-upu")) and calibration.has_plan(get("2pauu-ppap"))
 
 
+def _ladder_delta():
+    """The built-in Delta's description without its evaluation block (its calibrated plan): the tolerance form then
+    climbs the per-design ladder, as for any description without one."""
+    import yaml
+
+    from scalesynth.mechanisms.describe import BUILTIN_DIR, from_description, parse_description
+
+    data = yaml.safe_load((BUILTIN_DIR / "delta.yaml").read_text())
+    assert data.pop("evaluation")
+    data["name"] = "delta-ladder"
+    mech = from_description(parse_description(data))
+    assert mech.calibrated_plans == () and not calibration.has_plan(mech)
+    return mech
+
+
 def test_calibrated_delta_meets_the_configs_tolerance_against_a_finer_uniform_grid():
-    """configs/delta.yaml states volume within 1 % and GCI within 0.002. The reference: the uniform N = 96 grid (field
+    """The Delta without its calibrated plan (the ladder). configs/delta.yaml states volume within 1 % and GCI within
+    0.002. The reference: the uniform N = 96 grid (field
     kernel at 884 736 cell centres, no column intervals, no refinement), itself within 0.1 % and 2e-4 of N = 192 on
     such designs (benchmarks/results/described.json), and at least 3x finer across than the coarse columns of the
     rung each design is accepted at (checked). Every design must be within the tolerance of it, and report finite
     error estimates within the tolerance (the rung was accepted)."""
     cfg = load_config(ROOT / "configs" / "delta.yaml")
-    mech, options, region = cfg.mech, cfg.resolved_options(), cfg.grid.region
+    mech, options, region = _ladder_delta(), cfg.resolved_options(), cfg.grid.region
     tol = config_tolerance(cfg)
     assert tol == Tolerance(0.01, 0.002)
     designs = _designs(cfg, 3, seed=5)
@@ -144,9 +160,11 @@ def test_calibrated_delta_meets_the_configs_tolerance_against_a_finer_uniform_gr
     assert np.all(got["error_volume"] <= tol.volume) and np.all(got["error_gci"] <= tol.gci)
 
 
-def test_a_designs_calibrated_result_does_not_depend_on_its_population():
+@pytest.mark.parametrize("ladder", [True, False], ids=["ladder", "description's plan"])
+def test_a_designs_calibrated_result_does_not_depend_on_its_population(ladder):
     cfg = load_config(ROOT / "configs" / "delta.yaml")
-    mech, options, region, tol = cfg.mech, cfg.resolved_options(), cfg.grid.region, config_tolerance(cfg)
+    mech = _ladder_delta() if ladder else cfg.mech
+    options, region, tol = cfg.resolved_options(), cfg.grid.region, config_tolerance(cfg)
     designs = _designs(cfg, 3, seed=6)
     together = evaluate_population(mech, designs, options, region=region, tolerance=tol)
     for i, d in enumerate(designs):

@@ -39,6 +39,10 @@ SYMMETRIC = [
     ("planar-fivebar", {"mode": "-+", "forearm": "parallelogram"}, (0,)),
     ("planar-fivebar", {"alpha1_limits": [-4 * np.pi / 9, 7 * np.pi / 36],
                         "alpha2_limits": [29 * np.pi / 36, 13 * np.pi / 9]}, (0,)),
+    # described: legs at 0, 120, 240 deg map onto themselves in y = 0 (describe/symmetry.py), not in x = 0
+    ("delta", {}, (1,)),
+    ("delta", {"theta_limits": [-0.6, 1.6], "cone_limit": 1.5}, (1,)),
+    ("linear-delta", {}, (1,)),
 ]
 
 # (mechanism, options, axis): one condition broken, so the axis is not declared and the fields are not symmetric
@@ -165,7 +169,7 @@ def test_half_box_on_the_column_axis_equals_the_full_box():
 
 
 @pytest.mark.parametrize(("name", "axis"), [("rps-upu-tool", 1), ("ups-sspr", 1), ("planar-fivebar", 0),
-                                           ("rps-upu", 2)])
+                                           ("rps-upu", 2), ("delta", 1)])
 def test_half_box_on_a_cross_axis_equals_the_full_box(name, axis):
     """A mirror plane on a cross axis (kernels.adaptive's ``mirror``; the kernel's own tests check it against the
     NumPy twin): the mechanism's own plan on random designs, the half box (half the columns on that axis) against

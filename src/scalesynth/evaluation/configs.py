@@ -9,7 +9,7 @@ import numpy as np
 
 from scalesynth.evaluation.adaptive import column_axis, mirror_halves
 from scalesynth.evaluation.grid import design_boxes
-from scalesynth.evaluation.plans import Tolerance, adaptive_plan, uniform_resolution
+from scalesynth.evaluation.plans import Tolerance, adaptive_plan, calibrated_plan, uniform_resolution
 from scalesynth.evaluation.report import WorkspaceReport, evaluate, evaluate_population
 
 
@@ -20,12 +20,17 @@ def evaluator_description(cfg) -> str:
     if tol is None:
         return f"uniform grid, {cfg.grid.resolution} cells per axis"
     mech, options = cfg.mech, cfg.resolved_options()
-    n = uniform_resolution(mech, tol)
+    calibrated = calibrated_plan(mech, tol)
+    n = None if calibrated is not None else uniform_resolution(mech, tol)
     how = f"calibrated uniform grid, {n} cells per axis" if n is not None else "adaptive evaluator"
+    if calibrated is not None:
+        how += (f" with the description's plan calibrated at volume {calibrated.tolerance.volume:g}, GCI "
+                f"{calibrated.tolerance.gci:g}")
     if n is None:
         # what the config's own design runs: the half box of a mirror symmetry, closed-form column intervals
         lo, hi = design_boxes(mech, [cfg.resolved_design()], options, cfg.grid.region)
-        halves = mirror_halves(mech, options, lo, hi, adaptive_plan(mech, options), column_axis(mech, options))
+        plan = calibrated.plan if calibrated is not None else adaptive_plan(mech, options)
+        halves = mirror_halves(mech, options, lo, hi, plan, column_axis(mech, options))
         extras = ([f"half box of the mirror symmetry in {' and '.join(mech.task_axes[a] for a in halves)}"]
                   if halves else []) + (["column intervals"] if mech.interval_kernel_for(options) is not None else [])
         if extras:

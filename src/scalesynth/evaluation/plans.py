@@ -80,6 +80,24 @@ class UniformPlan:
         return min(ok) if ok else None
 
 
+@dataclass(frozen=True)
+class CalibratedPlan:
+    """An adaptive-evaluator plan calibrated for a tolerance (a description's ``evaluation`` block): run at
+    ``tolerance`` itself it met that tolerance against 3x finer uniform grids on random designs."""
+
+    tolerance: Tolerance
+    plan: ColumnPlan
+
+
+def calibrated_plan(mech: Mechanism, tolerance: Tolerance) -> CalibratedPlan | None:
+    """The mechanism's calibrated plan (``Mechanism.calibrated_plans``) for ``tolerance``: of those calibrated at a
+    tolerance at least as tight on both counts, the one calibrated at the loosest (volume, then GCI); None when none
+    is (the per-design ladder of scalesynth.calibration then meets it)."""
+    ok = [c for c in mech.calibrated_plans
+          if c.tolerance.volume <= tolerance.volume and c.tolerance.gci <= tolerance.gci]
+    return max(ok, key=lambda c: (c.tolerance.volume, c.tolerance.gci)) if ok else None
+
+
 def uniform_resolution(mech: Mechanism, tolerance: Tolerance) -> int | None:
     """The uniform grid the tolerance form uses for ``mech`` (``Mechanism.uniform_plan``), or None: the adaptive
     evaluator."""

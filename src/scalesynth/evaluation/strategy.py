@@ -11,7 +11,7 @@ import numpy as np
 from scalesynth.evaluation.adaptive import AdaptiveResult, adaptive_population_stats
 from scalesynth.evaluation.assembly import field_mean
 from scalesynth.evaluation.grid import make_grid
-from scalesynth.evaluation.plans import Tolerance, uniform_resolution
+from scalesynth.evaluation.plans import Tolerance, calibrated_plan, uniform_resolution
 from scalesynth.kernels import grid as _grid
 
 if TYPE_CHECKING:  # annotations only: nothing here imports the mechanisms
@@ -29,10 +29,18 @@ def tolerance_population_stats(
     lci_only: bool = False,
     estimates: bool = True,
 ) -> AdaptiveResult:
-    """Statistics of every design under the tolerance form: the adaptive evaluator, or, for a mechanism with a
-    calibrated uniform plan (``Mechanism.uniform_plan``), its uniform grid for ``tolerance``. There the error
+    """Statistics of every design under the tolerance form: an adaptive-evaluator plan calibrated for it
+    (``Mechanism.calibrated_plans``, run at its calibration tolerance), the adaptive evaluator, or, for a mechanism
+    with a calibrated uniform plan (``Mechanism.uniform_plan``), its uniform grid for ``tolerance``. There the error
     estimates are the change to the grid twice as fine (relative for the measure, absolute for the GCI), computed
-    only with ``estimates`` (NaN without); the adaptive evaluator's come with its statistics."""
+    only with ``estimates`` (NaN without); the adaptive evaluator's come with its statistics. A mechanism with
+    none of these climbs the per-design ladder (scalesynth.calibration)."""
+    calibrated = calibrated_plan(mech, tolerance)
+    if calibrated is not None:
+        # a plan calibrated at a tolerance at least as tight (a description's evaluation block), run at that
+        # tolerance: what was measured against the finer grids is what runs
+        return adaptive_population_stats(mech, designs, options, packed, calibrated.tolerance, edges, region,
+                                         plan=calibrated.plan, lci_only=lci_only)
     n_uniform = uniform_resolution(mech, tolerance)
     from scalesynth import calibration  # no hand-calibrated plan: the per-design ladder (calibration.py)
 

@@ -124,6 +124,9 @@ class Mechanism(ABC):
     node_plan: ClassVar[ColumnPlan | None] = None  # the adaptive evaluator with nodes and bisections
     interval_plan: ClassVar[ColumnPlan | None] = None  # with its closed-form column intervals (interval_kernel_for)
     uniform_plan: ClassVar[UniformPlan | None] = None  # the tolerance form on a calibrated uniform grid
+    # adaptive-evaluator plans calibrated per tolerance (evaluation.plans.CalibratedPlan; a description's evaluation
+    # block): ahead of the per-design calibration ladder
+    calibrated_plans: ClassVar[tuple] = ()
 
     @property
     def n_fields(self) -> int:

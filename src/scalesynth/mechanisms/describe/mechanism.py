@@ -8,6 +8,7 @@ of radius l_i about each actuated point minus the platform offset, so FK interse
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Mapping
@@ -30,7 +31,7 @@ from scalesynth.mechanisms.base import (
     singularity_label,
     svd_lci,
 )
-from scalesynth.mechanisms.describe import bodies, expressions, frame
+from scalesynth.mechanisms.describe import bodies, expressions, frame, symmetry
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
@@ -67,10 +68,13 @@ def _plans(desc: Description) -> tuple[_LegPlan, ...]:
     for index, leg in enumerate(desc.legs):
         lt = LEG_TYPES[leg.type]
         if leg.pattern:
-            phis = [math.radians(leg.pattern.start_deg + 360.0 * k / leg.pattern.count)
-                    for k in range(leg.pattern.count)]
+            degrees = [leg.pattern.start_deg + 360.0 * k / leg.pattern.count for k in range(leg.pattern.count)]
         else:
-            phis = [math.radians(leg.angle_deg)]
+            degrees = [leg.angle_deg]
+        # in [-180, 180] (math.remainder is exact): legs at +-a then turn by exactly mirrored cos and sin (sin is
+        # odd, cos even), so a mirror-symmetric pattern packs exactly symmetric and its box is symmetric about 0
+        # to the bit (the adaptive evaluator's half box, mirror_axes)
+        phis = [math.radians(math.remainder(d, 360.0)) for d in degrees]
         for phi in phis:
             out.append(_LegPlan(
                 leg.type, leg.joint or lt.joint, phi,
@@ -122,18 +126,7 @@ class DescribedMechanism(Mechanism):
                 if not v > 0.0:
                     raise InvalidParameter(f"design: leg {i + 1} {k} = {v:g}, must be > 0")
                 check_magnitude(f"design: leg {i + 1} {k}", v)
-            if lt.code == _k.R_PA:
-                u = _unit(_turn(plan.phi, plan.frame["arm_zero"]))
-                w = _unit(_turn(plan.phi, plan.frame["arm_positive"]))
-                normal = np.cross(u, w)
-            else:
-                u = _unit(_turn(plan.phi, plan.frame["rail"]))
-                w = np.zeros(3)
-                radial = _turn(plan.phi, (1.0, 0.0, 0.0))
-                normal = np.cross(u, radial)
-                if np.linalg.norm(normal) < 1e-9:  # a radial rail: the leg's plane is vertical
-                    normal = np.cross(u, (0.0, 0.0, 1.0))
-                normal = _unit(normal)
+            u, w, normal = _leg_directions(lt.code, plan.phi, tuple(sorted(plan.frame.items())))
             cone = options[plan.cone] if plan.cone else None
             out.append(Leg(lt, base, platform, u, w, normal, links.get("upper_arm", 0.0), links["forearm"],
                            lt.branches[plan.branch], options[plan.limits] if plan.limits else None,
@@ -164,6 +157,19 @@ class DescribedMechanism(Mechanism):
         return p
 
     @property
+    def calibrated_plans(self) -> tuple:
+        """The description's evaluation block as evaluation.plans.CalibratedPlan entries (none without one)."""
+        from scalesynth.evaluation.plans import CalibratedPlan, ColumnPlan, Tolerance
+
+        spec = self.description.evaluation if self.description is not None else None
+        if spec is None:
+            return ()
+        return tuple(CalibratedPlan(Tolerance(p.tolerance["volume"], p.tolerance["gci"]),
+                                    ColumnPlan(p.columns, p.cells, p.bisections, p.levels, p.beta, p.zlevels,
+                                               p.zconfirm, p.faces, p.field_levels, p.gauss_points))
+                     for p in spec.plans)
+
+    @property
     def field_kernel(self):
         return _k.point_fields
 
@@ -179,6 +185,27 @@ class DescribedMechanism(Mechanism):
 
     def kernel_branch(self, options) -> str:
         return "/".join(plan.branch for plan in self.plans)
+
+    def mirror_axes(self, options) -> tuple[int, ...]:
+        """x (0) and/or y (1) where the packed legs are a mirror image of themselves in that plane: every leg has a
+        partner (itself, on the plane) of the same type, lengths, branch, limits and cone whose base, platform and
+        arm/rail directions are its own reflected (the plane normal of the cone check up to sign: the kernel reads
+        only |f . axis|). The kernel's fields (reach, LCI, sigma_min, sigma_max) depend on nothing else, and a
+        reflection keeps singular values, so each such plane is a symmetry of every field. Checked on the packed
+        legs of the default design and of two designs with every parameter scaled and shifted apart (a
+        description symmetric only at its defaults, e.g. through an offset whose default is 0, is not declared).
+        3T only."""
+        if self.motion != "3T":
+            return ()
+        base = self.resolve_design({})
+        scale = max([abs(v) for v in base.values()] + [1e-3])
+        designs = [base] + [{n: v * (1.0 + 0.07 * (k + 1) * (1 + i % 3)) + 0.013 * scale * (k + 1) * (1 + i % 5)
+                             for i, (n, v) in enumerate(base.items())} for k in range(2)]
+        try:
+            packed = [self.pack(self.resolve_design(d), options) for d in designs]
+        except InvalidParameter:  # a scaled design the legs reject: declare nothing
+            return ()
+        return tuple(a for a in (0, 1) if all(symmetry.mirrored_legs(p, a) for p in packed))
 
     def bounding_box(self, design, options):
         """Intersection over the legs of the box of the set each leg can reach: R-Pa, a ball of radius L + l about
@@ -301,6 +328,28 @@ class DescribedMechanism(Mechanism):
         jac = self.jacobians(design, options, pose, q)
         with np.errstate(divide="ignore", invalid="ignore"):
             return jac["Jx"] / np.diag(jac["Jq"])[:, None]
+
+
+@functools.lru_cache(maxsize=256)
+def _leg_directions(code: float, phi: float, frame: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(u, w, normal) of a leg in the mechanism frame: they depend on its type, turn and frame directions only, not
+    on the design, so they are computed once per leg (the NSGA-II loop packs every design). Read-only arrays."""
+    vec = dict(frame)
+    if code == _k.R_PA:
+        u = _unit(_turn(phi, vec["arm_zero"]))
+        w = _unit(_turn(phi, vec["arm_positive"]))
+        normal = np.cross(u, w)
+    else:
+        u = _unit(_turn(phi, vec["rail"]))
+        w = np.zeros(3)
+        radial = _turn(phi, (1.0, 0.0, 0.0))
+        normal = np.cross(u, radial)
+        if np.linalg.norm(normal) < 1e-9:  # a radial rail: the leg's plane is vertical
+            normal = np.cross(u, (0.0, 0.0, 1.0))
+        normal = _unit(normal)
+    for a in (u, w, normal):
+        a.flags.writeable = False
+    return u, w, normal
 
 
 def _unit(v) -> np.ndarray:

@@ -82,6 +82,30 @@ class LegSpec(_Strict):
     cone_axis: tuple[float, float, float] | None = None  # UPS: the joints' cone axis (base frame; platform frame)
 
 
+class PlanSpec(_Strict):
+    """One calibrated plan of the adaptive column evaluator (evaluation.plans.ColumnPlan): the tolerance it was
+    calibrated at (volume relative, GCI absolute) and its resolution; the fields mean what ColumnPlan's do."""
+
+    tolerance: dict[Literal["volume", "gci"], float]
+    columns: int = Field(ge=2, le=256)
+    cells: int = Field(ge=1, le=256)
+    bisections: int = Field(default=5, ge=1, le=30)
+    levels: int = Field(ge=0, le=6)
+    beta: float = Field(default=1.0, gt=0.0, le=100.0)
+    zlevels: int = Field(default=0, ge=0, le=8)
+    zconfirm: int = Field(default=1, ge=1, le=8)
+    faces: bool = False
+    field_levels: int = Field(default=-1, ge=-1, le=6)
+    gauss_points: Literal[1, 2] = 2
+
+
+class EvaluationSpec(_Strict):
+    """How the tolerance form evaluates this mechanism: plans calibrated against finer uniform grids (docs/
+    describing.md). A config tolerance no plan was calibrated for runs the per-design calibration ladder."""
+
+    plans: list[PlanSpec] = Field(min_length=1, max_length=8)
+
+
 class Description(_Strict):
     """A whole mechanism."""
 
@@ -96,6 +120,7 @@ class Description(_Strict):
     # the registered mechanism this description reproduces (a twin for tests; `design` runs only the original
     # unless the spec names the twin)
     reproduces: str | None = None
+    evaluation: EvaluationSpec | None = None  # calibrated evaluation plans (the tolerance form); None: the ladder
 
 
 def _one_line(text: str, limit: int = 200) -> str:
@@ -228,8 +253,35 @@ def _check(desc: Description) -> None:
     if len(kinds) > 1:
         raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
                           "yet): use legs of one actuation kind")
+    _check_evaluation(desc)
     if MOBILITY_CHECK is not None:
         MOBILITY_CHECK(desc)  # the legs make the motion type (a platform that cannot turn, held by its actuators)
+
+
+def _check_evaluation(desc: Description) -> None:
+    """Each calibrated plan names both tolerances, finite and in (0, 1), at most once each pair; 3T only (the
+    column evaluator of a 3-D task with closed-form column intervals; other motions run the ladder)."""
+    if desc.evaluation is None:
+        return
+    if desc.motion != "3T":
+        raise ConfigError(f"evaluation: calibrated plans are read for motion 3T only, not {desc.motion} (leave the "
+                          "block out)")
+    seen = set()
+    for i, plan in enumerate(desc.evaluation.plans):
+        where = f"evaluation.plans[{i}].tolerance"
+        for key in ("volume", "gci"):
+            if key not in plan.tolerance:
+                raise ConfigError(f"{where}: needs volume and gci (missing {key})")
+            value = plan.tolerance[key]
+            if not (math.isfinite(value) and 0.0 < value < 1.0):
+                raise ConfigError(f"{where}.{key}: expected a number in (0, 1), got {value!r}")
+        pair = (plan.tolerance["volume"], plan.tolerance["gci"])
+        if pair in seen:
+            raise ConfigError(f"{where}: a second plan for volume {pair[0]:g}, GCI {pair[1]:g}")
+        seen.add(pair)
+        if plan.field_levels > plan.levels:
+            raise ConfigError(f"evaluation.plans[{i}].field_levels: {plan.field_levels} is deeper than levels "
+                              f"{plan.levels}")
 
 
 def _expression(where: str, value: Any, names: list[str]) -> expressions.Expression:
