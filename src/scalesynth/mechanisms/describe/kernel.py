@@ -34,6 +34,7 @@ from numba import njit
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import SIGMA_CAP, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.stiffness import legs as _sl
 
 # leg type codes (legs.LEG_TYPES' ``code``)
 R_PA = 1.0
@@ -56,7 +57,27 @@ HI = 21
 HAS_CONE = 22
 SIN_CONE = 23  # sin of the cone half-angle: |f . axis| <= l sin(cone)
 STRIDE = 24
-N_PACKED = HEAD + N_LEGS * STRIDE
+N_KINEMATIC = HEAD + N_LEGS * STRIDE  # the slots above; the stiffness block (per-voxel stiffness fields) follows
+# stiffness block, from N_KINEMATIC: a flag (1: options.stiffness_metrics, the fields are computed), the load
+# (N), the characteristic length of the singularity test (the longest link, as the reference solver's), then per
+# leg SSTRIDE slots: sections (EA, EI, GJ) of the upper arm (R-Pa) and of each forearm bar, the actuator's spring
+# (N length/rad rotary, N/length linear) and half the parallelogram's width
+STIFF = N_KINEMATIC
+LOAD = N_KINEMATIC + 1
+CHAR_LEN = N_KINEMATIC + 4
+SLEGS = N_KINEMATIC + 5
+EA_ARM = 0
+EI_ARM = 1
+GJ_ARM = 2
+EA_BAR = 3
+EI_BAR = 4
+GJ_BAR = 5
+K_ACT = 6
+HALF_WIDTH = 7
+SSTRIDE = 8
+N_PACKED = SLEGS + N_LEGS * SSTRIDE
+F_STIFFNESS_MIN = 3  # field slots of the stiffness fields
+F_DEFLECTION = 4
 TWO_PI = 2.0 * math.pi
 
 
@@ -130,9 +151,10 @@ def _leg(p, k, x, y, z):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _fields(p, x, y, z, out, conditioning):
+def _fields(p, x, y, z, out, conditioning, stiffness=False):
     """Slots 0-2 (LCI, sigma_min, sigma_max of dx/dq) at P, or write_unreachable; ``conditioning`` (a constant)
-    False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel)."""
+    False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel); ``stiffness`` (a
+    constant) True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set)."""
     k1 = HEAD
     k2 = HEAD + STRIDE
     k3 = HEAD + 2 * STRIDE
@@ -172,13 +194,194 @@ def _fields(p, x, y, z, out, conditioning):
     else:
         out[1] = smin / ad
         out[2] = smax / ad
+    if stiffness:
+        if p[STIFF] > 0.0:
+            out[F_STIFFNESS_MIN], out[F_DEFLECTION] = _stiffness(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz)
+        else:
+            out[F_STIFFNESS_MIN] = 0.0
+            out[F_DEFLECTION] = 0.0
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
-    """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of dx/dq at P = (x, y, z), -1 and zeros
-    where a leg does not reach P in its branch or a limit excludes it."""
-    _fields(p, x, y, z, out, True)
+    """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of dx/dq at P = (x, y, z), and
+    stiffness_min (N/length) and deflection (length unit) of the platform under the packed load where the packed
+    flag asks for them (else 0; _stiffness); -1 and zeros where a leg does not reach P in its branch or a limit
+    excludes it."""
+    _fields(p, x, y, z, out, True, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z, out):
+    """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel: a search whose
+    workspace metrics are the LCI's alone); slots 3-4 not written."""
+    _fields(p, x, y, z, out, True, False)
+
+
+# ----- per-voxel stiffness (docs/describing.md): the idealisation of frame.py, condensed per leg ------------------
+# Leg i: the platform joint Q = P + r_p, the elbow or carriage E = Q - l f (f the unit forearm), n the leg's normal
+# (R-Pa: the actuated axis), h half the parallelogram's width, t = unit(n x f).
+# * base to E: R-Pa, the upper arm B -> E (a cantilever clamped on the actuator) plus the actuator's torsional
+#   spring about n through B; P-Pa, the carriage's linear spring along the rail (the carriage rigid). Compliance
+#   C_e (6x6 at P; rank 1 for P-Pa).
+# * E to platform: two bars E +- h n -> Q +- h n, each on universal joints (t, n) at both ends: each passes the
+#   wrenches reciprocal to its four joint twists (its axial force and a couple normal to t and n), condensed with
+#   stiffness.legs (add_leg_stiffness): K_pa, rank 3 (the leg leaves the platform's turn about n free).
+# * in series: the wrench w through the leg moves E by C_e w and the platform relative to E by t_rel with
+#   w = K_pa t_rel, so K_leg = (I + K_pa C_e)^-1 K_pa: no inverse of a singular C_e or K_pa, no subtraction.
+# The platform K = sum of the legs' K_leg (6x6 at P) -> stiffness.legs.platform_response under the packed load.
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _solve6(a, b):
+    """b <- a^-1 b for 6x6 a (overwritten) and b, Gaussian elimination with partial pivoting; False if a pivot is
+    not a finite number > 0 in magnitude (b then unspecified)."""
+    for c in range(6):
+        piv = c
+        big = abs(a[c, c])
+        for r in range(c + 1, 6):
+            if abs(a[r, c]) > big:
+                big = abs(a[r, c])
+                piv = r
+        if not (big > 0.0 and math.isfinite(big)):
+            return False
+        if piv != c:
+            for j in range(6):
+                t = a[c, j]
+                a[c, j] = a[piv, j]
+                a[piv, j] = t
+                t = b[c, j]
+                b[c, j] = b[piv, j]
+                b[piv, j] = t
+        inv = 1.0 / a[c, c]
+        for r in range(c + 1, 6):
+            m = a[r, c] * inv
+            if m != 0.0:
+                for j in range(c, 6):
+                    a[r, j] -= m * a[c, j]
+                for j in range(6):
+                    b[r, j] -= m * b[c, j]
+    for c in range(5, -1, -1):
+        inv = 1.0 / a[c, c]
+        for j in range(6):
+            t = b[c, j]
+            for k in range(c + 1, 6):
+                t -= a[c, k] * b[k, j]
+            b[c, j] = t * inv
+    return True
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _beam_up(ax, ay, az, bx, by, bz):
+    """The section's reference axis of beam a -> b as the frame's FrameBuilder.link chooses it: z, or x for a beam
+    within ~25 deg of vertical (round tubes: it only fixes the local frame)."""
+    dx = bx - ax
+    dy = by - ay
+    dz = bz - az
+    if abs(dz) < 0.9 * math.sqrt(dx * dx + dy * dy + dz * dz):
+        return 0.0, 0.0, 1.0
+    return 1.0, 0.0, 0.0
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _add_leg(p, k, s, x, y, z, fx, fy, fz, K, ce, cb, kpa, jt, nw, work):
+    """K += K_leg (6x6 at P) of leg block k (stiffness slots from s), unit forearm (fx, fy, fz) at P = (x, y, z);
+    the rest are 6x6 scratch arrays. False when a step is singular (nothing added)."""
+    lf = p[k + FOREARM]
+    qx = x + p[k + PLAT]
+    qy = y + p[k + PLAT + 1]
+    qz = z + p[k + PLAT + 2]
+    ex = qx - lf * fx
+    ey = qy - lf * fy
+    ez = qz - lf * fz
+    nx = p[k + AXIS]
+    ny = p[k + AXIS + 1]
+    nz = p[k + AXIS + 2]
+    length = p[CHAR_LEN]
+    for i in range(6):
+        for j in range(6):
+            ce[i, j] = 0.0
+            kpa[i, j] = 0.0
+    if p[k + TYPE] == R_PA:
+        bx0 = p[k + BASE]
+        by0 = p[k + BASE + 1]
+        bz0 = p[k + BASE + 2]
+        upx, upy, upz = _beam_up(bx0, by0, bz0, ex, ey, ez)
+        if not _sl.add_beam_compliance(ce, bx0, by0, bz0, ex, ey, ez, upx, upy, upz, p[s + EA_ARM], p[s + EI_ARM],
+                                       p[s + EI_ARM], p[s + GJ_ARM], x, y, z):
+            return False
+        _sl.add_revolute_spring(ce, bx0, by0, bz0, nx, ny, nz, p[s + K_ACT], x, y, z)
+    else:
+        _sl.add_prismatic_spring(ce, p[k + U], p[k + U + 1], p[k + U + 2], p[s + K_ACT])
+    # t = unit(n x f)
+    tx = ny * fz - nz * fy
+    ty = nz * fx - nx * fz
+    tz = nx * fy - ny * fx
+    tn = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if not tn > 0.0:
+        return False  # a forearm along the leg's normal: the universal joints' axes coincide
+    tx /= tn
+    ty /= tn
+    tz /= tn
+    h = p[s + HALF_WIDTH]
+    for side in (1.0, -1.0):
+        ax = ex + side * h * nx
+        ay = ey + side * h * ny
+        az = ez + side * h * nz
+        bx = qx + side * h * nx
+        by = qy + side * h * ny
+        bz = qz + side * h * nz
+        for i in range(6):
+            for j in range(6):
+                cb[i, j] = 0.0
+        upx, upy, upz = _beam_up(ax, ay, az, bx, by, bz)
+        if not _sl.add_beam_compliance(cb, ax, ay, az, bx, by, bz, upx, upy, upz, p[s + EA_BAR], p[s + EI_BAR],
+                                       p[s + EI_BAR], p[s + GJ_BAR], x, y, z):
+            return False
+        _sl.set_rotation_twist(jt, 0, ax, ay, az, tx, ty, tz, x, y, z)
+        _sl.set_rotation_twist(jt, 1, ax, ay, az, nx, ny, nz, x, y, z)
+        _sl.set_rotation_twist(jt, 2, bx, by, bz, tx, ty, tz, x, y, z)
+        _sl.set_rotation_twist(jt, 3, bx, by, bz, nx, ny, nz, x, y, z)
+        m = _sl.constraint_wrenches(jt, 4, length, nw)
+        if not _sl.add_leg_stiffness(cb, nw, m, kpa, work):
+            return False
+    # K_leg = (I + K_pa C_e)^-1 K_pa
+    for i in range(6):
+        for j in range(6):
+            acc = 1.0 if i == j else 0.0
+            for q in range(6):
+                acc += kpa[i, q] * ce[q, j]
+            work[i, j] = acc
+    if not _solve6(work, kpa):
+        return False
+    for i in range(6):
+        for j in range(6):
+            K[i, j] += 0.5 * (kpa[i, j] + kpa[j, i])
+    return True
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """(stiffness_min N/length, deflection length) of the platform at P = (x, y, z) whose legs reach it with unit
+    forearms a, b, c (the comment above; ideal joints). A singular step or platform: (0, DEFLECTION_CAP), or 0
+    deflection under no load (stiffness.legs' caps); never NaN."""
+    fx = p[LOAD]
+    fy = p[LOAD + 1]
+    fz = p[LOAD + 2]
+    K = np.zeros((6, 6))
+    ce = np.empty((6, 6))
+    cb = np.empty((6, 6))
+    kpa = np.empty((6, 6))
+    jt = np.empty((6, 6))
+    nw = np.empty((6, 6))
+    work = np.empty((6, 6))
+    ok = _add_leg(p, HEAD, SLEGS, x, y, z, ax, ay, az, K, ce, cb, kpa, jt, nw, work)
+    ok = ok and _add_leg(p, HEAD + STRIDE, SLEGS + SSTRIDE, x, y, z, bx, by, bz, K, ce, cb, kpa, jt, nw, work)
+    ok = ok and _add_leg(p, HEAD + 2 * STRIDE, SLEGS + 2 * SSTRIDE, x, y, z, cx, cy, cz, K, ce, cb, kpa, jt, nw,
+                         work)
+    if not ok:
+        return 0.0, (0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else _sl.DEFLECTION_CAP)
+    return _sl.platform_response(K, fx, fy, fz, p[CHAR_LEN])
 
 
 @njit(cache=True, fastmath=FASTMATH)

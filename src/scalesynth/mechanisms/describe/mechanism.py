@@ -19,6 +19,7 @@ import numpy as np
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -34,6 +35,8 @@ from scalesynth.mechanisms.describe import bodies, expressions, frame
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
+from scalesynth.mechanisms.links import check_flag_option
+from scalesynth.stiffness import legs as _sl
 from scalesynth.stiffness.sections import check_stiffness_options
 
 
@@ -93,6 +96,7 @@ class DescribedMechanism(Mechanism):
     def check_options(self, options: dict[str, Any]) -> None:
         bodies.check_link_radius(options, self._codes())
         check_stiffness_options(options, 3, frame.link_groups(self._codes()[0]))
+        check_flag_option(options, "stiffness_metrics")
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":
@@ -161,11 +165,18 @@ class DescribedMechanism(Mechanism):
             if leg.sin_cone is not None:
                 p[k + _k.HAS_CONE] = 1.0
                 p[k + _k.SIN_CONE] = leg.sin_cone
+        if options.get("stiffness_metrics"):
+            frame.pack_stiffness(self, design, options, p)
         return p
 
     @property
     def field_kernel(self):
         return _k.point_fields
+
+    @property
+    def lci_kernel(self):
+        """point_fields without the stiffness stage (slot 0 bit for bit): a search on the LCI's metrics alone."""
+        return _k.point_lci
 
     @property
     def reach_kernel(self):
@@ -348,6 +359,21 @@ def _footprint(desc_mech_plans, d: Mapping[str, float]) -> float:
     return enclosing_circle_radius(pts)
 
 
+# The per-voxel stiffness fields (kernel._stiffness: frame.py's idealisation condensed per leg). Opt-in, as seed 000's:
+# their stage costs many times the kinematic fields, so a search whose metrics do not read them must not pay it.
+STIFFNESS_METRICS_OPTION = Option(
+    "stiffness_metrics", False, "true: compute the per-voxel fields stiffness_min and deflection (the frame of "
+    "`stiffness`, ideal joints) and enable their metrics; false: they are 0 and their metrics unavailable")
+STIFFNESS_FIELDS = (
+    Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at P felt by "
+          "a pure force (ideal joints, Euler-Bernoulli links, actuator springs; the frame of `stiffness`); 0 at a "
+          "singular pose; its metrics need options.stiffness_metrics", "max", needs_options=("stiffness_metrics",)),
+    Field("deflection", "{length}", "magnitude of the deflection of P under options.load (default 150 N down -z); "
+          f"{_sl.DEFLECTION_CAP:g} at a singular pose; its metrics need options.stiffness_metrics", "min",
+          (0.0, _sl.DEFLECTION_CAP), needs_options=("stiffness_metrics",)),
+)
+
+
 def from_description_3t(desc: Description) -> DescribedMechanism:
     """The registered mechanism of a validated 3T description (build.from_description dispatches by motion)."""
     plans = _plans(desc)
@@ -356,7 +382,7 @@ def from_description_3t(desc: Description) -> DescribedMechanism:
     joints = tuple(f"{plan.joint}{i + 1}" for i, plan in enumerate(plans))
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items())
     options += (Option("link_radius", None, bodies.LINK_RADIUS_DOC),
-                *frame.options(desc.stiffness, desc.length_unit, rotary))
+                *frame.options(desc.stiffness, desc.length_unit, rotary), STIFFNESS_METRICS_OPTION)
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = "J = dx/dq (platform motion per rad of arm rotation)" if rotary else \
         "J = dx/dq (platform motion per unit carriage motion)"
@@ -373,7 +399,7 @@ def from_description_3t(desc: Description) -> DescribedMechanism:
                          for name, spec in desc.parameters.items()),
         options=options,
         default_length_unit=desc.length_unit,
-        fields=base_fields(sigma_unit, jac),
+        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS),
         design_metrics=(
             DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (a parallelogram "
                          "counted once)", lambda d, o, _p=plans: _link_length_sum(_p, d)),
