@@ -175,8 +175,9 @@ class DescribedMechanism(Mechanism):
 
     @property
     def lci_kernel(self):
-        """point_fields without the stiffness stage (slot 0 bit for bit): a search on the LCI's metrics alone."""
-        return _k.point_lci
+        """point_fields without the stiffness stage (slot 0 bit for bit): a search on the LCI's metrics alone (a
+        subclass with a kernel of its own, e.g. the planar one, keeps the default: its field kernel)."""
+        return _k.point_lci if self.field_kernel is _k.point_fields else self.field_kernel
 
     @property
     def reach_kernel(self):
