@@ -24,6 +24,9 @@ takes M's singular values by one-sided (Hestenes) Jacobi, which keeps the small 
 reports those of dx/dq: LCI = s_min(M) / s_max(M), sigma_min = 1 / s_max(M), sigma_max = 1 / s_min(M) (capped).
 Where some |f_i . t_i| <= SQUARE_TOL * a_i (a rod square to its arm: an inverse singularity, M unbounded) the
 pose is written as singular (LCI 0, sigma_min 0, sigma_max the cap).
+
+Stiffness (slots 3-4, only where the packed flag, options.stiffness_metrics, is set; else 0): stiffness_min and
+deflection of frame6.py's idealisation, one bar wrench per leg (the section comment below).
 """
 
 import math
