@@ -221,6 +221,26 @@ def point_lci(p, x, y, z, out):
     _fields(p, x, y, z, out, True, False)
 
 
+@njit(cache=True, fastmath=FASTMATH)
+def point_reach(p, x, y, z, out):
+    """Slot 0 >= 0 exactly where point_fields' is (same legs, branches and limits), -1 elsewhere; no conditioning
+    (the adaptive evaluator's nodes and bisections)."""
+    _fields(p, x, y, z, out, False)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def leg_values(p, x, y, z, out):
+    """Per leg i: out[i] = (ok 1/0, fx, fy, fz, jq, q) as _leg gives them (tests compare them with the NumPy legs)."""
+    for i in range(N_LEGS):
+        ok, fx, fy, fz, jq, q = _leg(p, HEAD + i * STRIDE, x, y, z)
+        out[i, 0] = 1.0 if ok else 0.0
+        out[i, 1] = fx
+        out[i, 2] = fy
+        out[i, 3] = fz
+        out[i, 4] = jq
+        out[i, 5] = q
+
+
 # ----- per-voxel stiffness (docs/describing.md): the idealisation of frame.py, condensed per leg ------------------
 # Leg i: the platform joint Q = P + r (r the packed platform offset), the elbow or carriage E = Q - l f (f the unit
 # forearm), n the leg's normal (R-Pa: the actuated axis), h half the parallelogram's width.
