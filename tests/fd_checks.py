@@ -11,10 +11,11 @@ _STENCILS = {2: (((1, 1.0), (-1, -1.0)), 2.0),  # error O(h^2)
              4: (((-2, 1.0), (-1, -8.0), (1, 8.0), (2, -1.0)), 12.0)}  # error O(h^4)
 
 
-def reachable_points(point_fields, packed, lo, hi, rng, k, min_lci=1e-3, tries=200_000):
+def reachable_points(point_fields, packed, lo, hi, rng, k, min_lci=1e-3, tries=200_000, n_fields=3):
     """k random points of the box [lo, hi] (each drawn as rng.uniform(lo, hi)) where the kernel's
-    point_fields(packed, *p, out) writes an LCI above min_lci into out[0]; list of arrays of lo's shape."""
-    pts, out = [], np.zeros(3)
+    point_fields(packed, *p, out) writes an LCI above min_lci into out[0]; list of arrays of lo's shape.
+    ``n_fields``: the kernel's output size (its mechanism's n_fields: a kernel writes every field, unchecked)."""
+    pts, out = [], np.zeros(n_fields)
     for _ in range(tries):
         p = rng.uniform(lo, hi)
         point_fields(packed, *p, out)

@@ -36,7 +36,7 @@ def _reachable_points(design, options, rng, k):
     """k random platform centres that the kernel finds reachable, below the base."""
     reach = design["upper_arm"] + design["forearm"]
     return reachable_points(kernel.point_fields, DELTA.pack(design, options), [-reach, -reach, -reach],
-                            [reach, reach, -0.05], rng, k)
+                            [reach, reach, -0.05], rng, k, n_fields=DELTA.n_fields)
 
 
 def test_the_delta_follows_the_issue_conventions():
@@ -116,8 +116,8 @@ def test_kernel_fields_equal_the_numpy_twin_on_random_designs_and_points():
         twin = delta_fields(design, options, pts[:, 0], pts[:, 1], pts[:, 2])
         ok = fields[:, 0] >= 0
         assert np.array_equal(ok, twin[:, 0] >= 0) and 40 <= ok.sum() < 400
-        np.testing.assert_allclose(fields[ok], twin[ok], rtol=1e-7, atol=1e-12)
-        assert (fields[~ok] == [-1.0, 0.0, 0.0]).all()
+        np.testing.assert_allclose(fields[ok][:, :3], twin[ok], rtol=1e-7, atol=1e-12)
+        assert (fields[~ok] == [-1.0, 0.0, 0.0, 0.0, 0.0]).all()
 
 
 def _axis_theta(a, L, l, z):
@@ -141,7 +141,7 @@ def test_conditioning_on_the_central_axis_has_its_closed_form():
     options = DELTA.resolve_options({})
     a, L, l = design["base_radius"] - design["platform_radius"], design["upper_arm"], design["forearm"]
     packed = DELTA.pack(design, options)
-    out = np.zeros(3)
+    out = np.zeros(DELTA.n_fields)
     for z in (-0.4, -0.7, -1.0, -1.3, -1.6):
         t = _axis_theta(a, L, l, z)
         rho, h = abs(a + L * math.cos(t)), abs(z + L * math.sin(t))
@@ -150,7 +150,7 @@ def test_conditioning_on_the_central_axis_has_its_closed_form():
         kernel.point_fields(packed, 0.0, 0.0, z, out)
         # rtol 1e-7: two of the singular values are equal here (symmetry), where the kernel's closed-form 3x3
         # singular values (kernels.conditioning.sv_3x3) keep only about half the digits (sqrt(eps) ~ 1.5e-8)
-        np.testing.assert_allclose(out, [sv[0] / sv[1], sv[0], sv[1]], rtol=1e-7)
+        np.testing.assert_allclose(out[:3], [sv[0] / sv[1], sv[0], sv[1]], rtol=1e-7)
     # the isotropic point: h = l / sqrt(3), rho = l sqrt(2/3); elbow out: cos theta = (rho - a) / L, the arm below
     # the base (sin theta > 0), the platform below the elbow
     h, rho = l / math.sqrt(3.0), l * math.sqrt(2.0 / 3.0)
@@ -202,7 +202,7 @@ def test_the_linear_delta_leg_and_its_jacobian():
     # 'far' on a rail pointing up: the platform joint lies below its carriage, from the top of the stroke down to
     # its bottom minus the rod
     assert (lo[2], hi[2]) == pytest.approx((0.0 - 0.5, 1.0))
-    out, vals = np.zeros(3), np.zeros((3, 6))
+    out, vals = np.zeros(DELTA.n_fields), np.zeros((3, 6))
     h = 1e-6
     for p in ([0.0, 0.0, 0.2], [0.05, -0.03, 0.4], [-0.08, 0.02, 0.1]):
         p = np.array(p)
@@ -218,7 +218,7 @@ def test_the_linear_delta_leg_and_its_jacobian():
         np.testing.assert_allclose(jac, fd, rtol=1e-6, atol=1e-7)
         kernel.point_fields(packed, *p, out)
         sv = np.linalg.svd(jac, compute_uv=False)
-        np.testing.assert_allclose(out, [sv[-1] / sv[0], sv[-1], sv[0]], rtol=1e-9)
+        np.testing.assert_allclose(out[:3], [sv[-1] / sv[0], sv[-1], sv[0]], rtol=1e-9)
     with pytest.raises(InvalidParameter, match=r"^options.stroke: a P-Pa leg needs a stroke range"):
         mech.resolve_options({"stroke": None})
 

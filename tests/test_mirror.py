@@ -43,6 +43,7 @@ SYMMETRIC = [
     ("delta", {}, (1,)),
     ("delta", {"theta_limits": [-0.6, 1.6], "cone_limit": 1.5}, (1,)),
     ("linear-delta", {}, (1,)),
+    ("delta", {"stiffness_metrics": True}, (1,)),  # the per-voxel stiffness fields under the default load (-z)
 ]
 
 # (mechanism, options, axis): one condition broken, so the axis is not declared and the fields are not symmetric
@@ -57,6 +58,7 @@ BROKEN = [
     ("planar-fivebar", {"mode": "++"}, 0),
     ("planar-fivebar", {"load": [80.0, -150.0]}, 0),
     ("planar-fivebar", {"alpha1_limits": [-4 * np.pi / 9, 7 * np.pi / 36]}, 0),
+    ("delta", {"stiffness_metrics": True, "load": [0.0, 60.0, -150.0]}, 1),  # the deflection under a load across y = 0
 ]
 
 

@@ -51,7 +51,8 @@ UNITS_PER_M = {"m": 1.0, "dm": 10.0, "cm": 100.0, "mm": 1000.0}
 LINK_RADIUS_DOC = ("capsule radius of every body, or {group or body: radius} (groups upper_arm, forearm, carriage, "
                    "rail, rod, leg, base, platform); null = defaults (docs/describing.md)")
 # options every described mechanism has, whatever its description declares (schema refuses them as names)
-RESERVED_OPTIONS = ("link_radius", "youngs_modulus", "poisson_ratio", "tube", "sections", "actuator_stiffness", "load")
+RESERVED_OPTIONS = ("link_radius", "youngs_modulus", "poisson_ratio", "tube", "sections", "actuator_stiffness", "load",
+                    "stiffness_metrics")
 
 
 def leg_bodies(code: float, i: int) -> tuple[str, ...]:

@@ -133,6 +133,38 @@ def stiffness_model(mech, design: Mapping[str, float], opts: Mapping[str, Any], 
     return fb.model(unit_name, bodies, opts["load"], notes)
 
 
+def pack_stiffness(mech, design: Mapping[str, float], opts: Mapping[str, Any], p: np.ndarray) -> None:
+    """Fill the stiffness block of a packed vector (kernel.py: flag, load, characteristic length, per leg the
+    sections, actuator spring and half width) from the same sections and options as stiffness_model; the legs'
+    kinematic slots are already packed. InvalidParameter for a leg without a parallelogram width (as there)."""
+    from scalesynth.errors import InvalidParameter
+    from scalesynth.mechanisms.describe import kernel as _k
+    from scalesynth.mechanisms.describe.bodies import widths
+    from scalesynth.stiffness.sections import tube_section
+
+    unit_name = mech.default_length_unit
+    groups = {g: tube_section(opts, g, unit_name) for g in link_groups(p[_k.HEAD + _k.TYPE])}
+    bar = groups["forearm"]
+    arm = groups.get("upper_arm", bar)  # P-Pa: no upper arm (slots unused)
+    longest = 0.0
+    for i, (plan, w) in enumerate(zip(mech.plans, widths(mech.plans, design), strict=True)):
+        if not w > 0.0:
+            leg = mech.description.legs[plan.leg_index]
+            raise InvalidParameter(f"legs[{plan.leg_index}] ({leg.name}).width: the stiffness fields need the "
+                                   "parallelogram's width > 0 (one bar would leave the platform free to turn)")
+        k = _k.HEAD + i * _k.STRIDE
+        s = _k.SLEGS + i * _k.SSTRIDE
+        p[s + _k.EA_ARM], p[s + _k.EI_ARM], p[s + _k.GJ_ARM] = arm.EA, arm.EI, arm.GJ
+        p[s + _k.EA_BAR], p[s + _k.EI_BAR], p[s + _k.GJ_BAR] = bar.EA, bar.EI, bar.GJ
+        p[s + _k.K_ACT] = opts["actuator_stiffness"]
+        p[s + _k.HALF_WIDTH] = 0.5 * w
+        rotary = p[k + _k.TYPE] == _k.R_PA
+        longest = max(longest, p[k + _k.FOREARM], p[k + _k.ARM] if rotary else 0.0)
+    p[_k.STIFF] = 1.0
+    p[_k.LOAD : _k.LOAD + 3] = opts["load"]
+    p[_k.CHAR_LEN] = longest  # the reference solver's: its longest link (solve.solve)
+
+
 def check_spec(spec: StiffnessSpec | None, length_unit: str, code: float) -> None:
     """A description's ``stiffness:`` block checked as the options it sets; ConfigError 'stiffness.<field>: ...'."""
     from scalesynth.errors import ConfigError, InvalidParameter

@@ -24,6 +24,9 @@ J_q = diag(f_i . t_i), and dx/dq = J_x^-1 J_q = adj(J_x) J_q / det(J_x). The ker
 adj(J_x) J_q (its columns are (f_j x f_k) (f_i . t_i)) and divides by |det J_x|: finite at both singularities, LCI 0
 where J_x or J_q loses rank. Each f_i is first divided by its length l_i (rows and J_q alike), which leaves J
 unchanged and keeps every product far from overflow.
+
+Stiffness (slots 3-4, only where the packed flag, options.stiffness_metrics, is set; else 0): stiffness_min and
+deflection of frame.py's idealisation, condensed per leg in closed form (the section comment below).
 """
 
 import math
@@ -34,6 +37,7 @@ from numba import njit
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import SIGMA_CAP, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.stiffness import legs as _sl
 
 # leg type codes (legs.LEG_TYPES' ``code``)
 R_PA = 1.0
@@ -56,7 +60,27 @@ HI = 21
 HAS_CONE = 22
 SIN_CONE = 23  # sin of the cone half-angle: |f . axis| <= l sin(cone)
 STRIDE = 24
-N_PACKED = HEAD + N_LEGS * STRIDE
+N_KINEMATIC = HEAD + N_LEGS * STRIDE  # the slots above; the stiffness block (per-voxel stiffness fields) follows
+# stiffness block, from N_KINEMATIC: a flag (1: options.stiffness_metrics, the fields are computed), the load
+# (N), the characteristic length of the singularity test (the longest link, as the reference solver's), then per
+# leg SSTRIDE slots: sections (EA, EI, GJ) of the upper arm (R-Pa) and of each forearm bar, the actuator's spring
+# (N length/rad rotary, N/length linear) and half the parallelogram's width
+STIFF = N_KINEMATIC
+LOAD = N_KINEMATIC + 1
+CHAR_LEN = N_KINEMATIC + 4
+SLEGS = N_KINEMATIC + 5
+EA_ARM = 0
+EI_ARM = 1
+GJ_ARM = 2
+EA_BAR = 3
+EI_BAR = 4
+GJ_BAR = 5
+K_ACT = 6
+HALF_WIDTH = 7
+SSTRIDE = 8
+N_PACKED = SLEGS + N_LEGS * SSTRIDE
+F_STIFFNESS_MIN = 3  # field slots of the stiffness fields
+F_DEFLECTION = 4
 TWO_PI = 2.0 * math.pi
 
 
@@ -130,9 +154,10 @@ def _leg(p, k, x, y, z):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _fields(p, x, y, z, out, conditioning):
+def _fields(p, x, y, z, out, conditioning, stiffness=False):
     """Slots 0-2 (LCI, sigma_min, sigma_max of dx/dq) at P, or write_unreachable; ``conditioning`` (a constant)
-    False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel)."""
+    False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel); ``stiffness`` (a
+    constant) True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set)."""
     k1 = HEAD
     k2 = HEAD + STRIDE
     k3 = HEAD + 2 * STRIDE
@@ -172,13 +197,28 @@ def _fields(p, x, y, z, out, conditioning):
     else:
         out[1] = smin / ad
         out[2] = smax / ad
+    if stiffness:
+        if p[STIFF] > 0.0:
+            out[F_STIFFNESS_MIN], out[F_DEFLECTION] = _stiffness(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz)
+        else:
+            out[F_STIFFNESS_MIN] = 0.0
+            out[F_DEFLECTION] = 0.0
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
-    """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of dx/dq at P = (x, y, z), -1 and zeros
-    where a leg does not reach P in its branch or a limit excludes it."""
-    _fields(p, x, y, z, out, True)
+    """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of dx/dq at P = (x, y, z), and
+    stiffness_min (N/length) and deflection (length unit) of the platform under the packed load where the packed
+    flag asks for them (else 0; _stiffness); -1 and zeros where a leg does not reach P in its branch or a limit
+    excludes it."""
+    _fields(p, x, y, z, out, True, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z, out):
+    """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel: a search whose
+    workspace metrics are the LCI's alone); slots 3-4 not written."""
+    _fields(p, x, y, z, out, True, False)
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -199,6 +239,145 @@ def leg_values(p, x, y, z, out):
         out[i, 3] = fz
         out[i, 4] = jq
         out[i, 5] = q
+
+
+# ----- per-voxel stiffness (docs/describing.md): the idealisation of frame.py, condensed per leg ------------------
+# Leg i: the platform joint Q = P + r (r the packed platform offset), the elbow or carriage E = Q - l f (f the unit
+# forearm), n the leg's normal (R-Pa: the actuated axis), h half the parallelogram's width.
+# * E to platform: each bar E +- h n -> Q +- h n sits on universal joints (t, n) at both ends, t = unit(n x f), so it
+#   passes only the wrenches reciprocal to those four rotations: its axial force, w_+- = (f, (r +- h n) x f) at P,
+#   and a couple along m = unit(n x t) = (n (n . f) - f) / s, s = |n x f|, w_m = (0, m). On the bar, a cantilever of
+#   length l loaded at its tip, the two do not couple (the force lies on its axis): flexibilities l / EA and
+#   l (s^2 / GJ + (1 - s^2) / EI) (m . f = -s). The two bars share w_m: the parallelogram passes the wrenches
+#   W = [w_+, w_-, w_m] with flexibility diag(l / EA, l / EA, half the couple's).
+# * base to E, in series (the same wrench passes): R-Pa, the upper arm B -> E as a cantilever clamped on the
+#   actuator (stiffness.legs.tip_bilinear of the wrenches moved to E) and the actuator's torsional spring about n
+#   through B ((n . M_B)(n . M_B') / k); P-Pa, the carriage's spring along the rail ((u . F)(u . F') / k).
+# * the leg: K_leg = W Phi^-1 W^T with Phi the sum of the two (3 x 3), the wrench form of stiffness.legs
+#   (N (N^T C N)^-1 N^T over the leg's chain); the platform K = sum of the legs' (6 x 6 at P, as 21 scalars) ->
+#   stiffness.legs.response_upper under the packed load. tests/test_delta_stiffness_fields.py holds it equal to the
+#   frame assembled and solved per pose (stiffness.solve).
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z):
+    """w1^T C_e w2 for wrenches (F, M) at P and the compliance C_e of leg k's base-to-E chain (the comment above):
+    ``rot`` True for R-Pa, whose arm runs B -> E = B + la (la: E - B; E = (ex, ey, ez) minus P)."""
+    if not rot:
+        a1 = f1x * p[k + U] + f1y * p[k + U + 1] + f1z * p[k + U + 2]
+        a2 = f2x * p[k + U] + f2y * p[k + U + 1] + f2z * p[k + U + 2]
+        return a1 * a2 / p[s + K_ACT]
+    # moments about E (P - E = -e) and about B (P - B = -e + la)
+    n1x = m1x - (ey * f1z - ez * f1y)
+    n1y = m1y - (ez * f1x - ex * f1z)
+    n1z = m1z - (ex * f1y - ey * f1x)
+    n2x = m2x - (ey * f2z - ez * f2y)
+    n2y = m2y - (ez * f2x - ex * f2z)
+    n2z = m2z - (ex * f2y - ey * f2x)
+    length = math.sqrt(lax * lax + lay * lay + laz * laz)
+    inv = 1.0 / length
+    beam = _sl.tip_bilinear(length, p[s + EA_ARM], p[s + EI_ARM], p[s + GJ_ARM], lax * inv, lay * inv, laz * inv,
+                            f1x, f1y, f1z, n1x, n1y, n1z, f2x, f2y, f2z, n2x, n2y, n2z)
+    nx = p[k + AXIS]
+    ny = p[k + AXIS + 1]
+    nz = p[k + AXIS + 2]
+    b1 = nx * (n1x + lay * f1z - laz * f1y) + ny * (n1y + laz * f1x - lax * f1z) + nz * (n1z + lax * f1y - lay * f1x)
+    b2 = nx * (n2x + lay * f2z - laz * f2y) + ny * (n2y + laz * f2x - lax * f2z) + nz * (n2z + lax * f2y - lay * f2x)
+    return beam + b1 * b2 / p[s + K_ACT]
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _add_leg(kk, p, k, s, x, y, z, fx, fy, fz):
+    """(ok, kk + K_leg's 21 upper entries) for leg block k (stiffness slots from s) with unit forearm f, at
+    P = (x, y, z) (the comment above); ok False where the leg's wrench space is degenerate (kk unchanged)."""
+    lf = p[k + FOREARM]
+    rx = p[k + PLAT]
+    ry = p[k + PLAT + 1]
+    rz = p[k + PLAT + 2]
+    nx = p[k + AXIS]
+    ny = p[k + AXIS + 1]
+    nz = p[k + AXIS + 2]
+    h = p[s + HALF_WIDTH]
+    nf = nx * fx + ny * fy + nz * fz
+    sn2 = 1.0 - nf * nf
+    if not sn2 > 0.0:
+        return False, kk  # a forearm along the leg's normal: its universal joints' axes coincide
+    sn = math.sqrt(sn2)
+    mx = (nx * nf - fx) / sn
+    my = (ny * nf - fy) / sn
+    mz = (nz * nf - fz) / sn
+    # axial wrenches' moments at P: (r +- h n) x f = c0 +- h c1
+    c0x = ry * fz - rz * fy
+    c0y = rz * fx - rx * fz
+    c0z = rx * fy - ry * fx
+    c1x = h * (ny * fz - nz * fy)
+    c1y = h * (nz * fx - nx * fz)
+    c1z = h * (nx * fy - ny * fx)
+    ax = c0x + c1x
+    ay = c0y + c1y
+    az = c0z + c1z
+    bx = c0x - c1x
+    by = c0y - c1y
+    bz = c0z - c1z
+    # E - P and, for R-Pa, the arm E - B
+    ex = rx - lf * fx
+    ey = ry - lf * fy
+    ez = rz - lf * fz
+    rot = p[k + TYPE] == R_PA
+    lax = ex + x - p[k + BASE]
+    lay = ey + y - p[k + BASE + 1]
+    laz = ez + z - p[k + BASE + 2]
+    axial = lf / p[s + EA_BAR]
+    couple = 0.5 * lf * (sn2 / p[s + GJ_BAR] + (1.0 - sn2) / p[s + EI_BAR])
+    # Phi = the bars' diagonal + W^T C_e W
+    q00 = axial + _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, fx, fy, fz, ax, ay, az, fx, fy, fz, ax, ay, az)
+    q01 = _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, fx, fy, fz, ax, ay, az, fx, fy, fz, bx, by, bz)
+    q02 = _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, fx, fy, fz, ax, ay, az, 0.0, 0.0, 0.0, mx, my, mz)
+    q11 = axial + _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, fx, fy, fz, bx, by, bz, fx, fy, fz, bx, by, bz)
+    q12 = _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, fx, fy, fz, bx, by, bz, 0.0, 0.0, 0.0, mx, my, mz)
+    q22 = couple + _base_flex(p, k, s, rot, lax, lay, laz, ex, ey, ez, 0.0, 0.0, 0.0, mx, my, mz, 0.0, 0.0, 0.0, mx,
+                              my, mz)
+    ok, i00, i01, i02, i11, i12, i22 = _sl.sym3_inverse(q00, q01, q02, q11, q12, q22)
+    if not ok:
+        return False, kk
+    # Phi^-1 = L L^T (Cholesky); K_leg = sum over the columns c of L of (W L_c)(W L_c)^T
+    l00 = math.sqrt(i00)
+    l10 = i01 / l00
+    l20 = i02 / l00
+    d11 = i11 - l10 * l10
+    if not d11 > 0.0:
+        return False, kk
+    l11 = math.sqrt(d11)
+    l21 = (i12 - l20 * l10) / l11
+    d22 = i22 - l20 * l20 - l21 * l21
+    if not d22 > 0.0:
+        return False, kk
+    l22 = math.sqrt(d22)
+    # column 0: w_+ l00 + w_- l10 + w_m l20; column 1: w_- l11 + w_m l21; column 2: w_m l22
+    g = l00 + l10
+    kk = _sl.outer_add(kk, fx * g, fy * g, fz * g, ax * l00 + bx * l10 + mx * l20, ay * l00 + by * l10 + my * l20,
+                       az * l00 + bz * l10 + mz * l20)
+    kk = _sl.outer_add(kk, fx * l11, fy * l11, fz * l11, bx * l11 + mx * l21, by * l11 + my * l21,
+                       bz * l11 + mz * l21)
+    kk = _sl.outer_add(kk, 0.0, 0.0, 0.0, mx * l22, my * l22, mz * l22)
+    return True, kk
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """(stiffness_min N/length, deflection length) of the platform at P = (x, y, z) whose legs reach it with unit
+    forearms a, b, c (the comment above; ideal joints). A singular leg or
+    platform: (0, DEFLECTION_CAP), or 0 deflection under no load (stiffness.legs' caps); never NaN."""
+    fx = p[LOAD]
+    fy = p[LOAD + 1]
+    fz = p[LOAD + 2]
+    kk = (0.0,) * 21
+    ok1, kk = _add_leg(kk, p, HEAD, SLEGS, x, y, z, ax, ay, az)
+    ok2, kk = _add_leg(kk, p, HEAD + STRIDE, SLEGS + SSTRIDE, x, y, z, bx, by, bz)
+    ok3, kk = _add_leg(kk, p, HEAD + 2 * STRIDE, SLEGS + 2 * SSTRIDE, x, y, z, cx, cy, cz)
+    if not (ok1 and ok2 and ok3):
+        return 0.0, (0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else _sl.DEFLECTION_CAP)
+    return _sl.response_upper(kk, fx, fy, fz, p[CHAR_LEN])
 
 
 # ----- column intervals (Mechanism.interval_kernel): the reachable set of a z-column in closed form ---------------

@@ -24,6 +24,9 @@ takes M's singular values by one-sided (Hestenes) Jacobi, which keeps the small 
 reports those of dx/dq: LCI = s_min(M) / s_max(M), sigma_min = 1 / s_max(M), sigma_max = 1 / s_min(M) (capped).
 Where some |f_i . t_i| <= SQUARE_TOL * a_i (a rod square to its arm: an inverse singularity, M unbounded) the
 pose is written as singular (LCI 0, sigma_min 0, sigma_max the cap).
+
+Stiffness (slots 3-4, only where the packed flag, options.stiffness_metrics, is set; else 0): stiffness_min and
+deflection of frame6.py's idealisation, one bar wrench per leg (the section comment below).
 """
 
 import math
@@ -34,6 +37,7 @@ from numba import njit
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.stiffness import legs as _sl
 
 # leg type codes (legs.LEG_TYPES' ``code``), distinct from the 3T template's
 RUS = 3.0
@@ -58,7 +62,22 @@ HI = 24
 HAS_CONE = 25
 CONE = 26  # RUS: sin of the cone half-angle; UPS: its cosine
 STRIDE = 27
-N_PACKED = HEAD + N_LEGS * STRIDE
+N_KINEMATIC = HEAD + N_LEGS * STRIDE  # the slots above; the stiffness block (per-voxel stiffness fields) follows
+# stiffness block, from N_KINEMATIC: a flag (1: options.stiffness_metrics, the fields are computed) and the load (N),
+# then per leg SSTRIDE slots: the arm's section (EA, EI, GJ; RUS), the rod's or leg's EA and the actuator's spring
+# (N length/rad rotary, N/length linear)
+STIFF = N_KINEMATIC
+LOAD = N_KINEMATIC + 1
+SLEGS = N_KINEMATIC + 4
+EA_ARM = 0
+EI_ARM = 1
+GJ_ARM = 2
+EA_LINK = 3
+K_ACT = 4
+SSTRIDE = 5
+N_PACKED = SLEGS + N_LEGS * SSTRIDE
+F_STIFFNESS_MIN = 3  # field slots of the stiffness fields
+F_DEFLECTION = 4
 TWO_PI = 2.0 * math.pi
 SQUARE_TOL = 1e-12  # |f . t| / (l a) at or below which a RUS leg counts as an exact inverse singularity
 JACOBI_TOL = 1e-15  # columns count as orthogonal when |c_i . c_j| <= JACOBI_TOL |c_i| |c_j|
@@ -179,9 +198,11 @@ def _jacobi_extremes(g):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _fields(p, x, y, z, out, conditioning):
+def _fields(p, x, y, z, out, conditioning, stiffness=False):
     """Slots 0-2 (LCI, sigma_min, sigma_max of the homogenised dx/dq) at P, or write_unreachable; ``conditioning``
-    (a constant) False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel)."""
+    (a constant) False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel);
+    ``stiffness`` (a constant) True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is
+    set)."""
     inv_l = p[INV_L]
     g = np.empty((6, 6))
     square = False
@@ -212,21 +233,84 @@ def _fields(p, x, y, z, out, conditioning):
         return
     if square:
         _grid.write_singular(out)
-        return
-    smin, smax = _jacobi_extremes(g)
-    if not smax > 0.0:
-        _grid.write_singular(out)
-        return
-    out[0] = min(1.0, smin / smax)
-    out[1], out[2] = inverse_singular_values(smin, smax)
+    else:
+        smin, smax = _jacobi_extremes(g)
+        if not smax > 0.0:
+            _grid.write_singular(out)
+        else:
+            out[0] = min(1.0, smin / smax)
+            out[1], out[2] = inverse_singular_values(smin, smax)
+    if stiffness:
+        if p[STIFF] > 0.0:
+            # an inverse singularity is not one of the frame: the arm's bending and its spring still hold the rod
+            out[F_STIFFNESS_MIN], out[F_DEFLECTION] = _stiffness(p, x, y, z)
+        else:
+            out[F_STIFFNESS_MIN] = 0.0
+            out[F_DEFLECTION] = 0.0
+
+
+# ----- per-voxel stiffness (docs/describing.md): frame6.py's idealisation condensed per leg -----------------------
+# Each leg passes one wrench to the rigid platform: the force along its rod or leg through the platform joint Q,
+# w = (f, rho x f) at P (f the unit rod Q - E or leg Q - B, rho = Q - P): a RUS rod is a bar (a universal joint at the
+# elbow, a spherical one at Q), a UPS leg too (universal at B, spherical at Q). Its flexibility phi = w^T C w over the
+# chain: RUS, the arm as a cantilever B -> E loaded at its tip E by the force f alone (the rod's line passes through
+# E; stiffness.legs.tip_bilinear), the actuator's torsional spring ((n . ((E - B) x f))^2 / k) and the rod's axial
+# l / EA; UPS, 1 / k + q / EA (the leg of length q; its cylinder and piston halves in series). The platform
+# K = sum w w^T / phi (the wrench form; stiffness.legs.outer_add) -> response_upper under the packed load, with the
+# reference solver's characteristic length: its longest link (RUS the arm or rod, UPS a half leg, q / 2).
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def _stiffness(p, x, y, z):
+    """(stiffness_min N/length, deflection length) of the rigid platform at P = (x, y, z), every leg reaching it
+    (the comment above; ideal joints); (0, DEFLECTION_CAP) where K is singular (0 deflection under no load)."""
+    kk = (0.0,) * 21
+    longest = 0.0
+    for i in range(N_LEGS):
+        k = HEAD + i * STRIDE
+        s = SLEGS + i * SSTRIDE
+        _, fx, fy, fz, _, q, _ = _leg(p, k, x, y, z)
+        rx = p[k + RHO]
+        ry = p[k + RHO + 1]
+        rz = p[k + RHO + 2]
+        if p[k + TYPE] == RUS:
+            la = p[k + ARM]
+            lr = p[k + ROD]
+            c = math.cos(q)
+            sn = math.sin(q)
+            # arm B -> E, E - B = la (c u + sn w)
+            ax = la * (c * p[k + U] + sn * p[k + W])
+            ay = la * (c * p[k + U + 1] + sn * p[k + W + 1])
+            az = la * (c * p[k + U + 2] + sn * p[k + W + 2])
+            phi = _sl.tip_bilinear(la, p[s + EA_ARM], p[s + EI_ARM], p[s + GJ_ARM], ax / la, ay / la, az / la,
+                                   fx, fy, fz, 0.0, 0.0, 0.0, fx, fy, fz, 0.0, 0.0, 0.0)
+            m = p[k + AXIS] * (ay * fz - az * fy) + p[k + AXIS + 1] * (az * fx - ax * fz) + \
+                p[k + AXIS + 2] * (ax * fy - ay * fx)
+            phi += m * m / p[s + K_ACT] + lr / p[s + EA_LINK]
+            longest = max(longest, la, lr)
+        else:
+            phi = 1.0 / p[s + K_ACT] + q / p[s + EA_LINK]
+            longest = max(longest, 0.5 * q)
+        w = 1.0 / math.sqrt(phi)
+        kk = _sl.outer_add(kk, fx * w, fy * w, fz * w, (ry * fz - rz * fy) * w, (rz * fx - rx * fz) * w,
+                           (rx * fy - ry * fx) * w)
+    return _sl.response_upper(kk, p[LOAD], p[LOAD + 1], p[LOAD + 2], longest)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of the homogenised dx/dq at platform
-    centre P = (x, y, z) (orientation from the packed legs), -1 and zeros where a leg does not reach P in its branch
-    or a limit excludes it."""
-    _fields(p, x, y, z, out, True)
+    centre P = (x, y, z) (orientation from the packed legs), and stiffness_min (N/length) and deflection (length
+    unit) of the platform under the packed load where the packed flag asks for them (else 0; _stiffness); -1 and
+    zeros where a leg does not reach P in its branch or a limit excludes it."""
+    _fields(p, x, y, z, out, True, True)
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def point_lci(p, x, y, z, out):
+    """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel); slots 3-4 not
+    written."""
+    _fields(p, x, y, z, out, True, False)
 
 
 @njit(cache=True, fastmath=FASTMATH)

@@ -20,6 +20,7 @@ import numpy as np
 from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Mechanism,
     Option,
     Parameter,
@@ -35,6 +36,8 @@ from scalesynth.mechanisms.describe import bodies, expressions, frame, symmetry
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
+from scalesynth.mechanisms.links import check_flag_option
+from scalesynth.stiffness import legs as _sl
 from scalesynth.stiffness.sections import check_stiffness_options
 
 
@@ -97,6 +100,7 @@ class DescribedMechanism(Mechanism):
     def check_options(self, options: dict[str, Any]) -> None:
         bodies.check_link_radius(options, self._codes())
         check_stiffness_options(options, 3, frame.link_groups(self._codes()[0]))
+        check_flag_option(options, "stiffness_metrics")
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":
@@ -154,6 +158,8 @@ class DescribedMechanism(Mechanism):
             if leg.sin_cone is not None:
                 p[k + _k.HAS_CONE] = 1.0
                 p[k + _k.SIN_CONE] = leg.sin_cone
+        if options.get("stiffness_metrics"):
+            frame.pack_stiffness(self, design, options, p)
         return p
 
     @property
@@ -174,6 +180,12 @@ class DescribedMechanism(Mechanism):
         return _k.point_fields
 
     @property
+    def lci_kernel(self):
+        """point_fields without the stiffness stage (slot 0 bit for bit): a search on the LCI's metrics alone (a
+        subclass with a kernel of its own, e.g. the planar one, keeps the default: its field kernel)."""
+        return _k.point_lci if self.field_kernel is _k.point_fields else self.field_kernel
+
+    @property
     def reach_kernel(self):
         return _k.point_reach
 
@@ -190,10 +202,12 @@ class DescribedMechanism(Mechanism):
         """x (0) and/or y (1) where the packed legs are a mirror image of themselves in that plane: every leg has a
         partner (itself, on the plane) of the same type, lengths, branch, limits and cone whose base, platform and
         arm/rail directions are its own reflected (the plane normal of the cone check up to sign: the kernel reads
-        only |f . axis|). The kernel's fields (reach, LCI, sigma_min, sigma_max) depend on nothing else, and a
-        reflection keeps singular values, so each such plane is a symmetry of every field. Checked on the packed
-        legs of the default design and of two designs with every parameter scaled and shifted apart (a
-        description symmetric only at its defaults, e.g. through an offset whose default is 0, is not declared).
+        only |f . axis|; with the stiffness fields on, equal sections and springs and a load in the plane). The
+        kernel's fields (reach, LCI, sigma_min, sigma_max, stiffness_min, deflection) depend on nothing else, and a
+        reflection keeps singular values and eigenvalues, so each such plane is a symmetry of every field.
+        Checked on the packed legs of the default design and of two designs with every parameter scaled and shifted
+        apart (a description symmetric only at its defaults, e.g. through an offset whose default is 0, is not
+        declared).
         3T only."""
         if self.motion != "3T":
             return ()
@@ -397,6 +411,21 @@ def _footprint(desc_mech_plans, d: Mapping[str, float]) -> float:
     return enclosing_circle_radius(pts)
 
 
+# The per-voxel stiffness fields (kernel._stiffness: frame.py's idealisation condensed per leg). Opt-in, as seed 000's:
+# their stage costs many times the kinematic fields, so a search whose metrics do not read them must not pay it.
+STIFFNESS_METRICS_OPTION = Option(
+    "stiffness_metrics", False, "true: compute the per-voxel fields stiffness_min and deflection (the frame of "
+    "`stiffness`, ideal joints) and enable their metrics; false: they are 0 and their metrics unavailable")
+STIFFNESS_FIELDS = (
+    Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform's translational stiffness at P felt by "
+          "a pure force (ideal joints, Euler-Bernoulli links, actuator springs; the frame of `stiffness`); 0 at a "
+          "singular pose; its metrics need options.stiffness_metrics", "max", needs_options=("stiffness_metrics",)),
+    Field("deflection", "{length}", "magnitude of the deflection of P under options.load (default 150 N down -z); "
+          f"{_sl.DEFLECTION_CAP:g} at a singular pose; its metrics need options.stiffness_metrics", "min",
+          (0.0, _sl.DEFLECTION_CAP), needs_options=("stiffness_metrics",)),
+)
+
+
 def from_description_3t(desc: Description) -> DescribedMechanism:
     """The registered mechanism of a validated 3T description (build.from_description dispatches by motion)."""
     plans = _plans(desc)
@@ -405,7 +434,7 @@ def from_description_3t(desc: Description) -> DescribedMechanism:
     joints = tuple(f"{plan.joint}{i + 1}" for i, plan in enumerate(plans))
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items())
     options += (Option("link_radius", None, bodies.LINK_RADIUS_DOC),
-                *frame.options(desc.stiffness, desc.length_unit, rotary))
+                *frame.options(desc.stiffness, desc.length_unit, rotary), STIFFNESS_METRICS_OPTION)
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = "J = dx/dq (platform motion per rad of arm rotation)" if rotary else \
         "J = dx/dq (platform motion per unit carriage motion)"
@@ -422,7 +451,7 @@ def from_description_3t(desc: Description) -> DescribedMechanism:
                          for name, spec in desc.parameters.items()),
         options=options,
         default_length_unit=desc.length_unit,
-        fields=base_fields(sigma_unit, jac),
+        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS),
         design_metrics=(
             DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (a parallelogram "
                          "counted once)", lambda d, o, _p=plans: _link_length_sum(_p, d)),

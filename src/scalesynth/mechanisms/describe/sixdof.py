@@ -34,7 +34,15 @@ from scalesynth.mechanisms.base import (
 from scalesynth.mechanisms.describe import bodies, expressions, frame
 from scalesynth.mechanisms.describe import kernel6 as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, LegType
-from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, _footprint, _plans, _turn, _unit
+from scalesynth.mechanisms.describe.mechanism import (
+    STIFFNESS_FIELDS,
+    STIFFNESS_METRICS_OPTION,
+    DescribedMechanism,
+    _footprint,
+    _plans,
+    _turn,
+    _unit,
+)
 from scalesynth.mechanisms.describe.schema import Description
 from scalesynth.mechanisms.links import segment_ends
 
@@ -251,11 +259,37 @@ class SixDofMechanism(DescribedMechanism):
             if leg.cone is not None:
                 p[k + _k.HAS_CONE] = 1.0
                 p[k + _k.CONE] = math.sin(leg.cone) if leg.rus else math.cos(leg.cone)
+        if options.get("stiffness_metrics"):
+            self._pack_stiffness(options, p)
         return p
+
+    def _pack_stiffness(self, options: Mapping[str, Any], p: np.ndarray) -> None:
+        """The stiffness block of kernel6 (flag, load, per leg the sections and the actuator's spring) from the
+        sections and options of the stiffness frame (frame6.py)."""
+        from scalesynth.stiffness.sections import tube_section
+
+        codes = self._codes()
+        groups = {g: tube_section(options, g, self.default_length_unit) for g in frame.link_groups(codes[0])}
+        for i, code in enumerate(codes):
+            s = _k.SLEGS + i * _k.SSTRIDE
+            if code == _k.RUS:
+                arm, link = groups["upper_arm"], groups["rod"]
+                p[s + _k.EA_ARM], p[s + _k.EI_ARM], p[s + _k.GJ_ARM] = arm.EA, arm.EI, arm.GJ
+            else:
+                link = groups["leg"]
+            p[s + _k.EA_LINK] = link.EA
+            p[s + _k.K_ACT] = options["actuator_stiffness"]
+        p[_k.STIFF] = 1.0
+        p[_k.LOAD : _k.LOAD + 3] = options["load"]
 
     @property
     def field_kernel(self):
         return _k.point_fields
+
+    @property
+    def lci_kernel(self):
+        """point_fields without the stiffness stage (slot 0 bit for bit): a search on the LCI's metrics alone."""
+        return _k.point_lci
 
     @property
     def reach_kernel(self):
@@ -506,7 +540,7 @@ def from_description_6dof(desc: Description) -> SixDofMechanism:
     rotary = LEG_TYPES[plans[0].type].joint_unit == "angle"
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items()) + (
         Option("link_radius", None, bodies.LINK_RADIUS_DOC),
-        *frame.options(desc.stiffness, desc.length_unit, rotary),
+        *frame.options(desc.stiffness, desc.length_unit, rotary), STIFFNESS_METRICS_OPTION,
         Option(ORIENTATION, [0.0, 0.0, 0.0], "[roll, pitch, yaw] rad of the platform over the whole (constant-"
                "orientation) workspace, R = Rz(yaw) Ry(pitch) Rx(roll)"),
         Option(CHARACTERISTIC_LENGTH, None, "length L of the homogenised Jacobian dx/dq = (v, L omega) per joint "
@@ -529,7 +563,7 @@ def from_description_6dof(desc: Description) -> SixDofMechanism:
                          for name, spec in desc.parameters.items()),
         options=options,
         default_length_unit=desc.length_unit,
-        fields=base_fields(sigma_unit, jac),
+        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS),
         design_metrics=(
             DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (RUS: arm + rod; "
                          "UPS: its longest length)", lambda d, o, _h=holder: _link_length_sum(_h[0], d, o)),

@@ -18,15 +18,24 @@ def mirrored_legs(p: np.ndarray, axis: int) -> bool:
     """Whether the legs packed in ``p`` (shape (N_PACKED,)) are their own mirror image in the plane
     x_axis = 0 (axis 0 or 1): each leg has a partner (possibly itself) with equal type, lengths, branch, limits and
     cone, whose base, platform offset, arm (rail) direction and turn direction are the leg's reflected, and whose
-    leg-plane normal is the reflected one up to sign (the kernel reads only |f . normal|)."""
+    leg-plane normal is the reflected one up to sign (the kernel reads only |f . normal|). With the per-voxel
+    stiffness fields on (the packed flag), partners also need equal sections, actuator springs and widths, and the
+    load must have no component across the plane (a reflected load would give other deflections)."""
     n = int(p[0])
     blocks = [p[_k.HEAD + i * _k.STRIDE : _k.HEAD + (i + 1) * _k.STRIDE] for i in range(n)]
-    scale = max(1.0, float(np.abs(p).max()))
+    stiff = [p[_k.SLEGS + i * _k.SSTRIDE : _k.SLEGS + (i + 1) * _k.SSTRIDE] for i in range(n)]
+    scale = max(1.0, float(np.abs(p[: _k.N_KINEMATIC]).max()))
     flip = np.ones(3)
     flip[axis] = -1.0
+    with_stiffness = p[_k.STIFF] > 0.0
+    if with_stiffness and p[_k.LOAD + axis] != 0.0:
+        return False
 
-    def partner(a: np.ndarray, b: np.ndarray) -> bool:
+    def partner(i: int, j: int) -> bool:
+        a, b = blocks[i], blocks[j]
         if not np.allclose(a[list(_SCALARS)], b[list(_SCALARS)], rtol=0.0, atol=_RTOL * scale):
+            return False
+        if with_stiffness and not np.allclose(stiff[i], stiff[j], rtol=_RTOL, atol=0.0):
             return False
         for s in _VECTORS:
             if not np.allclose(flip * a[s : s + 3], b[s : s + 3], rtol=0.0, atol=_RTOL * scale):
@@ -35,4 +44,4 @@ def mirrored_legs(p: np.ndarray, axis: int) -> bool:
         return bool(np.allclose(na, nb, rtol=0.0, atol=_RTOL * scale)
                     or np.allclose(na, -nb, rtol=0.0, atol=_RTOL * scale))
 
-    return all(any(partner(a, b) for b in blocks) for a in blocks)
+    return all(any(partner(i, j) for j in range(n)) for i in range(n))
