@@ -19,7 +19,7 @@ bands of LCI, and min/max over the nodes (an estimate from inside, as every grid
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.flags import FASTMATH
@@ -136,12 +136,12 @@ def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws
     return calls
 
 
-@njit(cache=True, fastmath=FASTMATH)
+@njit(cache=True, fastmath=FASTMATH, parallel=True)
 def population_sector_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, edges,
                             cell, rows, calls):
     """sector_row for every design (params (n, N_PACKED); rmax, zlo, zhi, cell: (n,)) into rows (n, columns) and
-    calls (n,); serial (the population loop is cheap next to the NSGA-II bookkeeping at this cost)."""
-    for d in range(params.shape[0]):
+    calls (n,); parallel over designs (each writes its own row: the result does not depend on the threads)."""
+    for d in prange(params.shape[0]):
         _grid.init_row(rows[d], 3)
         calls[d] = sector_row(params[d], phi0, phi1, rmax[d], zlo[d], zhi[d], nscan, nbisect, xphi, wphi, xs, ws,
                               xz, wz, edges, cell[d], rows[d])
