@@ -1,9 +1,10 @@
 """Issue 28 experiment: the sector evaluator (describe/sector.py) on the Delta against the uniform N = 192 grid.
 
-    python benchmarks/sector_experiment.py [n_designs] [seed]
+    python benchmarks/sector_experiment.py [n_designs] [seed] [nphi,ns,nz,nscan,nbisect[,zmin] ...]
 
-Random designs in configs/delta.yaml's bounds, region z in [-2.5, -0.3]; per setting (nphi, ns, nz, nscan,
-nbisect): worst volume error (relative) and GCI error (absolute) as multiples of the paper tolerance (0.2 %, 5e-4),
+Random designs in configs/delta.yaml's bounds, region z in [-2.5, -0.3]; per setting (angles, radii, z-points,
+scan steps, bisections; with zmin the z-points are those of an interval as long as the box's z-range, shorter ones
+proportionally fewer but at least zmin, as SectorPlan's min_z_points; without, every interval nz): worst volume error (relative) and GCI error (absolute) as multiples of the paper tolerance (0.2 %, 5e-4),
 kernel calls and CPU ms per design. The reference rows are cached in /tmp (keyed by seed and count).
 """
 
@@ -45,8 +46,9 @@ def reference(cfg, designs, seed, n=192):
     return np.array(vol), np.array(gci)
 
 
-def sector(cfg, designs, nphi, ns, nz, nscan, nbisect, sector_deg=60.0):
+def sector(cfg, designs, nphi, ns, nz, nscan, nbisect, zmin=None, sector_deg=60.0):
     from scalesynth.evaluation.grid import design_boxes
+    from scalesynth.evaluation.sector import gauss_tables
     from scalesynth.mechanisms.describe import sector as sk
 
     mech, options, region = cfg.mech, cfg.resolved_options(), cfg.grid.region
@@ -56,7 +58,13 @@ def sector(cfg, designs, nphi, ns, nz, nscan, nbisect, sector_deg=60.0):
     edges = np.asarray(cfg.dexterity.band_edges, dtype=float)
     xp, wp = np.polynomial.legendre.leggauss(nphi)
     xs, ws = np.polynomial.legendre.leggauss(ns)
-    xz, wz = np.polynomial.legendre.leggauss(nz)
+    if zmin is None:  # every interval nz points (the first experiment's fixed rule)
+        xz, wz = gauss_tables(nz)
+        xz[:] = xz[nz]
+        wz[:] = wz[nz]
+        zmin = nz
+    else:
+        xz, wz = gauss_tables(nz)
     n = len(designs)
     rows = np.zeros((n, 1 + 12 + len(edges) - 1))
     calls = np.zeros(n, dtype=np.int64)
@@ -64,7 +72,7 @@ def sector(cfg, designs, nphi, ns, nz, nscan, nbisect, sector_deg=60.0):
     phi1 = math.radians(sector_deg)
     t0 = time.process_time()
     sk.population_sector_stats(packed, 0.0, phi1, rmax, lo[:, 2], hi[:, 2], nscan, nbisect, xp, wp, xs, ws, xz, wz,
-                               edges, cell, rows, calls)
+                               zmin, edges, cell, rows, calls)
     cpu = time.process_time() - t0
     factor = 2.0 * math.pi / phi1
     vol = rows[:, 0] * cell * factor
@@ -83,11 +91,13 @@ def main(argv):
     sector(cfg, designs[:1], 4, 4, 2, 4, 4)  # compile
     settings = [tuple(int(v) for v in s.split(",")) for s in (argv[2:] or ["8,12,4,16,30", "12,16,4,16,30",
                                                                           "16,24,6,24,40"])]
-    for nphi, ns, nz, nscan, nb in settings:
-        vol, gci, calls, cpu = sector(cfg, designs, nphi, ns, nz, nscan, nb)
+    for setting in settings:
+        nphi, ns, nz, nscan, nb = setting[:5]
+        zmin = setting[5] if len(setting) > 5 else None
+        vol, gci, calls, cpu = sector(cfg, designs, nphi, ns, nz, nscan, nb, zmin)
         ev = np.abs(vol - rv) / np.where(rv > 0, rv, 1.0)
         eg = np.abs(gci - rg)
-        print(f"nphi {nphi} ns {ns} nz {nz} nscan {nscan} nbis {nb}: vol err max {ev.max() / TOL_V:.2f}x "
+        print(f"nphi {nphi} ns {ns} nz {nz} zmin {zmin} nscan {nscan} nbis {nb}: vol err max {ev.max() / TOL_V:.2f}x "
               f"(design {ev.argmax()}), gci err max {eg.max() / TOL_G:.2f}x (design {eg.argmax()}), "
               f"calls/design {calls.mean():.0f}, cpu ms/design {1e3 * cpu / n:.3f}")
         sys.stdout.flush()

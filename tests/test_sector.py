@@ -31,7 +31,7 @@ def test_the_delta_has_the_60_degree_sector_and_an_offset_leg_has_none():
     q = p.copy()
     q[2 + 1] += 0.01  # leg 1's base moved along x: the rotation no longer maps the legs onto each other
     assert np.isnan(fundamental_sectors(q)[0])
-    assert sector_plan(mech, PAPER)[1].z_points == 16
+    assert sector_plan(mech, PAPER)[1].z_points == 32
     assert sector_plan(mech, Tolerance(0.001, 0.0005)) is None
 
 

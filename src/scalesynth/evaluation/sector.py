@@ -27,14 +27,25 @@ COARSE_CELLS = 64**3
 @dataclass(frozen=True)
 class SectorPlan:
     """Gauss-Legendre nodes over the sector's angle (``angles``), over the radius (``radii``, in s with r = R (1 -
-    s^2)) and on each reachable z-interval (``z_points``); ``scan`` steps and ``bisections`` for the boundary
-    radius of each ray."""
+    s^2)) and on a reachable z-interval as long as the box's z-range (``z_points``; a shorter interval gets
+    proportionally fewer, at least ``min_z_points``: about the same spacing everywhere); ``scan`` steps and
+    ``bisections`` for the boundary radius of each ray."""
 
     angles: int
     radii: int
     z_points: int
-    scan: int = 16
-    bisections: int = 30
+    min_z_points: int = 1
+    scan: int = 8
+    bisections: int = 12
+
+
+def gauss_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1] of every k <= n: row k of each (n + 1, n) table holds the
+    k-point rule in its first k entries."""
+    xz, wz = np.zeros((n + 1, n)), np.zeros((n + 1, n))
+    for k in range(1, n + 1):
+        xz[k, :k], wz[k, :k] = np.polynomial.legendre.leggauss(k)
+    return xz, wz
 
 
 def sector_plan(mech: Mechanism, tolerance: Tolerance) -> tuple[Tolerance, SectorPlan] | None:
@@ -73,11 +84,12 @@ def sector_population_stats(
     safe_cell = np.where(cell > 0.0, cell, 1.0)  # an empty box: nothing reachable, count 0 in any unit
     xp, wp = np.polynomial.legendre.leggauss(plan.angles)
     xs, ws = np.polynomial.legendre.leggauss(plan.radii)
-    xz, wz = np.polynomial.legendre.leggauss(plan.z_points)
+    xz, wz = gauss_tables(plan.z_points)
     rows = np.zeros((n, _grid.stat_columns(mech.n_fields, len(edges) - 1)))
     calls = np.zeros(n, dtype=np.int64)
     _sk.population_sector_stats(packed, 0.0, angle, np.where(cell > 0.0, rmax, 0.0), lo[:, 2], hi[:, 2],
-                                plan.scan, plan.bisections, xp, wp, xs, ws, xz, wz, edges, safe_cell, rows, calls)
+                                plan.scan, plan.bisections, xp, wp, xs, ws, xz, wz,
+                                min(plan.min_z_points, plan.z_points), edges, safe_cell, rows, calls)
     if np.any(calls < 0):
         return None
     stats = _grid.scale_extensive(rows, mech.n_fields, 2.0 * math.pi / angle)

@@ -179,7 +179,8 @@ class DescribedMechanism(Mechanism):
         if spec is None:
             return ()
         return tuple((Tolerance(p.tolerance["volume"], p.tolerance["gci"]),
-                      SectorPlan(p.angles, p.radii, p.z_points, p.scan, p.bisections)) for p in spec.sector)
+                      SectorPlan(p.angles, p.radii, p.z_points, p.min_z_points, p.scan, p.bisections))
+                     for p in spec.sector)
 
     @property
     def field_kernel(self):

@@ -102,14 +102,16 @@ class PlanSpec(_Strict):
 class SectorSpec(_Strict):
     """One calibrated plan of the sector evaluator (evaluation.sector.SectorPlan; legs rotationally symmetric about
     z): the tolerance it was calibrated at and its Gauss-Legendre nodes over the sector's angle, over the radius and
-    per reachable z-interval, the radial scan steps and the bisections of the boundary radius."""
+    on a reachable z-interval as long as the box's z-range (shorter ones proportionally fewer, at least
+    min_z_points), the radial scan steps and the bisections of the boundary radius."""
 
     tolerance: dict[Literal["volume", "gci"], float]
     angles: int = Field(ge=1, le=64)
     radii: int = Field(ge=1, le=64)
     z_points: int = Field(ge=1, le=64)
-    scan: int = Field(default=16, ge=1, le=256)
-    bisections: int = Field(default=30, ge=1, le=60)
+    min_z_points: int = Field(default=1, ge=1, le=64)
+    scan: int = Field(default=8, ge=1, le=256)
+    bisections: int = Field(default=12, ge=1, le=60)
 
 
 class EvaluationSpec(_Strict):

@@ -75,11 +75,13 @@ def boundary_radius(p, c, s, rmax, zlo, zhi, nscan, nbisect, iv):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, edges, cell, row):
+def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin, edges, cell, row):
     """Statistics row (kernels.grid layout, 3 fields, row pre-initialised by grid.init_row) of the sector
     [phi0, phi1] of the workspace in [zlo, zhi], radius at most rmax, extensive columns NOT yet scaled to the whole
     turn; counts in units of ``cell`` (m^3). Gauss-Legendre nodes/weights on [-1, 1]: xphi, wphi over phi, xs, ws
-    over s in [0, 1] (r = R (1 - s^2)), xz, wz on each z-interval. Returns the kernel calls (interval + field), or
+    over s in [0, 1] (r = R (1 - s^2)); on a z-interval of length len the n-point rule xz[n, :n], wz[n, :n] (tables
+(nz + 1, nz)) with n = ceil(nz len / (zhi - zlo)) clamped to [zmin, nz]: nodes at about the same spacing on
+every interval. Returns the kernel calls (interval + field), or
     -1 when a column is not handled in closed form."""
     iv = np.empty((MAX_INTERVALS, 2))
     out = np.empty(3)
@@ -106,18 +108,20 @@ def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws
             calls += 1
             if k < 0:
                 return -1
+            nzmax = xz.shape[1]
             for m in range(k):
                 a = iv[m, 0]
                 h = 0.5 * (iv[m, 1] - a)
                 row[_grid.COL_COUNT] += wcol * 2.0 * h / cell  # the exact column length
-                for q in range(xz.shape[0]):
-                    z = a + h * (xz[q] + 1.0)
+                nq = min(nzmax, max(zmin, int(math.ceil(nzmax * 2.0 * h / (zhi - zlo)))))
+                for q in range(nq):
+                    z = a + h * (xz[nq, q] + 1.0)
                     point_fields(p, r * c, r * s, z, out)
                     calls += 1
                     lci = out[0]
                     if lci < 0.0:  # an interval's node is reachable by construction; rounding at an end: skip
                         continue
-                    w = wcol * h * wz[q] / cell
+                    w = wcol * h * wz[nq, q] / cell
                     for f in range(3):
                         v = out[f]
                         col = 1 + 4 * f
@@ -137,11 +141,11 @@ def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws
 
 
 @njit(cache=True, fastmath=FASTMATH, parallel=True)
-def population_sector_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, edges,
-                            cell, rows, calls):
+def population_sector_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin,
+                            edges, cell, rows, calls):
     """sector_row for every design (params (n, N_PACKED); rmax, zlo, zhi, cell: (n,)) into rows (n, columns) and
     calls (n,); parallel over designs (each writes its own row: the result does not depend on the threads)."""
     for d in prange(params.shape[0]):
         _grid.init_row(rows[d], 3)
         calls[d] = sector_row(params[d], phi0, phi1, rmax[d], zlo[d], zhi[d], nscan, nbisect, xphi, wphi, xs, ws,
-                              xz, wz, edges, cell[d], rows[d])
+                              xz, wz, zmin, edges, cell[d], rows[d])
