@@ -54,3 +54,14 @@ def test_the_sector_evaluator_agrees_with_the_numpy_twin_grid():
     gci = lci[reach].mean()
     assert abs(got["volume_m3"][0] / volume - 1.0) <= 0.01, (got["volume_m3"][0], volume)
     assert abs(got["gci"][0] - gci) <= 2e-3, (got["gci"][0], gci)
+
+
+def test_a_design_that_reaches_nothing_is_volume_0_and_gci_0_through_the_sector_plan():
+    """Arms of 0.1 m and forearms of 0.05 m: no platform point lies more than 0.15 m below the base plane, and the
+    region starts 0.3 m below it (configs/delta.yaml), so nothing is reachable."""
+    cfg = _cfg()
+    mech, options, region = cfg.mech, cfg.resolved_options(), cfg.grid.region
+    design = dict(cfg.resolved_design(), upper_arm=0.1, forearm=0.05)
+    got = evaluate_population(mech, [design], options, region=region, tolerance=PAPER)
+    assert got["volume_m3"][0] == 0.0 and got["gci"][0] == 0.0
+    assert np.isnan(got["min_lci"][0])  # a statistic over nothing is null

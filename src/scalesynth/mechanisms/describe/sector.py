@@ -41,12 +41,13 @@ def _column_length(p, x, y, zlo, zhi, iv):
 
 @njit(cache=True, fastmath=FASTMATH)
 def boundary_radius(p, c, s, rmax, zlo, zhi, nscan, nbisect, iv):
-    """R on the ray (cos, sin) = (c, s): the last of nscan equal steps in (0, rmax] whose column is nonempty,
-    refined by nbisect bisections against the next (empty) step; 0 when no step is nonempty, -1 when a column is
-    not handled in closed form. Returns (R, interval-kernel calls)."""
+    """R on the ray (cos, sin) = (c, s): the last of nscan equal steps in [0, rmax] whose column is nonempty
+    (r = 0 included: a workspace narrower than one step), refined by nbisect bisections against the next (empty)
+    step; 0 when no step is nonempty, -1 when a column is not handled in closed form. Returns (R, interval-kernel
+    calls)."""
     calls = 0
     last = -1
-    for i in range(nscan, 0, -1):
+    for i in range(nscan, -1, -1):
         r = rmax * i / nscan
         length, k = _column_length(p, r * c, r * s, zlo, zhi, iv)
         calls += 1
