@@ -5,8 +5,8 @@ intervals and the automatic calibration of scalesynth.calibration).
 
 Parts of the result:
 
-* ``accuracy``: the tolerance form on the Delta (configs/delta.yaml) at volume 0.2 % and GCI 5e-4, i.e. the plan
-  of its description's evaluation block, on 8 random designs in its bounds (seed ACCURACY_SEED, not one of the plan
+* ``accuracy``: the tolerance form on the Delta (configs/delta.yaml) at volume 0.2 % and GCI 5e-4, i.e. the sector
+  plan of its description's evaluation block (benchmarks/notes/sector_evaluator.md; the column plan without it), on 8 random designs in its bounds (seed ACCURACY_SEED, not one of the plan
   search's seeds 0-4) against the uniform N = 192 grid (field kernel at cell centres, no intervals), whose own error
   is judged against N = 96 (a 2x coarser one) on the same designs; and the time of the per-design calibration
   ladder (scalesynth.calibration) on the same designs, the description without its evaluation block.

@@ -170,5 +170,6 @@ def test_a_designs_calibrated_result_does_not_depend_on_its_population(ladder):
     for i, d in enumerate(designs):
         alone = evaluate_population(mech, [d], options, region=region, tolerance=tol)
         for key in ("volume_m3", "gci", "error_volume", "error_gci"):
-            assert alone[key][0] == together[key][i], key
+            # the description's sector plan (evaluation.sector) reports no error estimates: NaN, equal to NaN here
+            np.testing.assert_array_equal(alone[key][0], together[key][i], err_msg=key)
 

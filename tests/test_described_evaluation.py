@@ -36,7 +36,9 @@ def test_the_delta_plan_meets_its_tolerance_against_a_3x_finer_uniform_grid():
     random designs within configs/delta.yaml's bounds (seed 11, not one of the plan search's seeds 0-3): within the
     tolerance of the uniform N = 192 grid (LCI kernel at 7 077 888 cell centres, no column intervals, no
     refinement; the search's reference, 3x finer than N = 64), itself within 0.12 % and 2.1e-4 of N = 96 on such
-    designs (benchmarks/RESULTS.md, issue 28)."""
+    designs (benchmarks/RESULTS.md, issue 28). The description's sector plan (evaluation.sector) runs first for the
+    Delta's rotationally symmetric legs, so this checks the sector evaluator; the adaptive plan is still its
+    fallback (a design without the symmetry)."""
     cfg = load_config(ROOT / "configs" / "delta.yaml", PAPER)
     mech, options, region, tol = cfg.mech, cfg.resolved_options(), cfg.grid.region, config_tolerance(cfg)
     assert calibrated_plan(mech, tol).plan.columns == 12

@@ -12,6 +12,7 @@ from scalesynth.evaluation.adaptive import AdaptiveResult, adaptive_population_s
 from scalesynth.evaluation.assembly import field_mean
 from scalesynth.evaluation.grid import make_grid
 from scalesynth.evaluation.plans import Tolerance, calibrated_plan, uniform_resolution
+from scalesynth.evaluation.sector import sector_plan, sector_population_stats
 from scalesynth.kernels import grid as _grid
 
 if TYPE_CHECKING:  # annotations only: nothing here imports the mechanisms
@@ -29,12 +30,19 @@ def tolerance_population_stats(
     lci_only: bool = False,
     estimates: bool = True,
 ) -> AdaptiveResult:
-    """Statistics of every design under the tolerance form: an adaptive-evaluator plan calibrated for it
+    """Statistics of every design under the tolerance form: a sector plan calibrated for it (evaluation.sector;
+    rotationally symmetric legs only), an adaptive-evaluator plan calibrated for it
     (``Mechanism.calibrated_plans``, run at its calibration tolerance), the adaptive evaluator, or, for a mechanism
     with a calibrated uniform plan (``Mechanism.uniform_plan``), its uniform grid for ``tolerance``. There the error
     estimates are the change to the grid twice as fine (relative for the measure, absolute for the GCI), computed
     only with ``estimates`` (NaN without); the adaptive evaluator's come with its statistics. A mechanism with
     none of these climbs the per-design ladder (scalesynth.calibration)."""
+    sector = sector_plan(mech, tolerance)
+    if sector is not None:
+        # a description's sector plan (evaluation.sector), where the legs' rotational symmetry admits it
+        result = sector_population_stats(mech, designs, options, packed, edges, region, sector[1])
+        if result is not None:
+            return result
     calibrated = calibrated_plan(mech, tolerance)
     if calibrated is not None:
         # a plan calibrated at a tolerance at least as tight (a description's evaluation block), run at that

@@ -176,6 +176,19 @@ class DescribedMechanism(Mechanism):
                      for p in spec.plans)
 
     @property
+    def sector_plans(self) -> tuple:
+        """The description's sector plans (evaluation.sector) as (Tolerance, SectorPlan) pairs (none without)."""
+        from scalesynth.evaluation.plans import Tolerance
+        from scalesynth.evaluation.sector import SectorPlan
+
+        spec = self.description.evaluation if self.description is not None else None
+        if spec is None:
+            return ()
+        return tuple((Tolerance(p.tolerance["volume"], p.tolerance["gci"]),
+                      SectorPlan(p.angles, p.radii, p.z_points, p.min_z_points, p.scan, p.bisections))
+                     for p in spec.sector)
+
+    @property
     def field_kernel(self):
         return _k.point_fields
 

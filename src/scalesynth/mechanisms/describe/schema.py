@@ -99,11 +99,28 @@ class PlanSpec(_Strict):
     gauss_points: Literal[1, 2] = 2
 
 
+class SectorSpec(_Strict):
+    """One calibrated plan of the sector evaluator (evaluation.sector.SectorPlan; legs rotationally symmetric about
+    z): the tolerance it was calibrated at and its Gauss-Legendre nodes over the sector's angle, over the radius and
+    on a reachable z-interval as long as the box's z-range (shorter ones proportionally fewer, at least
+    min_z_points), the radial scan steps and the bisections of the boundary radius."""
+
+    tolerance: dict[Literal["volume", "gci"], float]
+    angles: int = Field(ge=1, le=64)
+    radii: int = Field(ge=1, le=64)
+    z_points: int = Field(ge=1, le=64)
+    min_z_points: int = Field(default=1, ge=1, le=64)
+    scan: int = Field(default=8, ge=1, le=256)
+    bisections: int = Field(default=12, ge=1, le=60)
+
+
 class EvaluationSpec(_Strict):
     """How the tolerance form evaluates this mechanism: plans calibrated against finer uniform grids (docs/
-    describing.md). A config tolerance no plan was calibrated for runs the per-design calibration ladder."""
+    describing.md). A config tolerance no plan was calibrated for runs the per-design calibration ladder. A
+    sector plan, where one is calibrated for the tolerance and the legs are rotationally symmetric, runs first."""
 
     plans: list[PlanSpec] = Field(min_length=1, max_length=8)
+    sector: list[SectorSpec] = Field(default=[], max_length=8)
 
 
 class Description(_Strict):
@@ -267,14 +284,17 @@ def _check_evaluation(desc: Description) -> None:
         raise ConfigError(f"evaluation: calibrated plans are read for motion 3T only, not {desc.motion} (leave the "
                           "block out)")
     seen = set()
+    for i, plan in enumerate(desc.evaluation.sector):
+        where = f"evaluation.sector[{i}].tolerance"
+        _check_tolerance(where, plan.tolerance)
+        pair = (plan.tolerance["volume"], plan.tolerance["gci"])
+        if pair in seen:
+            raise ConfigError(f"{where}: a second sector plan for volume {pair[0]:g}, GCI {pair[1]:g}")
+        seen.add(pair)
+    seen = set()
     for i, plan in enumerate(desc.evaluation.plans):
         where = f"evaluation.plans[{i}].tolerance"
-        for key in ("volume", "gci"):
-            if key not in plan.tolerance:
-                raise ConfigError(f"{where}: needs volume and gci (missing {key})")
-            value = plan.tolerance[key]
-            if not (math.isfinite(value) and 0.0 < value < 1.0):
-                raise ConfigError(f"{where}.{key}: expected a number in (0, 1), got {value!r}")
+        _check_tolerance(where, plan.tolerance)
         pair = (plan.tolerance["volume"], plan.tolerance["gci"])
         if pair in seen:
             raise ConfigError(f"{where}: a second plan for volume {pair[0]:g}, GCI {pair[1]:g}")
@@ -282,6 +302,16 @@ def _check_evaluation(desc: Description) -> None:
         if plan.field_levels > plan.levels:
             raise ConfigError(f"evaluation.plans[{i}].field_levels: {plan.field_levels} is deeper than levels "
                               f"{plan.levels}")
+
+
+def _check_tolerance(where: str, tolerance: dict[str, float]) -> None:
+    """A plan's tolerance names volume and gci, each finite and in (0, 1)."""
+    for key in ("volume", "gci"):
+        if key not in tolerance:
+            raise ConfigError(f"{where}: needs volume and gci (missing {key})")
+        value = tolerance[key]
+        if not (math.isfinite(value) and 0.0 < value < 1.0):
+            raise ConfigError(f"{where}.{key}: expected a number in (0, 1), got {value!r}")
 
 
 def _expression(where: str, value: Any, names: list[str]) -> expressions.Expression:

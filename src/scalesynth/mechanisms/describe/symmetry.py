@@ -45,3 +45,57 @@ def mirrored_legs(p: np.ndarray, axis: int) -> bool:
                     or np.allclose(na, -nb, rtol=0.0, atol=_RTOL * scale))
 
     return all(any(partner(i, j) for j in range(n)) for i in range(n))
+
+
+
+def mapped_legs(params: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Per design (params: (n, N_PACKED)), whether its legs map onto themselves under the linear map ``m`` (3 x 3,
+    a rotation about z or a mirror): each leg has a partner (possibly itself) with equal scalar slots whose base,
+    platform offset, arm (rail) and turn directions are the leg's mapped, and whose leg-plane normal is the mapped
+    one up to sign; with the stiffness fields on, also equal stiffness blocks and a load that ``m`` leaves as it is.
+    (n,) bool; one array pass for a whole population."""
+    params = np.atleast_2d(params)
+    n_legs = int(params[0, 0])
+    blocks = params[:, _k.HEAD : _k.HEAD + n_legs * _k.STRIDE].reshape(len(params), n_legs, _k.STRIDE)
+    # rounding of cos, sin of 2 pi / n (the kinematic slots only: the stiffness block's EA is ~1e7)
+    tol = _RTOL * 1e3 * np.maximum(1.0, np.abs(params[:, : _k.N_KINEMATIC]).max(axis=1))[:, None, None]
+    sc = blocks[:, :, list(_SCALARS)]
+    ok = np.all(np.abs(sc[:, :, None, :] - sc[:, None, :, :]) <= tol[..., None], axis=3)  # (n, i, j)
+    for s in _VECTORS:
+        v = blocks[:, :, s : s + 3]
+        mv = v @ m.T
+        ok &= np.all(np.abs(mv[:, :, None, :] - v[:, None, :, :]) <= tol[..., None], axis=3)
+    a = blocks[:, :, _k.AXIS : _k.AXIS + 3]
+    ma = a @ m.T
+    plus = np.all(np.abs(ma[:, :, None, :] - a[:, None, :, :]) <= tol[..., None], axis=3)
+    minus = np.all(np.abs(ma[:, :, None, :] + a[:, None, :, :]) <= tol[..., None], axis=3)
+    ok &= plus | minus
+    # the stiffness fields, where a design turns them on: partners with equal sections, springs and widths, and a
+    # load the map leaves alone (a load across the map's plane or turned by it gives other deflections)
+    stiff = params[:, _k.STIFF] > 0.0
+    if np.any(stiff):
+        sb = params[:, _k.SLEGS : _k.SLEGS + n_legs * _k.SSTRIDE].reshape(len(params), n_legs, _k.SSTRIDE)
+        stol = _RTOL * 1e3 * np.maximum(1.0, np.abs(sb).max(axis=(1, 2)))[:, None, None, None]
+        same = np.all(np.abs(sb[:, :, None, :] - sb[:, None, :, :]) <= stol, axis=3)
+        load = params[:, _k.LOAD : _k.LOAD + 3]
+        kept = np.all(np.abs(load @ m.T - load) <= _RTOL * 1e3 * np.maximum(1.0, np.abs(load).max(axis=1))[:, None],
+                      axis=1)
+        ok &= np.where(stiff[:, None, None], same & kept[:, None, None], True)
+    return np.all(np.any(ok, axis=2), axis=1)
+
+
+def fundamental_sectors(params: np.ndarray) -> np.ndarray:
+    """Per design (params: (n, N_PACKED)), the angle (rad) of the fundamental sector phi in [0, angle] of its legs'
+    symmetry about z: 2 pi / n_legs for n_legs-fold rotation (n_legs >= 2), halved when the legs are also mirrored
+    in y = 0 (the sector's first edge, phi = 0, is then a mirror line); NaN without rotational symmetry."""
+    params = np.atleast_2d(params)
+    n_legs = int(params[0, 0])
+    out = np.full(len(params), np.nan)
+    if n_legs < 2:
+        return out
+    a = 2.0 * np.pi / n_legs
+    rot = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    rotated = mapped_legs(params, rot)
+    mirrored = mapped_legs(params, np.diag([1.0, -1.0, 1.0]))
+    out[rotated] = np.where(mirrored, a / 2.0, a)[rotated]
+    return out
