@@ -28,6 +28,7 @@ def test_case_packer_example_is_packaged_and_valid():
     assert (spec.envelope.box.x, spec.envelope.box.y, spec.envelope.box.z) == (400, 300, 80)
     assert spec.cycle.picks_per_minute == 120 and spec.rated_payload == 1.0
     assert spec.stiffness.max_deflection == 0.1 and spec.stiffness.force == 150
+    assert spec.links.tube == [60, 4] and spec.links.youngs_modulus == 135 and spec.links.density == 1600
 
 
 @pytest.mark.parametrize("change, field", [
@@ -42,6 +43,11 @@ def test_case_packer_example_is_packaged_and_valid():
     ({"mechanisms": ["detla"]}, "mechanisms.0"),
     ({"search": {"population": 1}}, "search.population"),
     ({"colour": "red"}, "colour"),
+    ({"links": {"tube": [40, 25]}}, "links.tube"),
+    ({"links": {"tube": [40]}}, "links.tube"),
+    ({"links": {"youngs_modulus": -70}}, "links.youngs_modulus"),
+    ({"links": {"density": 1e6}}, "links.density"),
+    ({"links": {"colour": "black"}}, "links.colour"),
 ])
 def test_bad_spec_is_one_line_naming_the_field(change, field, tmp_path, capsys):
     bad = tmp_path / "bad.yaml"
@@ -89,6 +95,19 @@ def test_zone_in_metres_below_a_delta_and_above_a_2pauu():
     assert z.a == pytest.approx(0.25)  # half the 500 mm diagonal
     up = sizing.build("2pauu-ppap", spec)
     assert up.config["task"]["box"]["z"] == [0.3, 0.38]
+
+
+def test_the_specs_links_reach_each_candidates_stiffness_and_mass_models():
+    """links: the tube (spec unit mm) in each candidate's own unit (the Delta's m: 60 x 4 mm -> 0.06 x 0.004 m),
+    the modulus in its stiffness options, the density in its cycle's mass model; without links, the defaults."""
+    zone = {"envelope": {"box": {"x": 400, "y": 300, "z": 80}, "depth": 300}, "mechanisms": ["delta"],
+            "stiffness": {"max_deflection": 0.1, "force": 150}}
+    spec = spec_from_dict({**PLANAR, **zone, "links": {"tube": [60, 4], "youngs_modulus": 135, "density": 1600}})
+    cfg = sizing.build("delta", spec).config
+    assert cfg["options"]["tube"] == pytest.approx([0.06, 0.004], rel=1e-12)
+    assert cfg["options"]["youngs_modulus"] == 135 and cfg["dynamics"] == {"density": 1600.0}
+    plain = sizing.build("delta", spec_from_dict({**PLANAR, **zone})).config
+    assert "tube" not in plain["options"] and "youngs_modulus" not in plain["options"] and "dynamics" not in plain
 
 
 # ----- export ------------------------------------------------------------------------------------------------

@@ -212,6 +212,8 @@ def build(name: str, spec: DesignSpec) -> Candidate:
                                         {"metric": "cycle_feasible", "min": 1.0}]
     data: dict[str, Any] = {"name": f"{spec.name}-{name}", "mechanism": name, "units": {"length": unit},
                             "design": design, "options": options}
+    if spec.links is not None:
+        _apply_links(spec, mech, unit, options, data, notes)
     if spec.stiffness is not None and "task_max_deflection" in cat and "load" in mech.option_names:
         k = METRES_PER_UNIT[spec.units.length] / METRES_PER_UNIT[unit]
         load = [0.0] * len(mech.task_axes)
@@ -259,3 +261,20 @@ def _drop_unsupported_cycle(data: dict[str, Any], notes: list[str]) -> None:
         data.pop("motors", None)
         data["constraints"] = [c for c in data["constraints"] if c["metric"] not in CYCLE_METRICS]
         notes.append(f"cycle not evaluated: {text}")
+
+
+def _apply_links(spec, mech, unit: str, options: dict[str, Any], data: dict[str, Any], notes: list[str]) -> None:
+    """The spec's links (tube in the spec's unit, Young's modulus, density) into a candidate's options (its unit)
+    and its dynamics' density; a mechanism without a tube option keeps its own sections, said in a note."""
+    links = spec.links
+    k = METRES_PER_UNIT[spec.units.length] / METRES_PER_UNIT[unit]
+    for key, value in (("tube", None if links.tube is None else [v * k for v in links.tube]),
+                       ("youngs_modulus", links.youngs_modulus)):
+        if value is None:
+            continue
+        if key in mech.option_names:
+            options[key] = value
+        else:
+            notes.append(f"links.{key}: {mech.name} has no such option; its own links are used")
+    if links.density is not None:
+        data["dynamics"] = {"density": float(links.density)}

@@ -13,6 +13,7 @@ envelope:                       # one of box, cylinder, task
 payloads: [1.0]                 # kg; the largest is the rated payload the robot is designed for
 cycle: {preset: adept, picks_per_minute: 120, dwell_s: 0.0, law: modified_trapezoid}
 stiffness: {max_deflection: 0.1, force: 150}   # length unit, N (downward)
+links: {tube: [50, 3], youngs_modulus: 135, density: 1600}   # optional: length unit, GPa, kg/m^3
 motors: {catalogue: builtin, model: SGM7J-08A, gear_ratio: 20}
 mechanisms: null                # null = every registered mechanism that can do the task
 search: {population: 16, generations: 6, seed: 1}
@@ -191,6 +192,44 @@ class StiffnessSpec(_Strict):
         return _positive("", v)
 
 
+class LinksSpec(_Strict):
+    """The links every candidate is built from: a round tube and its material, for the stiffness model (section,
+    Young's modulus) and the mass model of the cycle (section, density). Null fields keep each mechanism's defaults
+    (aluminium 70 GPa, 2700 kg/m^3, a 40 x 3 mm tube)."""
+
+    tube: list[float] | None = Field(None, description="[outer diameter, wall] in the spec's length unit")
+    youngs_modulus: float | None = Field(None, description="GPa")
+    density: float | None = Field(None, description="kg/m^3")
+
+    @field_validator("tube")
+    @classmethod
+    def _tube(cls, v):
+        if v is None:
+            return v
+        if len(v) != 2:
+            raise ValueError(f"expected [outer diameter, wall], got {len(v)} numbers")
+        d, t = (_positive("", x) for x in v)
+        if 2.0 * t > d:
+            raise ValueError(f"the wall ({t:g}) is more than half the outer diameter ({d:g})")
+        return [d, t]
+
+    @field_validator("youngs_modulus")
+    @classmethod
+    def _modulus(cls, v):
+        v = _positive("", v)
+        if v is not None and v > 2000.0:
+            raise ValueError(f"{v:g} GPa is stiffer than any structural material (at most 2000 GPa)")
+        return v
+
+    @field_validator("density")
+    @classmethod
+    def _density(cls, v):
+        v = _positive("", v)
+        if v is not None and v > 25_000.0:
+            raise ValueError(f"{v:g} kg/m^3 is denser than any structural material (at most 25000 kg/m^3)")
+        return v
+
+
 class SearchSpec(_Strict):
     """The budget of each candidate's search (NSGA-II): small by default, so a spec runs in minutes."""
 
@@ -212,6 +251,7 @@ class DesignSpec(_Strict):
     payloads: list[float] = Field(default_factory=lambda: [1.0], min_length=1, max_length=16)
     cycle: CycleSpec
     stiffness: StiffnessSpec | None = None
+    links: LinksSpec | None = Field(None, description="tube section and material of every candidate's links")
     motors: dict[str, Any] | None = Field(None, description="a run config's motors section (catalogue, model, gear)")
     mechanisms: list[str] | None = Field(None, min_length=1, description="null = every one that can do the task")
     search: SearchSpec = Field(default_factory=SearchSpec)
