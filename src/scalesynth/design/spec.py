@@ -213,20 +213,14 @@ class LinksSpec(_Strict):
             raise ValueError(f"the wall ({t:g}) is more than half the outer diameter ({d:g})")
         return [d, t]
 
-    @field_validator("youngs_modulus")
+    @field_validator("youngs_modulus", "density")
     @classmethod
-    def _modulus(cls, v):
+    def _material(cls, v, info):
         v = _positive("", v)
-        if v is not None and v > 2000.0:
-            raise ValueError(f"{v:g} GPa is stiffer than any structural material (at most 2000 GPa)")
-        return v
-
-    @field_validator("density")
-    @classmethod
-    def _density(cls, v):
-        v = _positive("", v)
-        if v is not None and v > 25_000.0:
-            raise ValueError(f"{v:g} kg/m^3 is denser than any structural material (at most 25000 kg/m^3)")
+        # the largest of any structural material: diamond's modulus, osmium's density
+        limit, unit = {"youngs_modulus": (2000.0, "GPa"), "density": (25_000.0, "kg/m^3")}[info.field_name]
+        if v is not None and v > limit:
+            raise ValueError(f"{v:g} {unit} is beyond any structural material (at most {limit:g} {unit})")
         return v
 
 
