@@ -14,21 +14,12 @@ from scalesynth.evaluate import Tolerance, config_tolerance, evaluate_population
 from scalesynth.evaluation.plans import calibrated_plan
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.describe import BUILTIN_DIR, load_description, parse_description
+from test_calibration import _designs  # random designs within a config's bounds
 
 from conftest import ROOT
 
 PAPER = ["grid.tolerance.volume=0.002", "grid.tolerance.gci=0.0005"]
 DELTA_TEXT = (BUILTIN_DIR / "delta.yaml").read_text().replace("\nname: delta\n", "\nname: my-delta\n")
-
-
-def _designs(cfg, n, seed):
-    rng = np.random.default_rng(seed)
-    out = []
-    for _ in range(n):
-        d = cfg.resolved_design()
-        d.update({k: float(rng.uniform(lo, hi)) for k, (lo, hi) in cfg.bounds.items()})
-        out.append(d)
-    return out
 
 
 def test_the_delta_plan_meets_its_tolerance_against_a_3x_finer_uniform_grid():
