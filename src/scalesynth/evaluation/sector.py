@@ -69,15 +69,13 @@ def sector_population_stats(
     other fields than the 3T template's, some design's legs (with the stiffness fields on: their sections,
     springs and load) are not rotationally symmetric about z, or a
     column is not handled in closed form. No error estimates (NaN): the plan's accuracy is its calibration's."""
-    from scalesynth.mechanisms.describe import sector as _sk
-    from scalesynth.mechanisms.describe.symmetry import fundamental_sectors
-
-    if mech.n_fields != _sk.N_FIELDS or tuple(mech.task_axes) != ("x", "y", "z"):
+    # the mechanism's hooks (DescribedMechanism.sector_angle, .sector_kernel): nothing here imports the mechanisms
+    sector_angle = getattr(mech, "sector_angle", None)
+    if sector_angle is None or tuple(mech.task_axes) != ("x", "y", "z"):
         return None
-    angles = fundamental_sectors(packed)
-    if not (np.all(np.isfinite(angles)) and np.all(angles == angles[0])):
+    angle = sector_angle(packed)
+    if angle is None:
         return None
-    angle = float(angles[0])
     n = len(designs)
     lo, hi = design_boxes(mech, designs, options, region)
     rmax = np.sqrt(np.maximum(lo[:, 0] ** 2, hi[:, 0] ** 2) + np.maximum(lo[:, 1] ** 2, hi[:, 1] ** 2))
@@ -88,9 +86,9 @@ def sector_population_stats(
     xz, wz = gauss_tables(plan.z_points)
     rows = np.zeros((n, _grid.stat_columns(mech.n_fields, len(edges) - 1)))
     calls = np.zeros(n, dtype=np.int64)
-    _sk.population_sector_stats(packed, 0.0, angle, np.where(cell > 0.0, rmax, 0.0), lo[:, 2], hi[:, 2],
-                                plan.scan, plan.bisections, xp, wp, xs, ws, xz, wz,
-                                min(plan.min_z_points, plan.z_points), edges, safe_cell, rows, calls)
+    mech.sector_kernel(packed, 0.0, angle, np.where(cell > 0.0, rmax, 0.0), lo[:, 2], hi[:, 2],
+                       plan.scan, plan.bisections, xp, wp, xs, ws, xz, wz,
+                       min(plan.min_z_points, plan.z_points), edges, safe_cell, rows, calls)
     if np.any(calls < 0):
         return None
     stats = _grid.scale_extensive(rows, mech.n_fields, 2.0 * math.pi / angle)

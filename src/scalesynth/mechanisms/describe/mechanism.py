@@ -34,6 +34,7 @@ from scalesynth.mechanisms.base import (
 )
 from scalesynth.mechanisms.describe import bodies, expressions, frame, symmetry
 from scalesynth.mechanisms.describe import kernel as _k
+from scalesynth.mechanisms.describe import sector as _sector
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, Leg
 from scalesynth.mechanisms.describe.schema import Description, leg_frame
 from scalesynth.mechanisms.links import check_flag_option
@@ -187,6 +188,22 @@ class DescribedMechanism(Mechanism):
         return tuple((Tolerance(p.tolerance["volume"], p.tolerance["gci"]),
                       SectorPlan(p.angles, p.radii, p.z_points, p.min_z_points, p.scan, p.bisections))
                      for p in spec.sector)
+
+    def sector_angle(self, packed: np.ndarray) -> float | None:
+        """The fundamental sector (rad) about z shared by every design of ``packed`` ((n, N_PACKED): rotational
+        symmetry of the legs, halved by a mirror; symmetry.fundamental_sectors), None where there is none or the
+        fields are not the 3T template's (the sector evaluator, evaluation/sector.py)."""
+        if self.motion != "3T" or self.n_fields != _sector.N_FIELDS:
+            return None
+        angles = symmetry.fundamental_sectors(packed)
+        if not (np.all(np.isfinite(angles)) and np.all(angles == angles[0])):
+            return None
+        return float(angles[0])
+
+    @property
+    def sector_kernel(self):
+        """The sector evaluator's Numba population kernel (describe/sector.population_sector_stats)."""
+        return _sector.population_sector_stats
 
     @property
     def field_kernel(self):
