@@ -2,7 +2,7 @@
 
     python benchmarks/sector_experiment.py [n_designs] [seed] [nphi,ns,nz,nscan,nbisect[,zmin] ...]
 
-Random designs in configs/delta.yaml's bounds, region z in [-2.5, -0.3]; per setting (angles, radii, z-points,
+Random designs in configs/delta.yaml's bounds (SECTOR_CONFIG=linear_delta.yaml: another config's), its region; per setting (angles, radii, z-points,
 scan steps, bisections; with zmin the z-points are those of an interval as long as the box's z-range, shorter ones
 proportionally fewer but at least zmin, as SectorPlan's min_z_points; without, every interval nz): worst volume error (relative) and GCI error (absolute) as multiples of the paper tolerance (0.2 %, 5e-4),
 kernel calls and CPU ms per design. The reference rows are cached in /tmp (keyed by seed and count).
@@ -11,6 +11,7 @@ kernel calls and CPU ms per design. The reference rows are cached in /tmp (keyed
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -28,7 +29,7 @@ TOL_V, TOL_G = 0.002, 0.0005
 def reference(cfg, designs, seed, n=192):
     from scalesynth.evaluation.grid import make_grid
 
-    path = Path(f"/tmp/h31p_ref_{seed}_{len(designs)}_{n}.npz")
+    path = Path(f"/tmp/h31p_ref_{cfg.name}_{seed}_{len(designs)}_{n}.npz")
     if path.exists():
         z = np.load(path)
         return z["vol"], z["gci"]
@@ -49,6 +50,7 @@ def reference(cfg, designs, seed, n=192):
 def sector(cfg, designs, nphi, ns, nz, nscan, nbisect, zmin=None, sector_deg=60.0):
     from scalesynth.evaluation.grid import design_boxes
     from scalesynth.evaluation.sector import gauss_tables
+    from scalesynth.kernels.grid import stat_columns
     from scalesynth.mechanisms.describe import sector as sk
 
     mech, options, region = cfg.mech, cfg.resolved_options(), cfg.grid.region
@@ -66,7 +68,7 @@ def sector(cfg, designs, nphi, ns, nz, nscan, nbisect, zmin=None, sector_deg=60.
     else:
         xz, wz = gauss_tables(nz)
     n = len(designs)
-    rows = np.zeros((n, 1 + 12 + len(edges) - 1))
+    rows = np.zeros((n, stat_columns(sk.N_FIELDS, len(edges) - 1)))  # every field the kernel writes
     calls = np.zeros(n, dtype=np.int64)
     cell = np.ones(n) * 1e-6
     phi1 = math.radians(sector_deg)
@@ -85,7 +87,7 @@ def main(argv):
 
     n = int(argv[0]) if argv else 24
     seed = int(argv[1]) if len(argv) > 1 else 11
-    cfg = load_config(ROOT / "configs" / "delta.yaml", [])
+    cfg = load_config(ROOT / "configs" / os.environ.get("SECTOR_CONFIG", "delta.yaml"), [])
     designs = synthesis.random_designs(cfg, n, seed=seed)
     rv, rg = reference(cfg, designs, seed)
     sector(cfg, designs[:1], 4, 4, 2, 4, 4)  # compile
