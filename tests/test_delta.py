@@ -1,7 +1,8 @@
 """The rotary Delta, the first described mechanism (describe/, mechanisms/delta.yaml): leg IK and the Jacobian
 against finite differences of the forward kinematics and a NumPy twin (tests/naive_delta.py), FK round trips, the
 kernel's fields against the twin, conditioning on the central axis against its closed form, the published workspace
-of Briot, Arakelian and Glazunov, the linear-Delta leg (P-Pa), and bad descriptions."""
+of Briot, Arakelian and Glazunov, Williams' published IK/FK examples (rotary and linear), the linear-Delta leg
+(P-Pa), and bad descriptions."""
 
 import json
 import math
@@ -178,6 +179,50 @@ def test_workspace_of_the_briot_arakelian_glazunov_delta():
     rep = evaluate_config(cfg)
     assert rep.measure == pytest.approx(case["volume_m3"], abs=0.01)
     assert 0.0 < rep.gci < 1.0
+
+
+def _from_williams(p):
+    """A point of Williams' frame (leg 1 along -y) in the Delta's (leg 1 along +x): turned +90 deg about z."""
+    return np.array([-p[1], p[0], p[2]])
+
+
+def test_published_inverse_and_forward_kinematics_of_williams_deltas():
+    """Williams' worked examples (tests/data/delta_williams_kinematics.json: his printed snapshots of a rotary Delta
+    with ABB IRB 360-1/1600 proportions and a linear Delta 3D printer, with his geometry and frame mapped as written
+    there): the elbows-out IK ('kinked out'), the 'near' linear IK ('lower solution') and the 'low' FK give his
+    numbers. Tolerances: linear, half a unit of the last printed digit; rotary, 0.1 deg and 1 mm, his 0.05 deg and
+    0.5 mm of rounding plus 0.55 mm by which his nominal FK height (-1.065 m) differs from the exact one of his stated
+    dimensions (-1.06445 m: sqrt(l^2 - (w_B + L - u_P)^2)), an offset of his own computation. A wrong convention
+    (leg order, the sign or zero of theta, the elbow branch, the frame) is off by degrees or centimetres."""
+    data = json.loads((ROOT / "tests" / "data" / "delta_williams_kinematics.json").read_text())
+    case = data["rotary"]
+    dims = case["dimensions_m"]
+    design = DELTA.resolve_design({"base_radius": dims["s_B"] * math.sqrt(3) / 6,
+                                   "platform_radius": dims["s_P"] / math.sqrt(3),
+                                   "upper_arm": dims["L"], "forearm": dims["l"]})
+    options = DELTA.resolve_options({})
+    for ex in case["inverse"]:
+        q = {s.label: s.values for s in DELTA.inverse_kinematics(design, options, _from_williams(ex["p_m"]))}
+        np.testing.assert_allclose(np.degrees(q["out/out/out"]), ex["theta_deg"], rtol=0, atol=0.1, err_msg=ex["where"])
+    for ex in case["forward"]:
+        sols = {s.label: s.values for s in DELTA.forward_kinematics(design, options, np.radians(ex["theta_deg"]))}
+        np.testing.assert_allclose(sols["low"], _from_williams(ex["p_m"]), rtol=0, atol=1e-3, err_msg=ex["where"])
+
+    case = data["linear"]
+    dims = case["dimensions_m"]
+    linear = get("linear-delta")
+    design = linear.resolve_design({"base_radius": dims["s_B"] * math.sqrt(3) / 6,
+                                    "platform_radius": dims["s_P"] / math.sqrt(3), "forearm": dims["l"]})
+    options = linear.resolve_options({})
+    assert linear.kernel_branch(options) == "near/near/near"
+    for ex in case["inverse"]:
+        q = {s.label: s.values for s in linear.inverse_kinematics(design, options, _from_williams(ex["p_m"]))}
+        np.testing.assert_allclose(q["near/near/near"], ex["s_m"], rtol=0, atol=0.5 * 10.0 ** -ex["decimals"],
+                                   err_msg=ex["where"])
+    for ex in case["forward"]:
+        sols = {s.label: s.values for s in linear.forward_kinematics(design, options, np.array(ex["s_m"]))}
+        np.testing.assert_allclose(sols["low"], _from_williams(ex["p_m"]), rtol=0, atol=0.5 * 10.0 ** -ex["decimals"],
+                                   err_msg=ex["where"])
 
 
 LINEAR = {
