@@ -4,8 +4,9 @@ PyNite (PyNiteFEA, a maintained 3-D frame finite-element package, test-only depe
 of scalesynth's solver: nothing here uses scalesynth code. Planar models live in the global XY plane with the
 out-of-plane DOFs (DZ, RX, RY) held at every node. Joints: all parts meeting at a point share one node; a passive
 revolute joint is a moment release (Rz) of the link end it names (the first part that is a link end when both
-are), an actuator a rotational support spring at the base node, a fixed joint no release. Rigid bodies (hinge
-plates, platform) are stars of members 1e4 times stiffer than the stiffest link from the body's reference node.
+are), an actuator a rotational support spring at the base node (a slide along x or y to the base: a roller across
+it and a support spring along it), a fixed joint no release. Rigid bodies (hinge plates, platform) are stars of
+members 1e4 times stiffer than the stiffest link from the body's reference node.
 """
 
 from __future__ import annotations
@@ -54,7 +55,10 @@ def solve_model(model: dict, rigid: float = RIGID) -> np.ndarray:
         links_here = [p for p in parts if "." in p]
         others = [p for p in parts if "." not in p]
         for o in others:
-            if o == "base":
+            if o == "base" and j["kind"] == "prismatic":  # a slide along a global axis: roller across it
+                sup = supports.setdefault(n, {})
+                sup[_across(j["axes"][0])] = sup["RZ"] = True  # a slide holds the carriage's rotation
+            elif o == "base":
                 sup = supports.setdefault(n, {"DX": True, "DY": True})
                 if j["kind"] == "revolute" and j["name"] not in {a["joint"] for a in model["actuators"]}:
                     sup["RZ"] = True  # the released member does not need it; holds the node's spare DOF
@@ -67,7 +71,8 @@ def solve_model(model: dict, rigid: float = RIGID) -> np.ndarray:
             releases[name][5 if end == "a" else 11] = True
     for a in model["actuators"]:
         n = node(a["at"])
-        fe.def_support_spring(n, "RZ", a["stiffness"], None)
+        along = "RZ" if a["kind"] == "revolute" else {"DX": "DY", "DY": "DX"}[_across(a["axis"])]
+        fe.def_support_spring(n, along, a["stiffness"], None)
     for b, pts in body_points.items():
         ref = _key(bodies[b]["ref"])
         node(bodies[b]["ref"])
@@ -91,6 +96,14 @@ def solve_model(model: dict, rigid: float = RIGID) -> np.ndarray:
     fe.analyze_linear(check_stability=False)
     nd = fe.nodes[p]
     return np.array([nd.DX["Combo 1"], nd.DY["Combo 1"]])
+
+
+def _across(axis) -> str:
+    """The global direction across a planar slide's axis, which must lie along x or y (PyNite's supports and
+    support springs act along global axes)."""
+    ax, ay = float(axis[0]), float(axis[1])
+    assert min(abs(ax), abs(ay)) < 1e-12, f"planar slide along {axis}: only x or y slides are rebuilt"
+    return "DY" if abs(ax) > abs(ay) else "DX"
 
 
 AUX = 0.25  # length of an actuator's spring member (_fold_actuators), times the shortest link

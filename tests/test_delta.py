@@ -292,7 +292,8 @@ def _bad(**changes):
     (_bad(leg_limits="strok"),
      "d: legs[0] (leg).limits: unknown option 'strok' (did you mean 'stroke'?; known: stroke)"),
     (_bad(leg_arm_zero=[1, 0, 0]), "d: legs[0] (leg).arm_zero: P-Pa has no arm_zero (frame: rail)"),
-    (_bad(leg_pattern={"count": 4}), "d: legs: motion 3T needs 3 actuated legs (a square Jacobian), these give 4"),
+    (_bad(leg_pattern={"count": 4}),
+     "d: legs[0] (leg).pattern.count: motion 3T needs 3 actuated legs (a square Jacobian), these give 4"),
     (_bad(leg_branch="up"), "d: legs[0] (leg).branch: 'up' is not a branch of P-Pa (branches: far, near)"),
     (_bad(leg_base=["__import__('os')", 0, 0]),
      "d: legs[0] (leg).base.x: \"__import__('os')\": only numbers, parameters, pi, + - * / ** and sqrt, sin, cos, "

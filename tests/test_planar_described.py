@@ -240,7 +240,8 @@ def test_described_fivebar_has_the_hand_written_bodies_and_kinematics():
     (lambda d: d["legs"][0].__setitem__("arm_zero", [0, 0, 1]), "legs[0] (right).arm_zero: motion 2T is planar"),
     (lambda d: d.__setitem__("motion", "3T"), "legs[0] (right).type: a RR leg makes motion 2T, not 3T"),
     (lambda d: d["legs"].pop(), "legs: motion 2T needs 2 actuated legs"),
-    (lambda d: d.__setitem__("stiffness", {"youngs_modulus": 70}), "stiffness: motion 2T has no stiffness frame"),
+    (lambda d: d.__setitem__("stiffness", {"sections": {"upper_arm": [40, 3]}}),
+     "stiffness.sections.upper_arm: unknown link group"),
     (lambda d: d["legs"][1].__setitem__("branch", "out"), "legs[1] (left).branch: 'out' is not a branch of RR"),
 ])
 def test_bad_planar_descriptions_name_the_leg_and_field(change, message):

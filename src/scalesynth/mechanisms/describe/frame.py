@@ -31,13 +31,15 @@ from pydantic import BaseModel, ConfigDict, Field
 ROTARY_STIFFNESS_NM_PER_RAD = 1e5  # N m / rad
 LINEAR_STIFFNESS_N_PER_M = 2e7  # N / m
 LOAD_N = [0.0, 0.0, -150.0]  # N: 150 N down -z (z up in the Delta conventions)
+LOAD_2T_N = [0.0, -150.0]  # N: motion 2T, 150 N along -y (the seed-004 five-bar's: its workspace below the base)
 STIFFNESS_OPTIONS = ("youngs_modulus", "poisson_ratio", "tube", "sections", "actuator_stiffness", "load")
 
 
 class StiffnessSpec(BaseModel):
     """A description's ``stiffness:`` block: the defaults of the stiffness options (null = the shared default:
     aluminium 70 GPa, nu 0.33, a 40 x 3 mm tube; actuators 1e5 N m/rad rotary, 2e7 N/m linear). Lengths in the
-    description's length unit; ``sections`` by link group (upper_arm, forearm; 6-DOF: upper_arm, rod or leg)."""
+    description's length unit; ``sections`` by link group (upper_arm, forearm; 6-DOF: upper_arm, rod or leg; 2T: arm,
+    forearm)."""
 
     model_config = ConfigDict(extra="forbid")
 
@@ -51,15 +53,23 @@ class StiffnessSpec(BaseModel):
 def link_groups(code: float) -> tuple[str, ...]:
     """The elastic link groups of the frame of a mechanism whose legs have type code ``code`` (kernel codes)."""
     from scalesynth.mechanisms.describe import kernel as _k
+    from scalesynth.mechanisms.describe import kernel2 as _k2
     from scalesynth.mechanisms.describe import kernel6 as _k6
 
     return {_k.R_PA: ("upper_arm", "forearm"), _k.P_PA: ("forearm",), _k6.RUS: ("upper_arm", "rod"),
-            _k6.UPS: ("leg",)}[code]
+            _k6.UPS: ("leg",), _k2.RR: ("arm", "forearm"), _k2.PR: ("forearm",)}[code]
 
 
-def options(spec: StiffnessSpec | None, length_unit: str, rotary: bool):
+def load_dim(code: float) -> int:
+    """Force components of the load of a mechanism whose legs have type code ``code``: 2 for a planar (2T) one."""
+    from scalesynth.mechanisms.describe import kernel2 as _k2
+
+    return 2 if code in (_k2.RR, _k2.PR) else 3
+
+
+def options(spec: StiffnessSpec | None, length_unit: str, rotary: bool, planar: bool = False):
     """The stiffness Options of a described mechanism: the shared ones (sections.stiffness_options) with the
-    description's defaults laid over them."""
+    description's defaults laid over them; ``planar`` (motion 2T): a load in the plane."""
     from scalesynth.mechanisms.base import Option
     from scalesynth.mechanisms.describe.bodies import UNITS_PER_M
     from scalesynth.stiffness.sections import stiffness_options
@@ -69,7 +79,8 @@ def options(spec: StiffnessSpec | None, length_unit: str, rotary: bool):
         k, doc = ROTARY_STIFFNESS_NM_PER_RAD * per_m, f"torsional stiffness of each arm actuator, N {length_unit}/rad"
     else:
         k, doc = LINEAR_STIFFNESS_N_PER_M / per_m, f"axial stiffness of each carriage actuator, N/{length_unit}"
-    shared = stiffness_options(length_unit, k, doc + " (an assumption)", LOAD_N, "default 150 N down -z at P")
+    load, where = (LOAD_2T_N, "default 150 N along -y at P") if planar else (LOAD_N, "default 150 N down -z at P")
+    shared = stiffness_options(length_unit, k, doc + " (an assumption)", load, where)
     given = {} if spec is None else {k: v for k, v in spec.model_dump().items() if v is not None and v != {}}
     return tuple(Option(o.name, given.get(o.name, o.default), o.doc) for o in shared)
 
@@ -175,8 +186,8 @@ def check_spec(spec: StiffnessSpec | None, length_unit: str, code: float) -> Non
     from scalesynth.mechanisms.describe.legs import LEG_TYPES
 
     rotary = next(lt for lt in LEG_TYPES.values() if lt.code == code).joint_unit == "angle"
-    values = {o.name: o.default for o in options(spec, length_unit, rotary)}
+    values = {o.name: o.default for o in options(spec, length_unit, rotary, load_dim(code) == 2)}
     try:
-        check_stiffness_options(values, 3, link_groups(code))
+        check_stiffness_options(values, load_dim(code), link_groups(code))
     except InvalidParameter as err:
         raise ConfigError(str(err).replace("options.", "stiffness.", 1)) from None

@@ -31,11 +31,12 @@ from scalesynth.mechanisms.base import (
     svd_lci,
     wrap_angle,
 )
-from scalesynth.mechanisms.describe import bodies, expressions
+from scalesynth.mechanisms.describe import bodies, expressions, frame, frame2
 from scalesynth.mechanisms.describe import kernel2 as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, LegType
 from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, _footprint, _plans, _turn, _unit
 from scalesynth.mechanisms.describe.schema import Description
+from scalesynth.stiffness.sections import check_stiffness_options
 
 # capsule radii (m) when link_radius does not give them: the seed-004 five-bar's illustrative ones (25, 20, 15, 40 mm)
 PLANAR_RADII_M = {"base": 0.025, "arm": 0.02, "forearm": 0.015, "platform": 0.04, "rail": 0.02, "carriage": 0.03}
@@ -116,6 +117,7 @@ class PlanarMechanism(DescribedMechanism):
     # ----- options, legs and packing ----------------------------------------------------------------------
     def check_options(self, options: dict[str, Any]) -> None:
         bodies.check_link_radius(options, self._codes())
+        check_stiffness_options(options, 2, frame.link_groups(self._codes()[0]))
         for name, spec in self.description.options.items():
             if spec.kind == "range":
                 options[name] = parse_range(name, options[name])
@@ -252,7 +254,10 @@ class PlanarMechanism(DescribedMechanism):
         return links.LinkGeometry(tuple(segs), links.adjacency(pairs))
 
     def stiffness_model(self, design, options, pose, joints: str = "ideal"):
-        raise InvalidParameter(f"mechanism: {self.name} (motion 2T) has no stiffness frame yet")
+        """The planar stiffness frame (scalesynth.stiffness.FrameModel) at platform point ``pose`` in the kernel's
+        branch: cranks or carriages on their actuator springs, links pinned to them and to the platform pin
+        (frame2.py); ``joints`` 'bonded' welds the passive revolute joints."""
+        return frame2.stiffness_model(self, design, options, pose, joints)
 
     # ----- NumPy kinematics ----------------------------------------------------------------------------------
     def inverse_kinematics(self, design, options, pose) -> list[Solution]:
@@ -345,7 +350,7 @@ def from_description_2t(desc: Description) -> PlanarMechanism:
     plans = _plans(desc)
     rotary = LEG_TYPES[plans[0].type].joint_unit == "angle"
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items()) + (
-        Option("link_radius", None, LINK_RADIUS_DOC),)
+        Option("link_radius", None, LINK_RADIUS_DOC), *frame.options(desc.stiffness, desc.length_unit, rotary, True))
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = ("J = dx/dq (platform motion per rad of crank rotation)" if rotary else
            "J = dx/dq (platform motion per unit carriage motion)")

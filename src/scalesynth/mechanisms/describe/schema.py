@@ -259,20 +259,28 @@ def _check(desc: Description) -> None:
         count += leg.pattern.count if leg.pattern else 1
     from scalesynth.mechanisms.describe.frame import check_spec
 
-    if desc.motion == "2T" and desc.stiffness is not None:
-        raise ConfigError("stiffness: motion 2T has no stiffness frame yet (leave the block out)")
-    if desc.motion != "2T":
-        check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].code)
+    check_spec(desc.stiffness, desc.length_unit, LEG_TYPES[desc.legs[0].type].code)
     need = LEG_COUNT[desc.motion]
     if count != need:
-        raise ConfigError(f"legs: motion {desc.motion} needs {need} actuated legs (a square Jacobian), these give "
-                          f"{count}")
+        raise ConfigError(f"{_extra_leg(desc, need)}: motion {desc.motion} needs {need} actuated legs (a square "
+                          f"Jacobian), these give {count}")
     if len(kinds) > 1:
         raise ConfigError("legs: rotary and prismatic actuators together need a characteristic length (not handled "
                           "yet): use legs of one actuation kind")
     _check_evaluation(desc)
     if MOBILITY_CHECK is not None:
         MOBILITY_CHECK(desc)  # the legs make the motion type (a platform that cannot turn, held by its actuators)
+
+
+def _extra_leg(desc: Description, need: int) -> str:
+    """Where a wrong leg count is: the leg (and its pattern's count) whose actuators go past ``need``, an extra
+    actuator; 'legs' when there are too few."""
+    count = 0
+    for i, leg in enumerate(desc.legs):
+        count += leg.pattern.count if leg.pattern else 1
+        if count > need:
+            return f"legs[{i}] ({leg.name})" + (".pattern.count" if leg.pattern else "")
+    return "legs"
 
 
 def _check_evaluation(desc: Description) -> None:
