@@ -158,6 +158,9 @@ def population_sector_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, 
     calls (n,); parallel over designs (each writes its own row: the result does not depend on the threads). The
     stiffness stage is compiled and run only where some design's packed flag asks for it (module docstring)."""
     stiffness = True if np.any(params[:, STIFF] > 0.0) else None
+    # contiguous per-design arrays: a column of the boxes (lo[:, 2]) is strided, except for one design, and Numba
+    # would compile the kernel once for each layout
+    rmax, zlo, zhi, cell = (np.ascontiguousarray(a, dtype=np.float64) for a in (rmax, zlo, zhi, cell))
     _population_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin, edges,
                       cell, rows, calls, stiffness)
 
