@@ -12,7 +12,8 @@ from naive_sector import sector_volume_gci
 from scalesynth.config import load_config
 from scalesynth.evaluate import Tolerance, evaluate_population
 from scalesynth.evaluation.grid import design_boxes, make_grid
-from scalesynth.evaluation.sector import sector_plan
+from scalesynth.evaluation.sector import sector_plan, sector_population_stats
+from scalesynth.kernels.grid import N_STATS
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.describe.symmetry import fundamental_sectors
 
@@ -101,3 +102,25 @@ def test_a_load_the_rotation_does_not_keep_gives_no_sector():
     across = mech.pack(design, {**cfg.resolved_options(), "stiffness_metrics": True, "load": [40.0, 0.0, -150.0]})
     assert fundamental_sectors(down)[0] == math.pi / 3
     assert np.isnan(fundamental_sectors(across)[0])
+
+
+def test_the_stiffness_flag_changes_no_conditioning_statistic_of_the_sector_evaluator():
+    """Without options.stiffness_metrics the sector kernel runs point_lci at its nodes, with it point_fields
+    (describe/sector.py; the default vertical load keeps the sector): the count, the bands and the statistics of
+    LCI, sigma_min and sigma_max are the same bits either way (point_lci's slots 0-2 are point_fields', kernel.py),
+    the stiffness fields' statistics 0 without the flag and positive with it."""
+    cfg = _cfg()
+    mech, region, design = cfg.mech, cfg.grid.region, cfg.resolved_design()
+    edges = np.array(cfg.dexterity.band_edges)
+    rows = {}
+    for flag in (False, True):
+        options = {**cfg.resolved_options(), "stiffness_metrics": flag}
+        packed = mech.pack(design, options)[None, :]
+        rows[flag] = sector_population_stats(mech, [design], options, packed, edges, region,
+                                             sector_plan(mech, PAPER)[1]).stats[0]
+    stiff = slice(1 + N_STATS * 3, 1 + N_STATS * mech.n_fields)  # stiffness_min, deflection
+    same = np.r_[0:stiff.start, stiff.stop:rows[True].shape[0]]
+    assert rows[True][0] > 0.0
+    np.testing.assert_array_equal(rows[False][same], rows[True][same])
+    assert np.all(rows[False][stiff] == 0.0)
+    assert rows[True][stiff][0] > 0.0 and rows[True][stiff][N_STATS] > 0.0  # the sums of both fields

@@ -154,13 +154,17 @@ def _leg(p, k, x, y, z):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _fields(p, x, y, z, out, conditioning, stiffness=False):
+def _fields(p, x, y, z, out, conditioning, stiffness=None):
     """Slots 0-2 (LCI, sigma_min, sigma_max of dx/dq) at P, or write_unreachable; ``conditioning`` (a constant)
-    False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel); ``stiffness`` (a
-    constant) True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set)."""
-    k1 = HEAD
-    k2 = HEAD + STRIDE
-    k3 = HEAD + 2 * STRIDE
+    False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel); ``stiffness`` True also
+    writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set), None (default) leaves them: a
+    None test, because Numba drops the branch of a None argument by its type but compiles both branches of a
+    literal bool's (the stiffness stage is about half the template's compile time)."""
+    # np.int64, not the literal HEAD: Numba would compile _leg a second time for the literal 2 (the column
+    # kernel's loop calls it with an int64)
+    k1 = np.int64(HEAD)
+    k2 = k1 + STRIDE
+    k3 = k1 + 2 * STRIDE
     ok, ax, ay, az, j1, _ = _leg(p, k1, x, y, z)
     if not ok:
         _grid.write_unreachable(out)
@@ -197,7 +201,7 @@ def _fields(p, x, y, z, out, conditioning, stiffness=False):
     else:
         out[1] = smin / ad
         out[2] = smax / ad
-    if stiffness:
+    if stiffness is not None:
         if p[STIFF] > 0.0:
             out[F_STIFFNESS_MIN], out[F_DEFLECTION] = _stiffness(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz)
         else:
@@ -218,7 +222,7 @@ def point_fields(p, x, y, z, out):
 def point_lci(p, x, y, z, out):
     """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel: a search whose
     workspace metrics are the LCI's alone); slots 3-4 not written."""
-    _fields(p, x, y, z, out, True, False)
+    _fields(p, x, y, z, out, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -372,9 +376,11 @@ def _stiffness(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz):
     fy = p[LOAD + 1]
     fz = p[LOAD + 2]
     kk = (0.0,) * 21
-    ok1, kk = _add_leg(kk, p, HEAD, SLEGS, x, y, z, ax, ay, az)
-    ok2, kk = _add_leg(kk, p, HEAD + STRIDE, SLEGS + SSTRIDE, x, y, z, bx, by, bz)
-    ok3, kk = _add_leg(kk, p, HEAD + 2 * STRIDE, SLEGS + 2 * SSTRIDE, x, y, z, cx, cy, cz)
+    k = np.int64(HEAD)  # int64 block offsets: the literals would compile _add_leg twice (_fields' comment)
+    s = np.int64(SLEGS)
+    ok1, kk = _add_leg(kk, p, k, s, x, y, z, ax, ay, az)
+    ok2, kk = _add_leg(kk, p, k + STRIDE, s + SSTRIDE, x, y, z, bx, by, bz)
+    ok3, kk = _add_leg(kk, p, k + 2 * STRIDE, s + 2 * SSTRIDE, x, y, z, cx, cy, cz)
     if not (ok1 and ok2 and ok3):
         return 0.0, (0.0 if (fx == 0.0 and fy == 0.0 and fz == 0.0) else _sl.DEFLECTION_CAP)
     return _sl.response_upper(kk, fx, fy, fz, p[CHAR_LEN])

@@ -24,6 +24,7 @@ J_x or J_q loses rank. Each f_i is divided by l_i first (rows and J_q alike), wh
 
 import math
 
+import numpy as np
 from numba import njit
 
 from scalesynth.kernels import grid as _grid
@@ -126,11 +127,12 @@ def _leg(p, k, x, y):
 def _fields(p, x, y, out, conditioning):
     """Slots 0-2 (LCI, sigma_min, sigma_max of dx/dq) at P, or write_unreachable; ``conditioning`` (a constant)
     False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel)."""
-    ok, ax, ay, j1, _, _ = _leg(p, HEAD, x, y)
+    k1 = np.int64(HEAD)  # not the literal HEAD: Numba would compile _leg for it and again for HEAD + STRIDE's int64
+    ok, ax, ay, j1, _, _ = _leg(p, k1, x, y)
     if not ok:
         _grid.write_unreachable(out)
         return
-    ok, bx, by, j2, _, _ = _leg(p, HEAD + STRIDE, x, y)
+    ok, bx, by, j2, _, _ = _leg(p, k1 + STRIDE, x, y)
     if not ok:
         _grid.write_unreachable(out)
         return

@@ -198,11 +198,11 @@ def _jacobi_extremes(g):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def _fields(p, x, y, z, out, conditioning, stiffness=False):
+def _fields(p, x, y, z, out, conditioning, stiffness=None):
     """Slots 0-2 (LCI, sigma_min, sigma_max of the homogenised dx/dq) at P, or write_unreachable; ``conditioning``
     (a constant) False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel);
-    ``stiffness`` (a constant) True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is
-    set)."""
+    ``stiffness`` True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set), None
+    (default) leaves them (a None test: Numba compiles both branches of a literal bool's; kernel.py's _fields)."""
     inv_l = p[INV_L]
     g = np.empty((6, 6))
     square = False
@@ -240,7 +240,7 @@ def _fields(p, x, y, z, out, conditioning, stiffness=False):
         else:
             out[0] = min(1.0, smin / smax)
             out[1], out[2] = inverse_singular_values(smin, smax)
-    if stiffness:
+    if stiffness is not None:
         if p[STIFF] > 0.0:
             # an inverse singularity is not one of the frame: the arm's bending and its spring still hold the rod
             out[F_STIFFNESS_MIN], out[F_DEFLECTION] = _stiffness(p, x, y, z)
@@ -310,7 +310,7 @@ def point_fields(p, x, y, z, out):
 def point_lci(p, x, y, z, out):
     """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel); slots 3-4 not
     written."""
-    _fields(p, x, y, z, out, True, False)
+    _fields(p, x, y, z, out, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)

@@ -216,6 +216,14 @@ class DescribedMechanism(Mechanism):
         return _k.point_lci if self.field_kernel is _k.point_fields else self.field_kernel
 
     @property
+    def point_kernel(self):
+        """The scalar LCI kernel (Mechanism.point_kernel) over ``lci_kernel`` instead of the field kernel: the same
+        LCI bit for bit, and a cycle or a single point never compiles the stiffness stage."""
+        from scalesynth.kernels.grid import lci_kernel
+
+        return lci_kernel(self.lci_kernel, self.n_fields)
+
+    @property
     def reach_kernel(self):
         return _k.point_reach
 

@@ -15,6 +15,10 @@ the three rules' weights); the statistics row (kernels.grid layout) accumulates 
 count = volume in units of the caller's cell, sums of every field (LCI, sigma_min, sigma_max, and the stiffness
 fields, 0 unless the packed design turns them on) and sums of squares,
 bands of LCI, and min/max over the nodes (an estimate from inside, as every grid's).
+
+The stiffness stage is about half of the template's compile time, so the nodes run point_fields only where some
+design's packed flag (options.stiffness_metrics) is set, else point_lci (slots 0-2 bit for bit, slots 3-4 left 0
+as point_fields writes them with the flag off): a run without the flag never compiles the stiffness stage.
 """
 
 import math
@@ -24,7 +28,7 @@ from numba import njit, prange
 
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.describe.kernel import F_DEFLECTION, column_intervals, point_fields
+from scalesynth.mechanisms.describe.kernel import F_DEFLECTION, STIFF, column_intervals, point_fields, point_lci
 
 MAX_INTERVALS = 8  # reachable z-intervals per column (column_intervals' K)
 N_FIELDS = F_DEFLECTION + 1  # the template's fields: LCI, sigma_min, sigma_max, stiffness_min, deflection
@@ -78,16 +82,18 @@ def boundary_radius(p, c, s, rmax, zlo, zhi, nscan, nbisect, iv):
 
 
 @njit(cache=True, fastmath=FASTMATH)
-def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin, edges, cell, row):
+def sector_row(p, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin, edges, cell, row,
+               stiffness):
     """Statistics row (kernels.grid layout, N_FIELDS fields, row pre-initialised by grid.init_row) of the sector
     [phi0, phi1] of the workspace in [zlo, zhi], radius at most rmax, extensive columns NOT yet scaled to the whole
     turn; counts in units of ``cell`` (m^3). Gauss-Legendre nodes/weights on [-1, 1]: xphi, wphi over phi, xs, ws
     over s in [0, 1] (r = R (1 - s^2)); on a z-interval of length len the n-point rule xz[n, :n], wz[n, :n] (tables
 (nz + 1, nz)) with n = ceil(nz len / (zhi - zlo)) clamped to [zmin, nz]: nodes at about the same spacing on
-every interval. Returns the kernel calls (interval + field), or
-    -1 when a column is not handled in closed form."""
+every interval. ``stiffness`` True: the nodes run point_fields; None: point_lci (the stiffness fields stay 0; a
+    None test, kernel._fields' comment: only the branch taken is compiled). Returns the kernel calls (interval +
+    field), or -1 when a column is not handled in closed form."""
     iv = np.empty((MAX_INTERVALS, 2))
-    out = np.empty(N_FIELDS)
+    out = np.zeros(N_FIELDS)  # point_lci writes slots 0-2 alone
     nb = edges.shape[0] - 1
     band0 = _grid.band_column(N_FIELDS, 0)
     calls = 0
@@ -119,7 +125,10 @@ every interval. Returns the kernel calls (interval + field), or
                 nq = min(nzmax, max(zmin, int(math.ceil(nzmax * 2.0 * h / (zhi - zlo)))))
                 for q in range(nq):
                     z = a + h * (xz[nq, q] + 1.0)
-                    point_fields(p, r * c, r * s, z, out)
+                    if stiffness is None:
+                        point_lci(p, r * c, r * s, z, out)
+                    else:
+                        point_fields(p, r * c, r * s, z, out)
                     calls += 1
                     lci = out[0]
                     if lci < 0.0:  # an interval's node is reachable by construction; rounding at an end: skip
@@ -143,12 +152,24 @@ every interval. Returns the kernel calls (interval + field), or
     return calls
 
 
-@njit(cache=True, fastmath=FASTMATH, parallel=True)
 def population_sector_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin,
                             edges, cell, rows, calls):
     """sector_row for every design (params (n, N_PACKED); rmax, zlo, zhi, cell: (n,)) into rows (n, columns) and
-    calls (n,); parallel over designs (each writes its own row: the result does not depend on the threads)."""
+    calls (n,); parallel over designs (each writes its own row: the result does not depend on the threads). The
+    stiffness stage is compiled and run only where some design's packed flag asks for it (module docstring)."""
+    stiffness = True if np.any(params[:, STIFF] > 0.0) else None
+    # contiguous per-design arrays: a column of the boxes (lo[:, 2]) is strided, except for one design, and Numba
+    # would compile the kernel once for each layout
+    rmax, zlo, zhi, cell = (np.ascontiguousarray(a, dtype=np.float64) for a in (rmax, zlo, zhi, cell))
+    _population_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin, edges,
+                      cell, rows, calls, stiffness)
+
+
+@njit(cache=True, fastmath=FASTMATH, parallel=True)
+def _population_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, xphi, wphi, xs, ws, xz, wz, zmin, edges,
+                      cell, rows, calls, stiffness):
+    """population_sector_stats; ``stiffness`` True or None as sector_row's (one compilation for each)."""
     for d in prange(params.shape[0]):
         _grid.init_row(rows[d], N_FIELDS)
         calls[d] = sector_row(params[d], phi0, phi1, rmax[d], zlo[d], zhi[d], nscan, nbisect, xphi, wphi, xs, ws,
-                              xz, wz, zmin, edges, cell[d], rows[d])
+                              xz, wz, zmin, edges, cell[d], rows[d], stiffness)
