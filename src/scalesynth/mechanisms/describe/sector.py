@@ -13,7 +13,7 @@ a vertical tangent) into a smooth factor of s; s and phi run over Gauss-Legendre
 is a Gauss-Legendre rule on every reachable z-interval (nz nodes per interval, the weight of a node the product of
 the three rules' weights); the statistics row (kernels.grid layout) accumulates those nodes with those weights:
 count = volume in units of the caller's cell, sums of every field (LCI, sigma_min, sigma_max, and the stiffness
-fields, 0 unless the packed design turns them on) and sums of squares,
+and clearance fields, 0 unless the packed design turns them on) and sums of squares,
 bands of LCI, and min/max over the nodes (an estimate from inside, as every grid's).
 """
 
@@ -24,10 +24,10 @@ from numba import njit, prange
 
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.describe.kernel import F_DEFLECTION, column_intervals, point_fields
+from scalesynth.mechanisms.describe.kernel import F_CLEARANCE, column_intervals, point_fields
 
 MAX_INTERVALS = 8  # reachable z-intervals per column (column_intervals' K)
-N_FIELDS = F_DEFLECTION + 1  # the template's fields: LCI, sigma_min, sigma_max, stiffness_min, deflection
+N_FIELDS = F_CLEARANCE + 1  # the template's fields: LCI, sigma_min, sigma_max, stiffness_min, deflection, clearance
 
 
 @njit(cache=True, fastmath=FASTMATH)

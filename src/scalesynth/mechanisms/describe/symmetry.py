@@ -20,7 +20,8 @@ def mirrored_legs(p: np.ndarray, axis: int) -> bool:
     cone, whose base, platform offset, arm (rail) direction and turn direction are the leg's reflected, and whose
     leg-plane normal is the reflected one up to sign (the kernel reads only |f . normal|). With the per-voxel
     stiffness fields on (the packed flag), partners also need equal sections, actuator springs and widths, and the
-    load must have no component across the plane (a reflected load would give other deflections)."""
+    load must have no component across the plane (a reflected load would give other deflections). With the
+    clearance field on, _clearance_keeps_symmetry."""
     n = int(p[0])
     blocks = [p[_k.HEAD + i * _k.STRIDE : _k.HEAD + (i + 1) * _k.STRIDE] for i in range(n)]
     stiff = [p[_k.SLEGS + i * _k.SSTRIDE : _k.SLEGS + (i + 1) * _k.SSTRIDE] for i in range(n)]
@@ -29,6 +30,8 @@ def mirrored_legs(p: np.ndarray, axis: int) -> bool:
     flip[axis] = -1.0
     with_stiffness = p[_k.STIFF] > 0.0
     if with_stiffness and p[_k.LOAD + axis] != 0.0:
+        return False
+    if not _clearance_keeps_symmetry(p):
         return False
 
     def partner(i: int, j: int) -> bool:
@@ -52,8 +55,8 @@ def mapped_legs(params: np.ndarray, m: np.ndarray) -> np.ndarray:
     """Per design (params: (n, N_PACKED)), whether its legs map onto themselves under the linear map ``m`` (3 x 3,
     a rotation about z or a mirror): each leg has a partner (possibly itself) with equal scalar slots whose base,
     platform offset, arm (rail) and turn directions are the leg's mapped, and whose leg-plane normal is the mapped
-    one up to sign; with the stiffness fields on, also equal stiffness blocks and a load that ``m`` leaves as it is.
-    (n,) bool; one array pass for a whole population."""
+    one up to sign; with the stiffness fields on, also equal stiffness blocks and a load that ``m`` leaves as it is;
+    with the clearance field on, _clearance_keeps_symmetry. (n,) bool; one array pass for a whole population."""
     params = np.atleast_2d(params)
     n_legs = int(params[0, 0])
     blocks = params[:, _k.HEAD : _k.HEAD + n_legs * _k.STRIDE].reshape(len(params), n_legs, _k.STRIDE)
@@ -81,7 +84,15 @@ def mapped_legs(params: np.ndarray, m: np.ndarray) -> np.ndarray:
         kept = np.all(np.abs(load @ m.T - load) <= _RTOL * 1e3 * np.maximum(1.0, np.abs(load).max(axis=1))[:, None],
                       axis=1)
         ok &= np.where(stiff[:, None, None], same & kept[:, None, None], True)
-    return np.all(np.any(ok, axis=2), axis=1)
+    return np.all(np.any(ok, axis=2), axis=1) & np.array([_clearance_keeps_symmetry(row) for row in params])
+
+
+def _clearance_keeps_symmetry(p: np.ndarray) -> bool:
+    """Whether the clearance block of a packed design keeps every symmetry of its legs: off, or on with the legs'
+    capsules alike (bodies.uniform_legs: the capsules are built from the legs' points, so a map of the legs onto
+    themselves maps them onto themselves, with their radii) and without interference_free (the column intervals
+    and the sector evaluator do not see the capsules' overlap: the evaluator falls back to nodes and bisection)."""
+    return not (p[_k.CLEAR] > 0.0 and (p[_k.UNIFORM] <= 0.0 or p[_k.FREE] > 0.0))
 
 
 def fundamental_sectors(params: np.ndarray) -> np.ndarray:
