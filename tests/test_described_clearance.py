@@ -84,16 +84,23 @@ def test_flags_and_interference_free():
     DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({"clearance_metrics": True})), *pose, on)
     DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({})), *pose, off)
     assert off[SLOT] == 0.0 and np.array_equal(on[:SLOT], off[:SLOT]) and on[SLOT] > 0.0
-    # thick forearms (0.3 m, their bars 0.1 m apart) overlap everywhere: interference_free leaves nothing reachable,
-    # in the field, LCI and reach kernels alike, and the column intervals hand the columns to nodes and bisection
-    fat = {"link_radius": {"forearm": 0.3}}
-    twin = _twin(DELTA, d, DELTA.resolve_options(fat), pose)
-    assert twin < 0.0
+    # a fat platform capsule (it meets the upper arms and the base in about half the poses): interference_free keeps
+    # exactly the reachable poses whose clearance is >= 0, in the field, LCI and reach kernels alike, and the column
+    # intervals hand every column to nodes and bisection
+    fat = DELTA.resolve_options({"theta_limits": [0.0, 1.6], "clearance_metrics": True,
+                                 "link_radius": {"platform": 0.86}})
     free = DELTA.pack(d, DELTA.resolve_options({**fat, "interference_free": True}))
-    for kernel in (DELTA.field_kernel, DELTA.lci_kernel, DELTA.reach_kernel):
+    plain, kept, rng = DELTA.pack(d, fat), [], np.random.default_rng(7)
+    for pose in _reachable(DELTA, d, fat, rng, 40):
         out = np.zeros(6)
-        kernel(free, *pose, out)
-        assert out[0] == -1.0
+        DELTA.field_kernel(plain, *pose, out)
+        gap = _twin(DELTA, d, fat, pose)
+        assert out[SLOT] == pytest.approx(gap, abs=1e-12)
+        for kernel in (DELTA.field_kernel, DELTA.lci_kernel, DELTA.reach_kernel):
+            kernel(free, *pose, out)
+            assert (out[0] >= 0.0) == (gap >= 0.0)
+        kept.append(gap >= 0.0)
+    assert 0 < sum(kept) < len(kept)  # both kinds of pose were met
     assert DELTA.interval_kernel(free, 0.0, 0.0, -2.0, -0.3, np.zeros((8, 2))) == -1
     # symmetry: alike legs keep the Delta's 60 degree sector and its y mirror; one thicker arm breaks both
     alike = DELTA.pack(d, DELTA.resolve_options({"clearance_metrics": True}))

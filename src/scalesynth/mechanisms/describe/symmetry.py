@@ -31,7 +31,7 @@ def mirrored_legs(p: np.ndarray, axis: int) -> bool:
     with_stiffness = p[_k.STIFF] > 0.0
     if with_stiffness and p[_k.LOAD + axis] != 0.0:
         return False
-    if not _clearance_keeps_symmetry(p):
+    if not bool(_clearance_keeps_symmetry(p)):
         return False
 
     def partner(i: int, j: int) -> bool:
@@ -84,15 +84,17 @@ def mapped_legs(params: np.ndarray, m: np.ndarray) -> np.ndarray:
         kept = np.all(np.abs(load @ m.T - load) <= _RTOL * 1e3 * np.maximum(1.0, np.abs(load).max(axis=1))[:, None],
                       axis=1)
         ok &= np.where(stiff[:, None, None], same & kept[:, None, None], True)
-    return np.all(np.any(ok, axis=2), axis=1) & np.array([_clearance_keeps_symmetry(row) for row in params])
+    return np.all(np.any(ok, axis=2), axis=1) & _clearance_keeps_symmetry(params)
 
 
-def _clearance_keeps_symmetry(p: np.ndarray) -> bool:
-    """Whether the clearance block of a packed design keeps every symmetry of its legs: off, or on with the legs'
-    capsules alike (bodies.uniform_legs: the capsules are built from the legs' points, so a map of the legs onto
-    themselves maps them onto themselves, with their radii) and without interference_free (the column intervals
-    and the sector evaluator do not see the capsules' overlap: the evaluator falls back to nodes and bisection)."""
-    return not (p[_k.CLEAR] > 0.0 and (p[_k.UNIFORM] <= 0.0 or p[_k.FREE] > 0.0))
+def _clearance_keeps_symmetry(p: np.ndarray) -> np.ndarray:
+    """Whether the clearance block of each packed design (p: (N_PACKED,) or (n, N_PACKED)) keeps every symmetry of
+    its legs: off, or on with the legs' capsules alike (bodies.uniform_legs: the capsules are built from the legs'
+    points, so a map of the legs onto themselves maps them onto themselves, with their radii) and without
+    interference_free (the column intervals and the sector evaluator do not see the capsules' overlap: the
+    evaluator falls back to nodes and bisection)."""
+    p = np.asarray(p)
+    return ~((p[..., _k.CLEAR] > 0.0) & ((p[..., _k.UNIFORM] <= 0.0) | (p[..., _k.FREE] > 0.0)))
 
 
 def fundamental_sectors(params: np.ndarray) -> np.ndarray:
