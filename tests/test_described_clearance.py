@@ -132,8 +132,15 @@ def test_evaluate_reports_the_clearance_of_the_delta(tmp_path):
     # the task grid's cell centres (evaluation.grid.task_grid)
     axes = [lo + (np.arange(3) + 0.5) * (hi - lo) / 3 for lo, hi in (cfg["task"]["box"][a] for a in "xyz")]
     twin = min(_twin(DELTA, d, opts, np.array(p)) for p in np.stack(np.meshgrid(*axes), -1).reshape(-1, 3))
-    # 0.276 m for the default Delta (default radii): two legs' forearm bars, at (0.133, -0.1, -1.067)
     assert metrics["task_min_clearance_m"] == pytest.approx(twin, rel=1e-9)
+    # and a closed form: in this box the closest capsules are two legs' neighbouring forearm bars at their platform
+    # ends, Q_1 + h n_1 = (r, h, .) and its neighbour Q_2 - h n_2 = Rz(120 deg) (r, -h) (r = platform_radius 0.2 m,
+    # h = half the 0.1 m width; the bars spread apart towards the elbows), minus two forearm radii (0.01 m default):
+    # 0.2964 - 0.02 = 0.2764 m at every pose of the box (the platform translates)
+    r, h, c, s = 0.2, 0.05, np.cos(2 * np.pi / 3), np.sin(2 * np.pi / 3)
+    closed = np.hypot(r - (r * c + h * s), h - (r * s - h * c)) - 2 * 0.01
+    assert metrics["task_min_clearance_m"] == pytest.approx(closed, rel=1e-12)
+    assert metrics["task_max_clearance_m"] == pytest.approx(closed, rel=1e-12)
     assert metrics["min_clearance_m"] <= metrics["task_min_clearance_m"]
     # without the flag the metric is refused in one line
     cfg["options"].pop("clearance_metrics")
