@@ -84,6 +84,10 @@ def test_flags_and_interference_free():
     DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({"clearance_metrics": True})), *pose, on)
     DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({})), *pose, off)
     assert off[SLOT] == 0.0 and np.array_equal(on[:SLOT], off[:SLOT]) and on[SLOT] > 0.0
+    # the cycle reads the kernel's slot only where it is computed (else link_geometry per sample)
+    assert DELTA.kernel_clearance(DELTA.resolve_options({"clearance_metrics": True}))
+    assert not DELTA.kernel_clearance(DELTA.resolve_options({}))
+    assert HEXAPOD.kernel_clearance(HEXAPOD.resolve_options({"interference_free": True}))
     # a fat platform capsule (it meets the upper arms and the base in about half the poses): interference_free keeps
     # exactly the reachable poses whose clearance is >= 0, in the field, LCI and reach kernels alike, and the column
     # intervals hand every column to nodes and bisection

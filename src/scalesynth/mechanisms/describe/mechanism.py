@@ -235,6 +235,11 @@ class DescribedMechanism(Mechanism):
     def kernel_branch(self, options) -> str:
         return "/".join(plan.branch for plan in self.plans)
 
+    def kernel_clearance(self, options) -> bool:
+        """The clearance slot is computed only where options.clearance_metrics or interference_free packs it."""
+        return "clearance" in self.field_names and bool(options.get("clearance_metrics")
+                                                         or options.get("interference_free"))
+
     def mirror_axes(self, options) -> tuple[int, ...]:
         """x (0) and/or y (1) where the packed legs are a mirror image of themselves in that plane: every leg has a
         partner (itself, on the plane) of the same type, lengths, branch, limits and cone whose base, platform and
