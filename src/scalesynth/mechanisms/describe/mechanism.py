@@ -469,7 +469,7 @@ STIFFNESS_FIELDS = (
 
 
 # The per-voxel clearance field (kernels.clearance.packed_capsule_gap over bodies.py's capsules), opt-in like the
-# stiffness fields: a Delta has 120 capsule pairs, tens of times the kinematic fields' cost per voxel.
+# stiffness fields: a Delta has 120 capsule pairs, about ten times the kinematic fields' cost per voxel.
 CLEARANCE_METRICS_OPTION = Option(
     "clearance_metrics", False, "true: compute the per-voxel field clearance (the link capsules of `show` and "
     "`cycle`, radii from link_radius) and enable its metrics; false: it is 0 and its metrics unavailable")
