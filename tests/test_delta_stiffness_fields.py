@@ -72,13 +72,13 @@ def test_the_kernel_equals_the_frame_solved_per_pose(mech, seed):
 
 def test_field_layout_and_the_flag():
     for mech in (DELTA, LINEAR, HEXA, HEXAPOD):
-        assert mech.field_names == ("lci", "sigma_min", "sigma_max", "stiffness_min", "deflection")
+        assert mech.field_names == ("lci", "sigma_min", "sigma_max", "stiffness_min", "deflection", "clearance")
         f = {fd.name: fd for fd in mech.fields}
         assert f["stiffness_min"].unit == "N/{length}" and f["deflection"].unit == "{length}"
         assert f["deflection"].needs_options == ("stiffness_metrics",)
     d = DELTA.default_design()
     pose = (0.1, -0.05, -1.0)
-    on, off, lci = np.zeros(5), np.zeros(5), np.full(5, 7.0)
+    on, off, lci = np.zeros(6), np.zeros(6), np.full(6, 7.0)
     DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({"stiffness_metrics": True})), *pose, on)
     DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({})), *pose, off)
     DELTA.lci_kernel(DELTA.pack(d, DELTA.resolve_options({"stiffness_metrics": True})), *pose, lci)
@@ -86,7 +86,7 @@ def test_field_layout_and_the_flag():
     assert off[3] == 0.0 and off[4] == 0.0 and np.array_equal(on[:3], off[:3])
     assert lci[0] == on[0] and lci[3] == 7.0  # the LCI kernel skips the stiffness stage
     d6 = HEXAPOD.default_design()
-    on6, lci6 = np.zeros(5), np.full(5, 7.0)
+    on6, lci6 = np.zeros(6), np.full(6, 7.0)
     p6 = HEXAPOD.pack(d6, HEXAPOD.resolve_options({"stiffness_metrics": True}))
     HEXAPOD.field_kernel(p6, 0.05, 0.0, 0.75, on6)
     HEXAPOD.lci_kernel(p6, 0.05, 0.0, 0.75, lci6)
@@ -98,7 +98,7 @@ def test_no_load_no_deflection_and_the_load_is_linear():
     pose = (0.2, 0.1, -0.9)
     vals = {}
     for key, load in (("zero", [0.0, 0.0, 0.0]), ("a", [10.0, 0.0, -150.0]), ("2a", [20.0, 0.0, -300.0])):
-        out = np.zeros(5)
+        out = np.zeros(6)
         DELTA.field_kernel(DELTA.pack(d, DELTA.resolve_options({"stiffness_metrics": True, "load": load})), *pose, out)
         vals[key] = out
     assert vals["zero"][4] == 0.0 and vals["zero"][3] == vals["a"][3]
@@ -113,7 +113,7 @@ def test_a_singular_platform_is_capped_never_nan():
     d = {**d0, "platform_radius": d0["base_radius"] + d0["upper_arm"] * math.cos(math.pi / 3)}
     opts = DELTA.resolve_options({"stiffness_metrics": True})
     pose = (0.0, 0.0, -d0["upper_arm"] * math.sin(math.pi / 3) - d0["forearm"])
-    out = np.zeros(5)
+    out = np.zeros(6)
     DELTA.field_kernel(DELTA.pack(d, opts), *pose, out)
     assert solve(DELTA.stiffness_model(d, opts, pose)).singular
     assert out[0] == 0.0 and out[3] == 0.0 and out[4] == DEFLECTION_CAP

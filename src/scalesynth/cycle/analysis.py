@@ -322,8 +322,9 @@ def _motor_columns(mech, cyc, qd, qdd, force, force_gravity, length_unit) -> dic
 def _clearance_along(mech: Mechanism, design, options, packed, poses: np.ndarray, q: np.ndarray,
                      reference: bool) -> np.ndarray:
     """Clearance (n,) at each sample: the field kernel's clearance slot (one compiled call for all samples) where
-    the mechanism has that field, else (and with ``reference``) cycle.clearance of link_geometry per sample."""
-    if "clearance" in mech.field_names and not reference:
+    the mechanism's kernel computes it under these options (Mechanism.kernel_clearance), else (and with
+    ``reference``) cycle.clearance of link_geometry per sample."""
+    if mech.kernel_clearance(options) and not reference:
         from scalesynth.kernels.grid import population_points_fields
 
         pts = np.pad(poses, ((0, 0), (0, 3 - poses.shape[1])))

@@ -238,8 +238,9 @@ def _followed(mech: Mechanism, designs, options, cyc: ccfg.CycleConfig, length_u
 
 def _clearance(mech: Mechanism, designs, options, packed: np.ndarray, poses: np.ndarray, q: np.ndarray):
     """Clearance (D, n) of every design at every sample: one field-kernel call for all designs where the
-    mechanism has the clearance field, else analysis._clearance_along per design."""
-    if "clearance" not in mech.field_names:
+    mechanism's kernel computes the clearance under these options (Mechanism.kernel_clearance), else
+    analysis._clearance_along per design."""
+    if not mech.kernel_clearance(options):
         return np.array([analysis._clearance_along(mech, d, options, p, poses, qd, False)
                          for d, p, qd in zip(designs, packed, q, strict=True)])
     from scalesynth.kernels.grid import population_points_fields

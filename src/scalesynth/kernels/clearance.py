@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from scalesynth.kernels.flags import FASTMATH
@@ -86,4 +87,52 @@ def min_capsule_gap(seg, pairs, radius):
         d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
                              seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
         gap = min(gap, d - radius[i] - radius[j])
+    return gap
+
+
+# ----- capsules packed as data (the described mechanisms' clearance field; mechanisms/describe/bodies.py) ----------
+# A block of the packed vector from ``off``: [n_seg, n_pairs, n_seg records of SEG_STRIDE, n_pairs index pairs]. A
+# record is two end points and a radius; an end point is (anchor, cx, cy, cz): the constant c plus the moving point
+# the anchor names: ANCHOR_FIXED none, ANCHOR_PLATFORM the platform centre P, i >= 0 leg i's elbow or carriage E_i
+# (the row i of the kernel's ``elbows`` array). Every capsule of a described 3T or 6-DOF mechanism is of that form.
+ANCHOR_FIXED = -1.0
+ANCHOR_PLATFORM = -2.0
+END_STRIDE = 4
+SEG_STRIDE = 2 * END_STRIDE + 1  # two end points, then the radius
+
+
+@njit(cache=True, fastmath=FASTMATH, inline="always")
+def _end(p, k, elbows, x, y, z):
+    """The end point whose record starts at p[k] (the comment above)."""
+    a = p[k]
+    if a == ANCHOR_FIXED:
+        return p[k + 1], p[k + 2], p[k + 3]
+    if a == ANCHOR_PLATFORM:
+        return p[k + 1] + x, p[k + 2] + y, p[k + 3] + z
+    i = int(a)
+    return p[k + 1] + elbows[i, 0], p[k + 2] + elbows[i, 1], p[k + 3] + elbows[i, 2]
+
+
+@njit(cache=True, fastmath=FASTMATH)
+def packed_capsule_gap(p, off, elbows, x, y, z):
+    """Smallest segment distance minus the two radii over the packed pairs of the packed capsules (block at p[off],
+    the comment above) with the platform centre at P = (x, y, z) and the legs' moving points ``elbows`` (n_legs, 3);
+    +inf without pairs. Each capsule's end points are placed once, then min_capsule_gap's loop."""
+    n_seg = int(p[off])
+    n_pairs = int(p[off + 1])
+    seg0 = off + 2
+    pair0 = seg0 + n_seg * SEG_STRIDE
+    seg = np.empty((n_seg, 7))
+    for s in range(n_seg):
+        k = seg0 + s * SEG_STRIDE
+        seg[s, 0], seg[s, 1], seg[s, 2] = _end(p, k, elbows, x, y, z)
+        seg[s, 3], seg[s, 4], seg[s, 5] = _end(p, k + END_STRIDE, elbows, x, y, z)
+        seg[s, 6] = p[k + 2 * END_STRIDE]
+    gap = math.inf
+    for k in range(n_pairs):
+        i = int(p[pair0 + 2 * k])
+        j = int(p[pair0 + 2 * k + 1])
+        d = segment_distance(seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5],
+                             seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], seg[j, 4], seg[j, 5])
+        gap = min(gap, d - seg[i, 6] - seg[j, 6])
     return gap

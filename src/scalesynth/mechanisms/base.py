@@ -336,6 +336,12 @@ class Mechanism(ABC):
         then evaluates only the half box x_a >= 0 where the box is symmetric about 0 (evaluate.py). Default: none."""
         return ()
 
+    def kernel_clearance(self, options: Mapping[str, Any]) -> bool:
+        """Whether the field kernel's ``clearance`` slot holds the link capsules' clearance under these resolved
+        options (the cycle then reads it from one kernel call instead of link_geometry per sample). Default:
+        wherever the mechanism has that field; an opt-in field (the described mechanisms') says when it is on."""
+        return "clearance" in self.field_names
+
     def grid_stats(self, packed: np.ndarray, lo: np.ndarray, step: np.ndarray, shape: np.ndarray, edges: np.ndarray,
                    lci_only: bool = False):
         """Statistics rows of every field for many designs (layout in kernels.grid); ``lci_only``: only the count,

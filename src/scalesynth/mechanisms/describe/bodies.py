@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from scalesynth.errors import InvalidParameter
+from scalesynth.kernels import clearance as _kc
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.describe import kernel as _k
 from scalesynth.mechanisms.describe import kernel2 as _k2
@@ -52,7 +53,7 @@ LINK_RADIUS_DOC = ("capsule radius of every body, or {group or body: radius} (gr
                    "rail, rod, leg, base, platform); null = defaults (docs/describing.md)")
 # options every described mechanism has, whatever its description declares (schema refuses them as names)
 RESERVED_OPTIONS = ("link_radius", "youngs_modulus", "poisson_ratio", "tube", "sections", "actuator_stiffness", "load",
-                    "stiffness_metrics")
+                    "stiffness_metrics", "clearance_metrics", "interference_free")
 
 
 def leg_bodies(code: float, i: int) -> tuple[str, ...]:
@@ -255,3 +256,102 @@ def widths(plans, design: Mapping[str, float]) -> list[float]:
             raise InvalidParameter(f"design: leg {i} width = {w:g}, must be >= 0")
         out.append(w)
     return out
+
+
+# ----- the capsules as data for the field kernels' clearance (kernels.clearance.packed_capsule_gap) ---------------
+# link_geometry's and link_geometry6's capsules with each end point written as a constant plus the moving point it
+# rides on (kernels.clearance: fixed, the platform centre P, or leg i's elbow or carriage E_i), and the index pairs
+# LinkGeometry.checked_pairs keeps (different bodies sharing no joint). tests/test_described_clearance.py holds the
+# kernel's field equal to cycle.clearance of link_geometry at random poses and designs.
+_FIXED, _PLATFORM = _kc.ANCHOR_FIXED, _kc.ANCHOR_PLATFORM
+
+
+def capsules(legs, widths: Sequence[float], rad: Mapping[str, float]) -> tuple[list, np.ndarray]:
+    """(capsules, pairs) of a 3T mechanism (link_geometry's bodies): capsules as (body, (anchor, c), (anchor, c),
+    radius), pairs (m, 2) int64 of the checked ones."""
+    out: list = []
+    pairs: list[tuple[str, str]] = []
+    base_pts, plat_offsets = [], []
+    zero = np.zeros(3)
+    for i, (leg, w) in enumerate(zip(legs, widths, strict=True), 1):
+        h = 0.5 * float(w)
+        side = h * leg.normal
+        e = float(i - 1)
+        base_pts.append(leg.base)
+        plat_offsets += [leg.platform - side, leg.platform + side] if h > 0.0 else [leg.platform]
+        if leg.type.code == _k.R_PA:
+            out.append((f"upper_arm{i}", (_FIXED, leg.base), (e, zero)))
+            if h > 0.0:
+                out.append((f"upper_arm{i}", (e, -side), (e, side)))
+            pairs += [("base", f"upper_arm{i}"), (f"upper_arm{i}", f"forearm{i}")]
+        else:
+            lo, hi = leg.limits
+            out.append((f"rail{i}", (_FIXED, leg.base + lo * leg.u), (_FIXED, leg.base + hi * leg.u)))
+            out.append((f"carriage{i}", (e, -side), (e, side)))
+            pairs += [("base", f"rail{i}"), (f"rail{i}", f"carriage{i}"), (f"carriage{i}", f"forearm{i}"),
+                      (f"rail{i}", f"forearm{i}")]
+        if h > 0.0:
+            out += [(f"forearm{i}", (e, side), (_PLATFORM, leg.platform + side)),
+                    (f"forearm{i}", (e, -side), (_PLATFORM, leg.platform - side))]
+        else:
+            out.append((f"forearm{i}", (e, zero), (_PLATFORM, leg.platform)))
+        pairs.append((f"forearm{i}", "platform"))
+    out += [("base", (_FIXED, a), (_FIXED, b)) for a, b in _ring(base_pts, np.mean(base_pts, axis=0))]
+    out += [("platform", (_PLATFORM, a), (_PLATFORM, b)) for a, b in _ring(plat_offsets, np.zeros(3))]
+    return _with_radii(out, pairs, rad)
+
+
+def capsules6(legs, rad: Mapping[str, float], rot: np.ndarray) -> tuple[list, np.ndarray]:
+    """(capsules, pairs) of a 6-DOF mechanism (link_geometry6's bodies) at the platform orientation ``rot``."""
+    out: list = []
+    pairs: list[tuple[str, str]] = []
+    base_pts, plat_offsets = [], []
+    zero = np.zeros(3)
+    for i, leg in enumerate(legs, 1):
+        rho = rot @ leg.r
+        base_pts.append(leg.base)
+        plat_offsets.append(rho)
+        if leg.rus:
+            e = float(i - 1)
+            out += [(f"upper_arm{i}", (_FIXED, leg.base), (e, zero)), (f"rod{i}", (e, zero), (_PLATFORM, rho))]
+            pairs += [("base", f"upper_arm{i}"), (f"upper_arm{i}", f"rod{i}"), (f"rod{i}", "platform")]
+        else:
+            out.append((f"leg{i}", (_FIXED, leg.base), (_PLATFORM, rho)))
+            pairs += [("base", f"leg{i}"), (f"leg{i}", "platform")]
+    out += [("base", (_FIXED, a), (_FIXED, b)) for a, b in _ring(base_pts, np.mean(base_pts, axis=0))]
+    out += [("platform", (_PLATFORM, a), (_PLATFORM, b)) for a, b in _ring(plat_offsets, np.zeros(3))]
+    return _with_radii(out, pairs, rad)
+
+
+def _with_radii(caps: list, pairs: list[tuple[str, str]], rad: Mapping[str, float]) -> tuple[list, np.ndarray]:
+    return ([(body, a, b, rad[body]) for body, a, b in caps],
+            links.kernel_pairs([body for body, *_ in caps], links.adjacency(pairs)))
+
+
+def pack_capsules(p: np.ndarray, off: int, caps: list, pairs: np.ndarray) -> None:
+    """Write the block kernels.clearance.packed_capsule_gap reads at p[off:] (p must have room: capsule_slots)."""
+    stride = _kc.SEG_STRIDE
+    p[off], p[off + 1] = len(caps), len(pairs)
+    k = off + 2
+    for _, (a0, c0), (a1, c1), radius in caps:
+        p[k], p[k + 1 : k + 4] = a0, c0
+        p[k + 4], p[k + 5 : k + 8] = a1, c1
+        p[k + 8] = radius
+        k += stride
+    p[k : k + 2 * len(pairs)] = np.asarray(pairs, dtype=float).ravel()
+
+
+def capsule_slots(max_capsules: int) -> int:
+    """Slots of a capsule block with at most ``max_capsules`` capsules and every pair of them."""
+    return 2 + max_capsules * _kc.SEG_STRIDE + max_capsules * (max_capsules - 1)
+
+
+def uniform_legs(caps: list, widths: Sequence[float] = ()) -> bool:
+    """Whether every leg's bodies have the radii of the other legs' bodies of their group and the legs have one
+    width: then a map of the legs onto themselves (a rotation, a mirror) maps the capsules onto themselves too, and
+    the clearance field keeps the legs' symmetry (describe/symmetry.py)."""
+    by_group: dict[str, set[float]] = {}
+    for body, _, _, radius in caps:
+        if body not in ("base", "platform"):
+            by_group.setdefault(group_of(body), set()).add(radius)
+    return all(len(v) == 1 for v in by_group.values()) and len(set(map(float, widths))) <= 1

@@ -27,6 +27,10 @@ unchanged and keeps every product far from overflow.
 
 Stiffness (slots 3-4, only where the packed flag, options.stiffness_metrics, is set; else 0): stiffness_min and
 deflection of frame.py's idealisation, condensed per leg in closed form (the section comment below).
+
+Clearance (slot 5, only where the packed flag, options.clearance_metrics or interference_free, is set; else 0): the
+smallest capsule gap of bodies.py's link capsules (the packed capsule block, kernels.clearance.packed_capsule_gap);
+with interference_free a pose whose capsules overlap is unreachable in every kernel of the template.
 """
 
 import math
@@ -35,6 +39,7 @@ import numpy as np
 from numba import njit
 
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import SEG_STRIDE, packed_capsule_gap
 from scalesynth.kernels.conditioning import SIGMA_CAP, sv_3x3
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.stiffness import legs as _sl
@@ -78,9 +83,20 @@ GJ_BAR = 5
 K_ACT = 6
 HALF_WIDTH = 7
 SSTRIDE = 8
-N_PACKED = SLEGS + N_LEGS * SSTRIDE
+N_STIFFNESS = SLEGS + N_LEGS * SSTRIDE
+# clearance block, from N_STIFFNESS: a flag (1: the clearance field is computed), the interference_free flag, 1 where
+# the legs' capsules are alike (bodies.uniform_legs: the field keeps the legs' symmetry), then the capsule block of
+# kernels.clearance (at most MAX_CAPSULES capsules: per leg an arm or rail, its elbow or carriage side and two bars;
+# the base triangle; the platform polygon of six corners)
+CLEAR = N_STIFFNESS
+FREE = N_STIFFNESS + 1
+UNIFORM = N_STIFFNESS + 2
+CAPS = N_STIFFNESS + 3
+MAX_CAPSULES = N_LEGS * 4 + N_LEGS + 2 * N_LEGS
+N_PACKED = CAPS + 2 + MAX_CAPSULES * SEG_STRIDE + MAX_CAPSULES * (MAX_CAPSULES - 1)
 F_STIFFNESS_MIN = 3  # field slots of the stiffness fields
 F_DEFLECTION = 4
+F_CLEARANCE = 5  # field slot of the clearance
 TWO_PI = 2.0 * math.pi
 
 
@@ -154,12 +170,28 @@ def _leg(p, k, x, y, z):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def _gap(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Clearance (length unit) of the packed capsules at P = (x, y, z) whose legs reach it with unit forearms a, b,
+    c: each elbow or carriage E_i = Q_i - l_i f_i."""
+    elbows = np.empty((N_LEGS, 3))
+    f = np.array([ax, ay, az, bx, by, bz, cx, cy, cz])
+    for i in range(N_LEGS):
+        k = HEAD + i * STRIDE
+        lf = p[k + FOREARM]
+        elbows[i, 0] = x + p[k + PLAT] - lf * f[3 * i]
+        elbows[i, 1] = y + p[k + PLAT + 1] - lf * f[3 * i + 1]
+        elbows[i, 2] = z + p[k + PLAT + 2] - lf * f[3 * i + 2]
+    return packed_capsule_gap(p, CAPS, elbows, x, y, z)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, conditioning, stiffness=None):
     """Slots 0-2 (LCI, sigma_min, sigma_max of dx/dq) at P, or write_unreachable; ``conditioning`` (a constant)
     False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel); ``stiffness`` True also
-    writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set), None (default) leaves them: a
-    None test, because Numba drops the branch of a None argument by its type but compiles both branches of a
-    literal bool's (the stiffness stage is about half the template's compile time)."""
+    writes slots 3-5 (stiffness_min, deflection, clearance; each 0 unless its packed flag is set), None (default)
+    leaves them: a None test, because Numba drops the branch of a None argument by its type but compiles both
+    branches of a literal bool's (the stiffness and clearance stages are most of the template's compile time).
+    With the packed interference_free flag, overlapping capsules make the pose unreachable in every variant."""
     # np.int64, not the literal HEAD: Numba would compile _leg a second time for the literal 2 (the column
     # kernel's loop calls it with an int64)
     k1 = np.int64(HEAD)
@@ -177,6 +209,12 @@ def _fields(p, x, y, z, out, conditioning, stiffness=None):
     if not ok:
         _grid.write_unreachable(out)
         return
+    gap = 0.0
+    if p[FREE] > 0.0 or (stiffness is not None and p[CLEAR] > 0.0):
+        gap = _gap(p, x, y, z, ax, ay, az, bx, by, bz, cx, cy, cz)
+        if p[FREE] > 0.0 and gap < 0.0:
+            _grid.write_unreachable(out)
+            return
     if not conditioning:
         out[0] = 0.0
         return
@@ -207,28 +245,30 @@ def _fields(p, x, y, z, out, conditioning, stiffness=None):
         else:
             out[F_STIFFNESS_MIN] = 0.0
             out[F_DEFLECTION] = 0.0
+        out[F_CLEARANCE] = gap
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_fields(p, x, y, z, out):
     """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of dx/dq at P = (x, y, z), and
     stiffness_min (N/length) and deflection (length unit) of the platform under the packed load where the packed
-    flag asks for them (else 0; _stiffness); -1 and zeros where a leg does not reach P in its branch or a limit
-    excludes it."""
+    flag asks for them (else 0; _stiffness), and the clearance of the link capsules (length unit) where its flag
+    asks for it (else 0; _gap); -1 and zeros where a leg does not reach P in its branch, a limit excludes it or
+    (interference_free) two capsules overlap."""
     _fields(p, x, y, z, out, True, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_lci(p, x, y, z, out):
-    """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel: a search whose
-    workspace metrics are the LCI's alone); slots 3-4 not written."""
+    """Slots 0-2 of point_fields, bit for bit, without the stiffness and clearance stages (Mechanism.lci_kernel: a
+    search whose workspace metrics are the LCI's alone; interference_free still applies); slots 3-5 not written."""
     _fields(p, x, y, z, out, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_reach(p, x, y, z, out):
-    """Slot 0 >= 0 exactly where point_fields' is (same legs, branches and limits), -1 elsewhere; no conditioning
-    (the adaptive evaluator's nodes and bisections)."""
+    """Slot 0 >= 0 exactly where point_fields' is (same legs, branches, limits and interference_free), -1
+    elsewhere; no conditioning (the adaptive evaluator's nodes and bisections)."""
     _fields(p, x, y, z, out, False)
 
 
@@ -514,7 +554,10 @@ def _reaches(p, x, y, z):
 def column_intervals(p, x, y, zlo, zhi, out):
     """The interval kernel (Mechanism.interval_kernel): the reachable set of the column at (x, y) over [zlo, zhi] as
     k sorted, disjoint intervals in out[:k] (out: (K, 2)); -1 when a leg is not handled in closed form (a tilted
-    R-Pa axis) or more than K intervals are needed."""
+    R-Pa axis), with interference_free (the capsules' overlap has no closed form here) or more than K intervals are
+    needed."""
+    if p[FREE] > 0.0:
+        return -1
     br = np.empty(MAX_BREAKS)
     br[0] = zlo
     nb = 1

@@ -27,6 +27,10 @@ pose is written as singular (LCI 0, sigma_min 0, sigma_max the cap).
 
 Stiffness (slots 3-4, only where the packed flag, options.stiffness_metrics, is set; else 0): stiffness_min and
 deflection of frame6.py's idealisation, one bar wrench per leg (the section comment below).
+
+Clearance (slot 5, only where the packed flag, options.clearance_metrics or interference_free, is set; else 0): the
+smallest capsule gap of bodies.py's link capsules (kernels.clearance.packed_capsule_gap); with interference_free a
+pose whose capsules overlap is unreachable in every kernel of the template.
 """
 
 import math
@@ -35,6 +39,7 @@ import numpy as np
 from numba import njit
 
 from scalesynth.kernels import grid as _grid
+from scalesynth.kernels.clearance import SEG_STRIDE, packed_capsule_gap
 from scalesynth.kernels.conditioning import inverse_singular_values
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.stiffness import legs as _sl
@@ -75,9 +80,18 @@ GJ_ARM = 2
 EA_LINK = 3
 K_ACT = 4
 SSTRIDE = 5
-N_PACKED = SLEGS + N_LEGS * SSTRIDE
+N_STIFFNESS = SLEGS + N_LEGS * SSTRIDE
+# clearance block, from N_STIFFNESS (kernel.py's layout): the field's flag, interference_free, 1 where the legs'
+# capsules are alike, then the capsule block (at most: per leg an arm and a rod, the base and platform hexagons)
+CLEAR = N_STIFFNESS
+FREE = N_STIFFNESS + 1
+UNIFORM = N_STIFFNESS + 2
+CAPS = N_STIFFNESS + 3
+MAX_CAPSULES = N_LEGS * 2 + 2 * N_LEGS
+N_PACKED = CAPS + 2 + MAX_CAPSULES * SEG_STRIDE + MAX_CAPSULES * (MAX_CAPSULES - 1)
 F_STIFFNESS_MIN = 3  # field slots of the stiffness fields
 F_DEFLECTION = 4
+F_CLEARANCE = 5  # field slot of the clearance
 TWO_PI = 2.0 * math.pi
 SQUARE_TOL = 1e-12  # |f . t| / (l a) at or below which a RUS leg counts as an exact inverse singularity
 JACOBI_TOL = 1e-15  # columns count as orthogonal when |c_i . c_j| <= JACOBI_TOL |c_i| |c_j|
@@ -198,11 +212,29 @@ def _jacobi_extremes(g):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def _gap(p, x, y, z):
+    """Clearance (length unit) of the packed capsules at P = (x, y, z), every leg reaching it: a RUS leg's elbow
+    E_i = Q_i - l_i f_i (a UPS leg has none: its row is unused)."""
+    elbows = np.zeros((N_LEGS, 3))
+    for i in range(N_LEGS):
+        k = HEAD + i * STRIDE
+        if p[k + TYPE] == RUS:
+            _, fx, fy, fz, _, _, _ = _leg(p, k, x, y, z)
+            lr = p[k + ROD]
+            elbows[i, 0] = x + p[k + RHO] - lr * fx
+            elbows[i, 1] = y + p[k + RHO + 1] - lr * fy
+            elbows[i, 2] = z + p[k + RHO + 2] - lr * fz
+    return packed_capsule_gap(p, CAPS, elbows, x, y, z)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def _fields(p, x, y, z, out, conditioning, stiffness=None):
     """Slots 0-2 (LCI, sigma_min, sigma_max of the homogenised dx/dq) at P, or write_unreachable; ``conditioning``
     (a constant) False stops after reach and limits with slot 0 = 0 where they pass (the reach kernel);
-    ``stiffness`` True also writes slots 3-4 (stiffness_min, deflection; 0 unless the packed flag is set), None
-    (default) leaves them (a None test: Numba compiles both branches of a literal bool's; kernel.py's _fields)."""
+    ``stiffness`` True also writes slots 3-5 (stiffness_min, deflection, clearance; each 0 unless its packed flag is
+    set), None (default) leaves them (a None test: Numba compiles both branches of a literal bool's; kernel.py's
+    _fields). With the packed interference_free flag, overlapping capsules make the pose unreachable in every
+    variant."""
     inv_l = p[INV_L]
     g = np.empty((6, 6))
     square = False
@@ -228,6 +260,12 @@ def _fields(p, x, y, z, out, conditioning, stiffness=None):
         g[3, i] = (ry * fz - rz * fy) * inv_l * s
         g[4, i] = (rz * fx - rx * fz) * inv_l * s
         g[5, i] = (rx * fy - ry * fx) * inv_l * s
+    gap = 0.0
+    if p[FREE] > 0.0 or (stiffness is not None and p[CLEAR] > 0.0):
+        gap = _gap(p, x, y, z)
+        if p[FREE] > 0.0 and gap < 0.0:
+            _grid.write_unreachable(out)
+            return
     if not conditioning:
         out[0] = 0.0
         return
@@ -247,6 +285,7 @@ def _fields(p, x, y, z, out, conditioning, stiffness=None):
         else:
             out[F_STIFFNESS_MIN] = 0.0
             out[F_DEFLECTION] = 0.0
+        out[F_CLEARANCE] = gap
 
 
 # ----- per-voxel stiffness (docs/describing.md): frame6.py's idealisation condensed per leg -----------------------
@@ -301,21 +340,23 @@ def _stiffness(p, x, y, z):
 def point_fields(p, x, y, z, out):
     """The field kernel (kernels.grid contract): LCI, sigma_min, sigma_max of the homogenised dx/dq at platform
     centre P = (x, y, z) (orientation from the packed legs), and stiffness_min (N/length) and deflection (length
-    unit) of the platform under the packed load where the packed flag asks for them (else 0; _stiffness); -1 and
-    zeros where a leg does not reach P in its branch or a limit excludes it."""
+    unit) of the platform under the packed load where the packed flag asks for them (else 0; _stiffness), and the
+    clearance of the link capsules (length unit) where its flag asks for it (else 0; _gap); -1 and zeros where a
+    leg does not reach P in its branch, a limit excludes it or (interference_free) two capsules overlap."""
     _fields(p, x, y, z, out, True, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_lci(p, x, y, z, out):
-    """Slots 0-2 of point_fields, bit for bit, without the stiffness stage (Mechanism.lci_kernel); slots 3-4 not
-    written."""
+    """Slots 0-2 of point_fields, bit for bit, without the stiffness and clearance stages (Mechanism.lci_kernel;
+    interference_free still applies); slots 3-5 not written."""
     _fields(p, x, y, z, out, True)
 
 
 @njit(cache=True, fastmath=FASTMATH)
 def point_reach(p, x, y, z, out):
-    """Slot 0 >= 0 exactly where point_fields' is, -1 elsewhere; no conditioning (the adaptive evaluator)."""
+    """Slot 0 >= 0 exactly where point_fields' is (interference_free included), -1 elsewhere; no conditioning (the
+    adaptive evaluator)."""
     _fields(p, x, y, z, out, False)
 
 

@@ -102,6 +102,8 @@ class DescribedMechanism(Mechanism):
         bodies.check_link_radius(options, self._codes())
         check_stiffness_options(options, 3, frame.link_groups(self._codes()[0]))
         check_flag_option(options, "stiffness_metrics")
+        check_flag_option(options, "clearance_metrics")
+        check_flag_option(options, "interference_free")
         for name, spec in self.description.options.items():
             value = options[name]
             if spec.kind == "range":
@@ -141,7 +143,8 @@ class DescribedMechanism(Mechanism):
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
         p = np.zeros(_k.N_PACKED)
         p[0] = len(self.plans)
-        for i, leg in enumerate(self.legs(design, options)):
+        legs = self.legs(design, options)
+        for i, leg in enumerate(legs):
             k = _k.HEAD + i * _k.STRIDE
             p[k + _k.TYPE] = leg.type.code
             p[k + _k.BASE : k + _k.BASE + 3] = leg.base
@@ -161,6 +164,10 @@ class DescribedMechanism(Mechanism):
                 p[k + _k.SIN_CONE] = leg.sin_cone
         if options.get("stiffness_metrics"):
             frame.pack_stiffness(self, design, options, p)
+        if options.get("clearance_metrics") or options.get("interference_free"):
+            w = bodies.widths(self.plans, design)
+            caps, pairs = bodies.capsules(legs, w, bodies.radii(options, self._codes(), self.default_length_unit))
+            pack_clearance(p, (_k.CLEAR, _k.FREE, _k.UNIFORM, _k.CAPS), options, caps, pairs, w)
         return p
 
     @property
@@ -235,6 +242,11 @@ class DescribedMechanism(Mechanism):
 
     def kernel_branch(self, options) -> str:
         return "/".join(plan.branch for plan in self.plans)
+
+    def kernel_clearance(self, options) -> bool:
+        """The clearance slot is computed only where options.clearance_metrics or interference_free packs it."""
+        return "clearance" in self.field_names and bool(options.get("clearance_metrics")
+                                                         or options.get("interference_free"))
 
     def mirror_axes(self, options) -> tuple[int, ...]:
         """x (0) and/or y (1) where the packed legs are a mirror image of themselves in that plane: every leg has a
@@ -464,6 +476,30 @@ STIFFNESS_FIELDS = (
 )
 
 
+# The per-voxel clearance field (kernels.clearance.packed_capsule_gap over bodies.py's capsules), opt-in like the
+# stiffness fields: a Delta has 120 capsule pairs, about ten times the kinematic fields' cost per voxel.
+CLEARANCE_METRICS_OPTION = Option(
+    "clearance_metrics", False, "true: compute the per-voxel field clearance (the link capsules of `show` and "
+    "`cycle`, radii from link_radius) and enable its metrics; false: it is 0 and its metrics unavailable")
+INTERFERENCE_FREE_OPTION = Option(
+    "interference_free", False, "true: a pose whose link capsules overlap (clearance < 0) is unreachable")
+CLEARANCE = Field(
+    "clearance", "{length}", "smallest distance between the capsules of links that share no joint, minus their radii "
+    "(< 0: the links interfere; bodies and radii of `show` and `cycle`, options.link_radius); its metrics need "
+    "options.clearance_metrics", "max", (-math.inf, math.inf), needs_options=("clearance_metrics",))
+
+
+def pack_clearance(p: np.ndarray, slots: tuple[int, int, int, int], options: Mapping[str, Any], caps, pairs,
+                   widths=()) -> None:
+    """The clearance block (flag, interference_free, uniform legs, capsules at ``slots``) of a 3T or 6-DOF
+    template's packed vector from bodies.capsules / capsules6."""
+    clear, free, uniform, at = slots
+    p[clear] = 1.0
+    p[free] = 1.0 if options.get("interference_free") else 0.0
+    p[uniform] = 1.0 if bodies.uniform_legs(caps, widths) else 0.0
+    bodies.pack_capsules(p, at, caps, pairs)
+
+
 def from_description_3t(desc: Description) -> DescribedMechanism:
     """The registered mechanism of a validated 3T description (build.from_description dispatches by motion)."""
     plans = _plans(desc)
@@ -472,7 +508,8 @@ def from_description_3t(desc: Description) -> DescribedMechanism:
     joints = tuple(f"{plan.joint}{i + 1}" for i, plan in enumerate(plans))
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items())
     options += (Option("link_radius", None, bodies.LINK_RADIUS_DOC),
-                *frame.options(desc.stiffness, desc.length_unit, rotary), STIFFNESS_METRICS_OPTION)
+                *frame.options(desc.stiffness, desc.length_unit, rotary), STIFFNESS_METRICS_OPTION,
+                CLEARANCE_METRICS_OPTION, INTERFERENCE_FREE_OPTION)
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = "J = dx/dq (platform motion per rad of arm rotation)" if rotary else \
         "J = dx/dq (platform motion per unit carriage motion)"
@@ -489,7 +526,7 @@ def from_description_3t(desc: Description) -> DescribedMechanism:
                          for name, spec in desc.parameters.items()),
         options=options,
         default_length_unit=desc.length_unit,
-        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS),
+        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS, CLEARANCE),
         design_metrics=(
             DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (a parallelogram "
                          "counted once)", lambda d, o, _p=plans: _link_length_sum(_p, d)),

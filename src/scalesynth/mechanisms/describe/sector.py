@@ -13,12 +13,13 @@ a vertical tangent) into a smooth factor of s; s and phi run over Gauss-Legendre
 is a Gauss-Legendre rule on every reachable z-interval (nz nodes per interval, the weight of a node the product of
 the three rules' weights); the statistics row (kernels.grid layout) accumulates those nodes with those weights:
 count = volume in units of the caller's cell, sums of every field (LCI, sigma_min, sigma_max, and the stiffness
-fields, 0 unless the packed design turns them on) and sums of squares,
+and clearance fields, 0 unless the packed design turns them on) and sums of squares,
 bands of LCI, and min/max over the nodes (an estimate from inside, as every grid's).
 
-The stiffness stage is about half of the template's compile time, so the nodes run point_fields only where some
-design's packed flag (options.stiffness_metrics) is set, else point_lci (slots 0-2 bit for bit, slots 3-4 left 0
-as point_fields writes them with the flag off): a run without the flag never compiles the stiffness stage.
+The stiffness and clearance stages are most of the template's compile time, so the nodes run point_fields only
+where some design's packed flag (options.stiffness_metrics or clearance_metrics) is set, else point_lci (slots 0-2
+bit for bit, slots 3-5 left 0 as point_fields writes them with the flags off): a run without the flags never
+compiles those stages.
 """
 
 import math
@@ -28,10 +29,10 @@ from numba import njit, prange
 
 from scalesynth.kernels import grid as _grid
 from scalesynth.kernels.flags import FASTMATH
-from scalesynth.mechanisms.describe.kernel import F_DEFLECTION, STIFF, column_intervals, point_fields, point_lci
+from scalesynth.mechanisms.describe.kernel import CLEAR, F_CLEARANCE, STIFF, column_intervals, point_fields, point_lci
 
 MAX_INTERVALS = 8  # reachable z-intervals per column (column_intervals' K)
-N_FIELDS = F_DEFLECTION + 1  # the template's fields: LCI, sigma_min, sigma_max, stiffness_min, deflection
+N_FIELDS = F_CLEARANCE + 1  # the template's fields: LCI, sigma_min, sigma_max, stiffness_min, deflection, clearance
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -157,7 +158,7 @@ def population_sector_stats(params, phi0, phi1, rmax, zlo, zhi, nscan, nbisect, 
     """sector_row for every design (params (n, N_PACKED); rmax, zlo, zhi, cell: (n,)) into rows (n, columns) and
     calls (n,); parallel over designs (each writes its own row: the result does not depend on the threads). The
     stiffness stage is compiled and run only where some design's packed flag asks for it (module docstring)."""
-    stiffness = True if np.any(params[:, STIFF] > 0.0) else None
+    stiffness = True if np.any(params[:, STIFF] > 0.0) or np.any(params[:, CLEAR] > 0.0) else None
     # contiguous per-design arrays: a column of the boxes (lo[:, 2]) is strided, except for one design, and Numba
     # would compile the kernel once for each layout
     rmax, zlo, zhi, cell = (np.ascontiguousarray(a, dtype=np.float64) for a in (rmax, zlo, zhi, cell))

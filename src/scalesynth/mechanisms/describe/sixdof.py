@@ -35,6 +35,9 @@ from scalesynth.mechanisms.describe import bodies, expressions, frame
 from scalesynth.mechanisms.describe import kernel6 as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, LegType
 from scalesynth.mechanisms.describe.mechanism import (
+    CLEARANCE,
+    CLEARANCE_METRICS_OPTION,
+    INTERFERENCE_FREE_OPTION,
     STIFFNESS_FIELDS,
     STIFFNESS_METRICS_OPTION,
     DescribedMechanism,
@@ -42,6 +45,7 @@ from scalesynth.mechanisms.describe.mechanism import (
     _plans,
     _turn,
     _unit,
+    pack_clearance,
 )
 from scalesynth.mechanisms.describe.schema import Description
 from scalesynth.mechanisms.links import segment_ends
@@ -261,6 +265,10 @@ class SixDofMechanism(DescribedMechanism):
                 p[k + _k.CONE] = math.sin(leg.cone) if leg.rus else math.cos(leg.cone)
         if options.get("stiffness_metrics"):
             self._pack_stiffness(options, p)
+        if options.get("clearance_metrics") or options.get("interference_free"):
+            rad = bodies.radii(options, self._codes(), self.default_length_unit)
+            caps, pairs = bodies.capsules6(self.legs(design, options), rad, rot)
+            pack_clearance(p, (_k.CLEAR, _k.FREE, _k.UNIFORM, _k.CAPS), options, caps, pairs)
         return p
 
     def _pack_stiffness(self, options: Mapping[str, Any], p: np.ndarray) -> None:
@@ -541,6 +549,7 @@ def from_description_6dof(desc: Description) -> SixDofMechanism:
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items()) + (
         Option("link_radius", None, bodies.LINK_RADIUS_DOC),
         *frame.options(desc.stiffness, desc.length_unit, rotary), STIFFNESS_METRICS_OPTION,
+        CLEARANCE_METRICS_OPTION, INTERFERENCE_FREE_OPTION,
         Option(ORIENTATION, [0.0, 0.0, 0.0], "[roll, pitch, yaw] rad of the platform over the whole (constant-"
                "orientation) workspace, R = Rz(yaw) Ry(pitch) Rx(roll)"),
         Option(CHARACTERISTIC_LENGTH, None, "length L of the homogenised Jacobian dx/dq = (v, L omega) per joint "
@@ -563,7 +572,7 @@ def from_description_6dof(desc: Description) -> SixDofMechanism:
                          for name, spec in desc.parameters.items()),
         options=options,
         default_length_unit=desc.length_unit,
-        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS),
+        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS, CLEARANCE),
         design_metrics=(
             DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (RUS: arm + rod; "
                          "UPS: its longest length)", lambda d, o, _h=holder: _link_length_sum(_h[0], d, o)),

@@ -18,7 +18,8 @@ _RTOL = 1e-12
 def mirrored_legs(p: np.ndarray, axis: int) -> bool:
     """Whether the legs packed in ``p`` (shape (N_PACKED,)) are their own mirror image in the plane
     x_axis = 0 (axis 0 or 1): :func:`mapped_legs` with that reflection (with the stiffness fields on, partners also
-    need equal sections, springs and widths, and a load with no component across the plane)."""
+    need equal sections, springs and widths, and a load with no component across the plane; with the clearance
+    field on, _clearance_keeps_symmetry)."""
     flip = np.ones(3)
     flip[axis] = -1.0
     return bool(mapped_legs(p, np.diag(flip))[0])
@@ -28,8 +29,8 @@ def mapped_legs(params: np.ndarray, m: np.ndarray) -> np.ndarray:
     """Per design (params: (n, N_PACKED)), whether its legs map onto themselves under the linear map ``m`` (3 x 3,
     a rotation about z or a mirror): each leg has a partner (possibly itself) with equal scalar slots whose base,
     platform offset, arm (rail) and turn directions are the leg's mapped, and whose leg-plane normal is the mapped
-    one up to sign; with the stiffness fields on, also equal stiffness blocks and a load that ``m`` leaves as it is.
-    (n,) bool; one array pass for a whole population."""
+    one up to sign; with the stiffness fields on, also equal stiffness blocks and a load that ``m`` leaves as it is;
+    with the clearance field on, _clearance_keeps_symmetry. (n,) bool; one array pass for a whole population."""
     params = np.atleast_2d(params)
     n_legs = int(params[0, 0])
     blocks = params[:, _k.HEAD : _k.HEAD + n_legs * _k.STRIDE].reshape(len(params), n_legs, _k.STRIDE)
@@ -57,7 +58,17 @@ def mapped_legs(params: np.ndarray, m: np.ndarray) -> np.ndarray:
         kept = np.all(np.abs(load @ m.T - load) <= _RTOL * 1e3 * np.maximum(1.0, np.abs(load).max(axis=1))[:, None],
                       axis=1)
         ok &= np.where(stiff[:, None, None], same & kept[:, None, None], True)
-    return np.all(np.any(ok, axis=2), axis=1)
+    return np.all(np.any(ok, axis=2), axis=1) & _clearance_keeps_symmetry(params)
+
+
+def _clearance_keeps_symmetry(p: np.ndarray) -> np.ndarray:
+    """Whether the clearance block of each packed design (p: (N_PACKED,) or (n, N_PACKED)) keeps every symmetry of
+    its legs: off, or on with the legs' capsules alike (bodies.uniform_legs: the capsules are built from the legs'
+    points, so a map of the legs onto themselves maps them onto themselves, with their radii) and without
+    interference_free (the column intervals and the sector evaluator do not see the capsules' overlap: the
+    evaluator falls back to nodes and bisection)."""
+    p = np.asarray(p)
+    return ~((p[..., _k.CLEAR] > 0.0) & ((p[..., _k.UNIFORM] <= 0.0) | (p[..., _k.FREE] > 0.0)))
 
 
 def fundamental_sectors(params: np.ndarray) -> np.ndarray:
