@@ -95,3 +95,30 @@ def linear_delta_fields(design, options, x, y, z):
         sv = np.linalg.svd(np.linalg.solve(jx, jq), compute_uv=False)
         out[idx] = (sv[-1] / sv[0], sv[-1], sv[0])
     return out
+
+
+def linear_delta_volume(design, options, zlim, n=2000):
+    """The linear Delta's workspace volume by its closed form, a double integral: at a point of the plane with
+    horizontal distances d_i <= l to the three rails (a = R - r, as linear_delta_fields), z ranges over
+    [-s_hi - h_i, -s_lo - h_i] for every i (h_i = sqrt(l^2 - d_i^2), [s_lo, s_hi] the stroke), within zlim = (z_lo,
+    z_hi); the height min(-s_lo - max h_i, z_hi) - max(-s_hi - min h_i, z_lo) (at least 0) integrated by the
+    midpoint rule on an n x n grid of the box of the three discs' intersection, that of the curved triangle about the
+    axis where l < 2 a / sqrt(3) (x in [a - l, rho], |y| <= rho sin 60 deg, rho = sqrt(l^2 - 3 a^2 / 4) - a / 2, its
+    corners at rho, 120 and 240 deg): a sliver's own extent (smooth integrand inside, O(1/n) at the rims)."""
+    a, ll = design["base_radius"] - design["platform_radius"], design["forearm"]
+    s_lo, s_hi = options["stroke"]
+    if ll < a:
+        return 0.0
+    centres = a * np.stack([np.cos(PHIS), np.sin(PHIS)], axis=1)
+    lo, hi = (centres - ll).max(axis=0), (centres + ll).min(axis=0)
+    if ll < 2.0 * a / np.sqrt(3.0):
+        rho = np.sqrt(ll * ll - 0.75 * a * a) - 0.5 * a
+        lo, hi = np.maximum(lo, [a - ll, -rho * np.sqrt(0.75)]), np.minimum(hi, [rho, rho * np.sqrt(0.75)])
+    x, y = np.meshgrid(lo[0] + (np.arange(n) + 0.5) * (hi[0] - lo[0]) / n,
+                       lo[1] + (np.arange(n) + 0.5) * (hi[1] - lo[1]) / n, indexing="ij")
+    d2 = np.stack([(x - c[0]) ** 2 + (y - c[1]) ** 2 for c in centres])
+    h = np.sqrt(np.clip(ll * ll - d2, 0.0, None))
+    top = np.minimum(-s_lo - h.max(axis=0), zlim[1])
+    bottom = np.maximum(-s_hi - h.min(axis=0), zlim[0])
+    height = np.where((d2 <= ll * ll).all(axis=0), np.clip(top - bottom, 0.0, None), 0.0)
+    return float(height.sum() * (hi[0] - lo[0]) * (hi[1] - lo[1]) / n**2)

@@ -1,6 +1,6 @@
-"""NumPy twin of the sector evaluator (mechanisms/describe/sector.py) for the rotary Delta: the same Gauss nodes,
-boundary scan and bisection, r = R (1 - s^2) substitution and z-rules, written as plain Python loops, with the
-fields from the textbook kinematics of tests/naive_delta.py (np.linalg.svd per node). Only the reachable
+"""NumPy twin of the sector evaluator (mechanisms/describe/sector.py) for the rotary and the linear Delta: the same
+Gauss nodes, boundary scan and bisection, r = R (1 - s^2) substitution and z-rules, written as plain Python loops,
+with the fields from the textbook kinematics of tests/naive_delta.py (np.linalg.svd per node). Only the reachable
 z-intervals of a column come from the template's closed form (kernel.column_intervals, checked against the
 field kernel's reach in tests/test_adaptive.py)."""
 
@@ -30,15 +30,19 @@ def _boundary(p, c, s, rmax, zlo, zhi, nscan, nbisect):
     if last == nscan:
         return a
     b = rmax * (last + 1) / nscan
-    for _ in range(nbisect):
+    done = 0
+    # a sliver about the axis (only r = 0 nonempty): halve until the bracket is within 2^-nbisect of its inner end
+    while done < 64 and (done < nbisect or (last == 0 and b - a > 0.5**nbisect * a)):
         m = 0.5 * (a + b)
         a, b = (m, b) if nonempty(m) else (a, m)
+        done += 1
     return 0.5 * (a + b)
 
 
-def sector_volume_gci(design, options, p, angle, rmax, zlo, zhi, plan):
+def sector_volume_gci(design, options, p, angle, rmax, zlo, zhi, plan, fields=delta_fields):
     """(volume, GCI) of the whole turn from the sector [0, angle]: volume = 2 pi / angle times the Gauss sum of
-    the exact column lengths; GCI = the LCI's weighted mean over the z-nodes (0 over nothing)."""
+    the exact column lengths; GCI = the LCI's weighted mean over the z-nodes (0 over nothing). ``fields``: the
+    mechanism's NumPy twin (naive_delta.delta_fields, or linear_delta_fields for the linear Delta)."""
     xp, wp = np.polynomial.legendre.leggauss(plan.angles)
     xs, ws = np.polynomial.legendre.leggauss(plan.radii)
     volume = 0.0
@@ -62,7 +66,7 @@ def sector_volume_gci(design, options, p, angle, rmax, zlo, zhi, plan):
     if not nodes:
         return 0.0, 0.0
     x, y, z = np.array(nodes).T
-    lci = delta_fields(design, options, x, y, z)[:, 0]
+    lci = fields(design, options, x, y, z)[:, 0]
     w = np.array(weights)
     keep = lci >= 0.0
     return volume * 2.0 * math.pi / angle, float(np.sum(w[keep] * lci[keep]) / np.sum(w[keep]))

@@ -130,6 +130,19 @@ def test_an_evaluation_block_is_refused_on_a_motion_that_does_not_read_it():
         parse_description(data)
 
 
+def test_an_evaluation_block_of_sector_plans_alone_parses_and_an_empty_one_is_one_line():
+    """The built-in linear Delta's block holds sector plans only (no column plans: a design without the symmetry
+    climbs the ladder); a block with neither is refused."""
+    import yaml
+
+    lin = get("linear-delta")
+    assert lin.calibrated_plans == () and len(lin.sector_plans) == 2
+    data = yaml.safe_load((BUILTIN_DIR / "linear-delta.yaml").read_text())
+    data["evaluation"] = {}
+    with pytest.raises(ConfigError, match=r"^description: evaluation: needs plans \(column plans\) or sector"):
+        parse_description(data)
+
+
 def test_a_description_symmetric_only_at_its_defaults_gets_no_half_box():
     """The Delta as three single legs, then with a parameter 'offset' (default 0) moving leg 2's base along its arm
     axis: mirrored at the defaults, not for offset != 0, so no mirror axis is declared (the check shifts every

@@ -136,9 +136,11 @@ def _volume_closed_form(a, l, stroke, n=1500):
     ({"base_radius": 0.4, "platform_radius": 0.05, "forearm": 0.6}, None),  # the config's design: the integral
 ])
 def test_workspace_volume_has_its_closed_form(design, exact):
-    """configs/linear_delta.yaml's evaluator (adaptive, volume tolerance 0.2 %) against the closed form; 0.3 %:
-    the tolerance plus the quadrature's error (1e-5 relative between n = 1500 and 4000). Measured: 0.62809 m^3
-    (a = 0, exact pi 0.5^2 0.8 = 0.62832: -0.04 %) and 0.13029 m^3 (integral 0.13022: +0.05 %)."""
+    """configs/linear_delta.yaml's evaluator at volume tolerance 0.2 % (its description's sector plan for it,
+    src/scalesynth/mechanisms/linear-delta.yaml) against the closed form; 0.3 %: the tolerance plus the quadrature's
+    error (1e-5 relative between n = 1500 and 4000). Measured: 0.628320 m^3 (a = 0, exact pi 0.5^2 0.8 = 0.628319:
+    +2e-6 relative) and 0.130219 m^3 (integral 0.13022: -0.001 %); the adaptive evaluator before the plan (the
+    per-design ladder): 0.62809 (-0.04 %) and 0.13029 (+0.05 %)."""
     a = design["base_radius"] - design["platform_radius"]
     value = _volume_closed_form(a, design["forearm"], (0.0, 0.8))
     if exact is not None:

@@ -117,9 +117,11 @@ class SectorSpec(_Strict):
 class EvaluationSpec(_Strict):
     """How the tolerance form evaluates this mechanism: plans calibrated against finer uniform grids (docs/
     describing.md). A config tolerance no plan was calibrated for runs the per-design calibration ladder. A
-    sector plan, where one is calibrated for the tolerance and the legs are rotationally symmetric, runs first."""
+    sector plan, where one is calibrated for the tolerance and the legs are rotationally symmetric, runs first;
+    a block may hold sector plans alone (a design without the symmetry then climbs the ladder)."""
 
-    plans: list[PlanSpec] = Field(min_length=1, max_length=8)
+    # omitted: none (validate_default is off, so the default skips min_length); written: at least one
+    plans: list[PlanSpec] = Field(default=[], min_length=1, max_length=8)
     sector: list[SectorSpec] = Field(default=[], max_length=8)
 
 
@@ -291,6 +293,8 @@ def _check_evaluation(desc: Description) -> None:
     if desc.motion != "3T":
         raise ConfigError(f"evaluation: calibrated plans are read for motion 3T only, not {desc.motion} (leave the "
                           "block out)")
+    if not desc.evaluation.plans and not desc.evaluation.sector:
+        raise ConfigError("evaluation: needs plans (column plans) or sector (sector plans), or leave the block out")
     seen = set()
     for i, plan in enumerate(desc.evaluation.sector):
         where = f"evaluation.sector[{i}].tolerance"

@@ -33,6 +33,7 @@ from scalesynth.mechanisms.describe.kernel import CLEAR, F_CLEARANCE, STIFF, col
 
 MAX_INTERVALS = 8  # reachable z-intervals per column (column_intervals' K)
 N_FIELDS = F_CLEARANCE + 1  # the template's fields: LCI, sigma_min, sigma_max, stiffness_min, deflection, clearance
+MAX_BISECTIONS = 64  # a boundary radius below 2^-64 of a scan step is 0 to any tolerance
 
 
 @njit(cache=True, fastmath=FASTMATH)
@@ -50,8 +51,9 @@ def _column_length(p, x, y, zlo, zhi, iv):
 def boundary_radius(p, c, s, rmax, zlo, zhi, nscan, nbisect, iv):
     """R on the ray (cos, sin) = (c, s): the last of nscan equal steps in [0, rmax] whose column is nonempty
     (r = 0 included: a workspace narrower than one step), refined by nbisect bisections against the next (empty)
-    step; 0 when no step is nonempty, -1 when a column is not handled in closed form. Returns (R, interval-kernel
-    calls)."""
+    step, and where that is r = 0 by more until the bracket is within 2^-nbisect of its inner end (at most
+    MAX_BISECTIONS in all); 0 when no step is nonempty, -1 when a column is not handled in closed form. Returns
+    (R, interval-kernel calls)."""
     calls = 0
     last = -1
     for i in range(nscan, -1, -1):
@@ -69,7 +71,13 @@ def boundary_radius(p, c, s, rmax, zlo, zhi, nscan, nbisect, iv):
     if last == nscan:
         return a, calls
     b = rmax * (last + 1) / nscan
-    for _ in range(nbisect):
+    # nbisect halvings; where only r = 0 is nonempty (last = 0: a sliver about the axis, narrower than one scan
+    # step) more, until the bracket is within 2^-nbisect of its inner end: R to the relative precision that
+    # last >= 1 has after nbisect (bracket step / 2^nbisect, inner end >= step); at most MAX_BISECTIONS in all
+    tight = 0.5**nbisect
+    for i in range(MAX_BISECTIONS):
+        if i >= nbisect and (last > 0 or b - a <= tight * a):
+            break
         m = 0.5 * (a + b)
         length, k = _column_length(p, m * c, m * s, zlo, zhi, iv)
         calls += 1
