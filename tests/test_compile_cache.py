@@ -22,7 +22,7 @@ g = make_grid(m, d, o, 6)
 p = m.pack(d, o)[None, :]
 s = kgrid.population_stats(m.field_kernel, m.n_fields, p, g.lo[None, :], g.step[None, :], g.shape,
                            np.array([0.0, 0.3, 1.0]))
-k = bind(kgrid._population_stats, m.field_kernel, m.n_fields, **kgrid._PARALLEL)  # the memoised one
+k = bind(kgrid._population_stats, m.field_kernel, m.n_fields, **kgrid._THREADED)  # the memoised one
 print(json.dumps({"hits": sum(k.stats.cache_hits.values()), "misses": sum(k.stats.cache_misses.values()),
                   "count": float(s[0, 0])}))
 """

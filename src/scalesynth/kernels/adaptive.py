@@ -72,11 +72,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from scalesynth.kernels.bind import bind
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.kernels.grid import accumulate_cells, init_row
+from scalesynth.kernels.threads import in_threads
 
 # placeholders: kernels.bind gives each bound copy one mechanism's field kernel and field count, and (``_column``)
 # its reach kernel: same signature, slot 0 >= 0 exactly where the field kernel's is, the other slots not written
@@ -738,15 +739,13 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
 
 
 def _column_stats(params, lo, hi, ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
-                  mirror_x, mirror_y, field_levels, gauss_points, edges):
-    """Template (parallel over designs): FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel."""
-    n_designs = params.shape[0]
-    stats = np.zeros((n_designs, 1 + 4 * N_FIELDS + edges.shape[0] - 1))
-    info = np.zeros((n_designs, 4))
-    for d in prange(n_designs):
+                  mirror_x, mirror_y, field_levels, gauss_points, edges, stats, info, start, step):
+    """Template (designs start, start + step, ... of the population; threads.in_threads runs the strides):
+    FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel. Each design writes its own rows of
+    ``stats`` and ``info``."""
+    for d in range(start, params.shape[0], step):
         FIELD_KERNEL(params[d], lo[d], hi[d], ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm,
                      faces, mirror_x, mirror_y, field_levels, gauss_points, edges, stats[d], info[d])
-    return stats, info
 
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
@@ -787,9 +786,14 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
         col = bind(_column_intervals, field_kernel, n_fields,
                    extra={"INTERVAL_KERNEL": interval_kernel, "NODE_COLUMN": col}, fastmath=FASTMATH)
     one = bind(_design_stats, col, n_fields, fastmath=FASTMATH)
-    run = bind(_column_stats, one, n_fields, parallel=True, fastmath=FASTMATH)
-    stats, info = run(np.ascontiguousarray(params, dtype=float), np.ascontiguousarray(lo, dtype=float),
-                      np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), ny, int(m), int(nbis), int(maxlev),
-                      float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces), mirror_x,
-                      mirror_y, int(field_levels), int(gauss_points), np.ascontiguousarray(edges, dtype=float))
+    # serial over designs, run in threads (kernels.threads: a parfor would be a third of this chain's compile time)
+    run = bind(_column_stats, one, n_fields, nogil=True, fastmath=FASTMATH)
+    params = np.ascontiguousarray(params, dtype=float)
+    edges = np.ascontiguousarray(edges, dtype=float)
+    stats = np.zeros((params.shape[0], 1 + 4 * int(n_fields) + edges.shape[0] - 1))
+    info = np.zeros((params.shape[0], 4))
+    in_threads(run, params.shape[0], params, np.ascontiguousarray(lo, dtype=float),
+                 np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), ny, int(m), int(nbis), int(maxlev),
+                 float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces), mirror_x, mirror_y,
+                 int(field_levels), int(gauss_points), edges, stats, info)
     return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()

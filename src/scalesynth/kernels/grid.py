@@ -31,11 +31,12 @@ copies, so a second process loads them instead of compiling (a kernel passed as 
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from scalesynth.kernels.bind import bind
 from scalesynth.kernels.conditioning import SIGMA_CAP
 from scalesynth.kernels.flags import FASTMATH
+from scalesynth.kernels.threads import in_threads
 
 # names a template's bound copy resolves to one mechanism's kernel (kernels.bind); placeholders here
 FIELD_KERNEL = None
@@ -279,15 +280,13 @@ def reduce_partials(partial, n_designs, nx, n_fields):
     return out
 
 
-def _population_stats(params, lo, step, shape, edges):
-    """Template of population_stats (FIELD_KERNEL, N_FIELDS bound by kernels.bind)."""
+def _population_stats(params, lo, step, shape, edges, partial, start, stride):
+    """Template of population_stats (FIELD_KERNEL, N_FIELDS bound by kernels.bind): the slabs (design, x index)
+    start, start + stride, ... into their rows of ``partial`` (threads.in_threads runs the strides)."""
     n_fields = N_FIELDS
     n_designs = params.shape[0]
     nx, ny, nz = shape[0], shape[1], shape[2]
-    nb = edges.shape[0] - 1
-    ncol = 1 + 4 * n_fields + nb
-    partial = np.zeros((n_designs * nx, ncol))
-    for task in prange(n_designs * nx):
+    for task in range(start, n_designs * nx, stride):
         d = task // nx
         i = task - d * nx
         p = params[d]
@@ -307,15 +306,13 @@ def _population_stats(params, lo, step, shape, edges):
                     vals[f, k] = cell[f]
             m = gather_column(buf, wbuf, m, vals, 0, nz - 1, 1.0)
         accumulate_cells(row, buf, wbuf, m, edges)
-    return reduce_partials(partial, n_designs, nx, n_fields)
 
 
-def _sample_fields(p, lo, step, shape):
-    """Template of sample_fields."""
+def _sample_fields(p, lo, step, shape, out, start, stride):
+    """Template of sample_fields: the x indices start, start + stride, ... into ``out`` (nx, ny, nz, N_FIELDS)."""
     n_fields = N_FIELDS
     nx, ny, nz = shape[0], shape[1], shape[2]
-    out = np.empty((nx, ny, nz, n_fields))
-    for i in prange(nx):
+    for i in range(start, nx, stride):
         x = lo[0] + (i + 0.5) * step[0]
         cell = np.zeros(n_fields)
         for j in range(ny):
@@ -323,22 +320,19 @@ def _sample_fields(p, lo, step, shape):
             for k in range(nz):
                 FIELD_KERNEL(p, x, y, lo[2] + (k + 0.5) * step[2], cell)
                 out[i, j, k, :] = cell
-    return out
 
 
-def _population_points_fields(params, pts):
-    """Template of population_points_fields."""
+def _population_points_fields(params, pts, out, start, stride):
+    """Template of population_points_fields: designs start, start + stride, ... into ``out`` (n_designs, n,
+    N_FIELDS)."""
     n_fields = N_FIELDS
-    n_designs = params.shape[0]
     n = pts.shape[0]
-    out = np.empty((n_designs, n, n_fields))
-    for d in prange(n_designs):
+    for d in range(start, params.shape[0], stride):
         p = params[d]
         cell = np.zeros(n_fields)
         for i in range(n):
             FIELD_KERNEL(p, pts[i, 0], pts[i, 1], pts[i, 2], cell)
             out[d, i, :] = cell
-    return out
 
 
 def _point_lci(p, x, y, z):
@@ -348,17 +342,16 @@ def _point_lci(p, x, y, z):
     return out[0]
 
 
-def _sample_grid(p, lo, step, shape):
-    """Template of sample_grid (FIELD_KERNEL is a scalar LCI kernel here)."""
+def _sample_grid(p, lo, step, shape, out, start, stride):
+    """Template of sample_grid (FIELD_KERNEL is a scalar LCI kernel here): x indices start, start + stride, ...
+    into ``out`` (nx, ny, nz)."""
     nx, ny, nz = shape[0], shape[1], shape[2]
-    out = np.empty((nx, ny, nz))
-    for i in prange(nx):
+    for i in range(start, nx, stride):
         x = lo[0] + (i + 0.5) * step[0]
         for j in range(ny):
             y = lo[1] + (j + 0.5) * step[1]
             for k in range(nz):
                 out[i, j, k] = FIELD_KERNEL(p, x, y, lo[2] + (k + 0.5) * step[2])
-    return out
 
 
 def _points_lci(p, pts):
@@ -370,7 +363,8 @@ def _points_lci(p, pts):
     return out
 
 
-_PARALLEL = {"parallel": True, "fastmath": FASTMATH}
+# serial kernels over strides of their rows, run in threads (kernels.threads: no parfor to compile per binding)
+_THREADED = {"nogil": True, "fastmath": FASTMATH}
 _SERIAL = {"fastmath": FASTMATH}
 
 
@@ -380,18 +374,27 @@ def population_stats(field_kernel, n_fields, params, lo, step, shape, edges):
     params: (n_designs, k) packed designs; lo, step: (n_designs, 3); shape: int64[3] (nx, ny, nz);
     edges: dexterity band edges. Returns (n_designs, stat_columns(n_fields, n_bands)) float64.
     """
-    return bind(_population_stats, field_kernel, n_fields, **_PARALLEL)(params, lo, step, shape, edges)
+    n_designs, nx = params.shape[0], int(shape[0])
+    partial = np.zeros((n_designs * nx, stat_columns(int(n_fields), edges.shape[0] - 1)))
+    in_threads(bind(_population_stats, field_kernel, n_fields, **_THREADED), n_designs * nx, params, lo, step, shape,
+               edges, partial)
+    return reduce_partials(partial, n_designs, nx, int(n_fields))
 
 
 def sample_fields(field_kernel, n_fields, p, lo, step, shape):
     """Every field at every node of one design's grid: (nx, ny, nz, n_fields); field 0 (LCI) -1 = unreachable."""
-    return bind(_sample_fields, field_kernel, n_fields, **_PARALLEL)(p, lo, step, shape)
+    out = np.empty((int(shape[0]), int(shape[1]), int(shape[2]), int(n_fields)))
+    in_threads(bind(_sample_fields, field_kernel, n_fields, **_THREADED), int(shape[0]), p, lo, step, shape, out)
+    return out
 
 
 def population_points_fields(field_kernel, n_fields, params, pts):
     """Every field of every design at the same points: params (n_designs, k), pts (n, 3) ->
     (n_designs, n, n_fields); field 0 (LCI) -1 where unreachable."""
-    return bind(_population_points_fields, field_kernel, n_fields, **_PARALLEL)(params, pts)
+    out = np.empty((params.shape[0], pts.shape[0], int(n_fields)))
+    in_threads(bind(_population_points_fields, field_kernel, n_fields, **_THREADED), params.shape[0], params, pts,
+               out)
+    return out
 
 
 def lci_kernel(field_kernel, n_fields: int):
@@ -402,7 +405,9 @@ def lci_kernel(field_kernel, n_fields: int):
 
 def sample_grid(point_kernel, p, lo, step, shape):
     """LCI at every node of one design's grid, shape (nx, ny, nz), from a scalar LCI kernel; -1 = unreachable."""
-    return bind(_sample_grid, point_kernel, 0, **_PARALLEL)(p, lo, step, shape)
+    out = np.empty((int(shape[0]), int(shape[1]), int(shape[2])))
+    in_threads(bind(_sample_grid, point_kernel, 0, **_THREADED), int(shape[0]), p, lo, step, shape, out)
+    return out
 
 
 def points_lci(point_kernel, p, pts):
