@@ -172,7 +172,12 @@ def _random_designs(mech, cfg, count, seed):
 
 # link radius with which interference_free removes part of the test designs' workspaces (tried on seed 3's designs
 # below: 15 mm leaves pprs-rprs's and the five-bar's untouched, 60 mm would empty pprs-rprs's, 80 mm a five-bar's)
-INTERFERENCE_RADIUS = {"2pauu-ppap": 0.015, "pprs-rprs": 30.0, "planar-fivebar": 60.0}  # default 15 (mm)
+# link radii for the interference_free variants, in each mechanism's length unit (default 15: mm): the clearance
+# must remove some points of the test grids but not all. The described mechanisms (m): axis-to-axis distances of
+# their capsules over the reach test's grids are delta 0.048-0.30 (5 % below 0.28), linear-delta 1e-4-0.05 (5 %
+# below 0.008), hexa 0.001-0.035, hexapod 0.008-0.10 (5 % below 0.036), so 2 r sits among the small ones
+INTERFERENCE_RADIUS = {"2pauu-ppap": 0.015, "pprs-rprs": 30.0, "planar-fivebar": 60.0, "delta": 0.14,
+                       "linear-delta": 0.01, "hexa": 0.01, "hexapod": 0.015}
 
 
 def _option_variants(mech, cfg):
