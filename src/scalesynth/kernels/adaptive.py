@@ -73,8 +73,9 @@ import math
 
 import numpy as np
 from numba import njit
+from numba import types as nbtypes
 
-from scalesynth.kernels.bind import bind
+from scalesynth.kernels.bind import bind, shared
 from scalesynth.kernels.flags import FASTMATH
 from scalesynth.kernels.grid import accumulate_cells, init_row
 from scalesynth.kernels.threads import in_threads
@@ -505,12 +506,13 @@ def _column_intervals(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, 
     out[3] = evals
 
 
-def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
-                  mirror_x, mirror_y, field_levels, gauss_points, edges, row, info):
-    """Template (serial; FIELD_KERNEL is the bound ``_column``): statistics row of one design into ``row``; info:
+def _design_stats(column, n_fields, p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, beta, zlevels,
+                  zconfirm, faces, mirror_x, mirror_y, field_levels, gauss_points, edges, row, info):
+    """Template (serial; compiled once for every mechanism, ``shared``): statistics row of one design into ``row``
+    by the column kernel ``column`` (the bound ``_column`` or ``_column_intervals``, COLUMN_SIGNATURE) of a
+    mechanism with ``n_fields`` field slots; info:
     error_volume, error_gci, level, evaluations. nx, ny3: coarse columns along cross axes 0, 1 (ny3 unused when
     planar); mirror_x, mirror_y: the lo face of cross axis 0, 1 is a mirror plane (no face ghost there)."""
-    n_fields = N_FIELDS
     nb = edges.shape[0] - 1
     ncol = 1 + 4 * n_fields + nb
     ny = ny3 if ndim == 3 else 1
@@ -605,8 +607,8 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
             # step 3b: the measure alone where the column inherits its parent's fields (one call site: the column
             # and the field kernel in it are compiled into each)
             inh = inherit and lpar > 0.0 and not own[a]
-            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
-                         0 if inh else gauss_points)
+            column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf, out,
+                   0 if inh else gauss_points)
             evals += out[3]
             if inh:
                 # the fields' statistics are the parent's per unit measure
@@ -681,8 +683,8 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
                             # column's mean LCI (unless the edge column has none)
                             ledge = gl[gi[a]]
                             fon = not (inherit and ledge > 0.0)
-                            FIELD_KERNEL(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1,
-                                         buf, wbuf, out, gauss_points if fon else 0)
+                            column(p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes, cell, q0, q1, buf, wbuf,
+                                   out, gauss_points if fon else 0)
                             evals += out[3]
                             fs = out[1] if fon else out[0] * (gs[gi[a]] / ledge)
                             if axis == 0:
@@ -738,14 +740,43 @@ def _design_stats(p, lo_d, hi_d, ndim, nx, ny3, m, nbis, maxlev, tol_v, tol_g, b
     info[3] = evals
 
 
-def _column_stats(params, lo, hi, ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm, faces,
-                  mirror_x, mirror_y, field_levels, gauss_points, edges, stats, info, start, step):
-    """Template (designs start, start + step, ... of the population; threads.in_threads runs the strides):
-    FIELD_KERNEL is the bound ``_design_stats`` here, not a field kernel. Each design writes its own rows of
-    ``stats`` and ``info``."""
+def _population_column_stats(column, n_fields, params, lo, hi, ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta,
+                             zlevels, zconfirm, faces, mirror_x, mirror_y, field_levels, gauss_points, edges, stats,
+                             info, start, step):
+    """Template (designs start, start + step, ... of the population; threads.in_threads runs the strides; compiled
+    once, ``shared``, its DESIGN_STATS the shared ``_design_stats``). Each design writes its own rows of ``stats``
+    and ``info``."""
     for d in range(start, params.shape[0], step):
-        FIELD_KERNEL(params[d], lo[d], hi[d], ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta, zlevels, zconfirm,
-                     faces, mirror_x, mirror_y, field_levels, gauss_points, edges, stats[d], info[d])
+        DESIGN_STATS(column, n_fields, params[d], lo[d], hi[d], ndim, nx, ny, m, nbis, maxlev, tol_v, tol_g, beta,
+                     zlevels, zconfirm, faces, mirror_x, mirror_y, field_levels, gauss_points, edges, stats[d],
+                     info[d])
+
+
+DESIGN_STATS = None  # placeholder: the shared _design_stats (_shared_kernels)
+
+_F8 = nbtypes.float64
+_I8 = nbtypes.int64
+_B1 = nbtypes.boolean
+_V = nbtypes.float64[::1]
+_M = nbtypes.float64[:, ::1]
+# the column kernel (bound _column / _column_intervals): p, x, y, zfix, ndim, zlo, hz, hz0, mz, nbis, area, nodes,
+# cell, q0, q1, buf, wbuf, out, gauss
+COLUMN_SIGNATURE = nbtypes.none(_V, _F8, _F8, _F8, _I8, _F8, _F8, _F8, _I8, _I8, _F8, _V, _V, _V, _V, _M, _V, _V,
+                                _I8)
+_COLUMN = nbtypes.FunctionType(COLUMN_SIGNATURE)
+# column, n_fields, then the shared arguments of one design (p, lo_d, hi_d) or of the population (params, lo, hi)
+_OPTIONS = (_I8, _I8, _I8, _I8, _I8, _I8, _F8, _F8, _F8, _I8, _I8, _B1, _B1, _B1, _I8, _I8, _V)
+DESIGN_SIGNATURE = nbtypes.none(_COLUMN, _I8, _V, _V, _V, *_OPTIONS, _V, _V)
+POPULATION_SIGNATURE = nbtypes.none(_COLUMN, _I8, _M, _M, _M, *_OPTIONS, _M, _M, _I8, _I8)
+
+
+def _shared_kernels():
+    """(design, population): the column algorithm compiled once for every mechanism (kernels.bind.shared), on
+    first use (an explicit signature compiles at once, or loads from the disk cache)."""
+    one = shared(_design_stats, DESIGN_SIGNATURE, fastmath=FASTMATH)
+    run = shared(_population_column_stats, POPULATION_SIGNATURE, extra={"DESIGN_STATS": one}, nogil=True,
+                 fastmath=FASTMATH)
+    return one, run
 
 
 def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxlev, tol_v, tol_g, edges,
@@ -780,20 +811,21 @@ def column_stats(field_kernel, n_fields, params, lo, hi, ndim, n, m, nbis, maxle
     if mirror_y and int(ndim) == 2:
         raise ValueError("mirror on axis 1 of a planar task: that is the column axis, not a cross axis")
     reach = field_kernel if reach_kernel is None else reach_kernel
-    col = bind(_column, field_kernel, n_fields, extra={"REACH_KERNEL": reach}, fastmath=FASTMATH)
+    # the mechanism's column kernel is its only compilation here; the algorithm around it is shared
+    col = bind(_column, field_kernel, n_fields, extra={"REACH_KERNEL": reach}, signature=COLUMN_SIGNATURE,
+               fastmath=FASTMATH)
     if interval_kernel is not None and int(ndim) == 3:
-        # a separate bound variant: without an interval kernel the compiled code is today's, bit for bit
+        # a separate bound variant: without an interval kernel the compiled code is the node column's, bit for bit
         col = bind(_column_intervals, field_kernel, n_fields,
-                   extra={"INTERVAL_KERNEL": interval_kernel, "NODE_COLUMN": col}, fastmath=FASTMATH)
-    one = bind(_design_stats, col, n_fields, fastmath=FASTMATH)
+                   extra={"INTERVAL_KERNEL": interval_kernel, "NODE_COLUMN": col}, signature=COLUMN_SIGNATURE,
+                   fastmath=FASTMATH)
     # serial over designs, run in threads (kernels.threads: a parfor would be a third of this chain's compile time)
-    run = bind(_column_stats, one, n_fields, nogil=True, fastmath=FASTMATH)
-    params = np.ascontiguousarray(params, dtype=float)
-    edges = np.ascontiguousarray(edges, dtype=float)
+    _, run = _shared_kernels()
+    # the explicit signatures take writable C arrays of float64 (a read-only or strided view would not match)
+    params, lo, hi, edges = (np.require(a, float, ["C", "W"]) for a in (params, lo, hi, edges))
     stats = np.zeros((params.shape[0], 1 + 4 * int(n_fields) + edges.shape[0] - 1))
     info = np.zeros((params.shape[0], 4))
-    in_threads(run, params.shape[0], params, np.ascontiguousarray(lo, dtype=float),
-                 np.ascontiguousarray(hi, dtype=float), int(ndim), int(n), ny, int(m), int(nbis), int(maxlev),
-                 float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces), mirror_x, mirror_y,
-                 int(field_levels), int(gauss_points), edges, stats, info)
+    in_threads(run, params.shape[0], col, int(n_fields), params, lo, hi, int(ndim), int(n), ny, int(m), int(nbis),
+               int(maxlev), float(tol_v), float(tol_g), float(beta), int(zlevels), int(zconfirm), bool(faces),
+               mirror_x, mirror_y, int(field_levels), int(gauss_points), edges, stats, info)
     return stats, info[:, 0].copy(), info[:, 1].copy(), info[:, 2].astype(np.int64), info[:, 3].copy()

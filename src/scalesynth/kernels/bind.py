@@ -10,6 +10,12 @@ Cache identity of a bound copy: its file is the field kernel's source file (Numb
 file's time stamp and size) and its name carries a hash of the sources of ``scalesynth/kernels/*.py``,
 ``scalesynth/stiffness/legs.py`` and of that file, so editing either the mechanism or a shared kernel module
 compiles afresh (Numba alone would not notice an edited callee in another file).
+
+``shared`` compiles a template that takes its per-mechanism kernel as an argument (a Numba first-class function)
+once for every mechanism: an explicit signature makes the argument a function pointer, which Numba can
+disk-cache. A large driver (the column algorithm of kernels/adaptive.py) then compiles once per machine instead of
+once per mechanism and plan variant; the bound kernel it calls must be compiled with the matching signature
+(``bind(..., signature=...)``).
 """
 
 from __future__ import annotations
@@ -47,12 +53,15 @@ def _sources_hash(kernel_file: str) -> str:
 
 
 def bind(template: Callable, field_kernel: Any, n_fields: int, extra: dict[str, Any] | None = None,
-         **jit_options) -> Any:
+         signature: Any = None, **jit_options) -> Any:
     """The template compiled for ``field_kernel`` (an @njit dispatcher) with ``n_fields`` slots; memoised per
     process, disk-cached when the kernel comes from a real source file. ``extra``: more globals of the copy
-    (e.g. ``REACH_KERNEL``), kernels from the field kernel's file or kernels/ (the cache follows those files)."""
+    (e.g. ``REACH_KERNEL``), kernels from the field kernel's file or kernels/ (the cache follows those files).
+    ``signature``: compile for this Numba signature alone, at once (so the result can be passed to a ``shared``
+    template whose signature names it as a function type); None: lazily, for the argument types of each call."""
     extra = dict(extra or {})
-    key = (field_kernel, int(n_fields), template.__name__, tuple(sorted(extra.items(), key=lambda kv: kv[0])))
+    key = (field_kernel, int(n_fields), template.__name__, tuple(sorted(extra.items(), key=lambda kv: kv[0])),
+           str(signature))
     out = _BOUND.get(key)
     if out is not None:
         return out
@@ -80,5 +89,29 @@ def bind(template: Callable, field_kernel: Any, n_fields: int, extra: dict[str, 
     fn = types.FunctionType(code, env, name, template.__defaults__)
     fn.__qualname__ = name
     fn.__module__ = template.__module__
-    out = _BOUND[key] = njit(cache=cacheable, **jit_options)(fn)
+    jit = njit(cache=cacheable, **jit_options) if signature is None else njit(signature, cache=cacheable,
+                                                                             **jit_options)
+    out = _BOUND[key] = jit(fn)
+    return out
+
+
+def shared(template: Callable, signature: Any, extra: dict[str, Any] | None = None, **jit_options) -> Any:
+    """``template`` compiled once for ``signature`` (memoised per process, disk-cached): a copy named with the hash
+    of the kernel package's sources (an edited callee in another file of kernels/ compiles afresh), whose globals
+    add ``extra`` (e.g. another shared kernel it calls)."""
+    extra = dict(extra or {})
+    key = (template, "shared", tuple(sorted(extra.items(), key=lambda kv: kv[0])), str(signature))
+    out = _BOUND.get(key)
+    if out is not None:
+        return out
+    source = template.__code__.co_filename
+    tag = _sources_hash(source)
+    name = f"{template.__name__.lstrip('_')}__shared" + (f"__{tag}" if tag else "")
+    code = template.__code__.replace(co_name=name, co_qualname=name)
+    env = dict(template.__globals__)
+    env.update(extra)
+    fn = types.FunctionType(code, env, name, template.__defaults__)
+    fn.__qualname__ = name
+    fn.__module__ = template.__module__
+    out = _BOUND[key] = njit(signature, cache=bool(tag), **jit_options)(fn)
     return out
