@@ -61,6 +61,9 @@ hx = box / nx, hy = box / ny. So the half box [0, hi] of a box symmetric about 0
 columns on that axis and its lo face a mirror plane, evaluates the same columns as the full box's upper half and
 makes the same refinement decisions there (up to rounding): its extensive statistics are half the full box's.
 Parallel over designs, each design serial with a fixed order of columns: deterministic whatever the thread count.
+Compilation: the design and population loops (``_design_stats``, ``_population_column_stats``) compile once for
+every mechanism (kernels.bind.shared); a mechanism's column kernel (``_column`` or ``_column_intervals`` bound to
+its field, reach and interval kernels, COLUMN_SIGNATURE) is their first argument, a first-class function.
 The columns' L and S live in a sparse cell store (initial_cells, refine_cells: each column with its neighbours'
 cells), not in a dense grid of the finest level, whose copies and sums cost more than the refined columns at level
 3 (tests/test_adaptive_store.py compares the two; benchmarks/adaptive_store_ab.py, in git history at 76b48df, the
