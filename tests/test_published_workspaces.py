@@ -57,7 +57,8 @@ def test_masory_and_wangs_fig9_volumes():
     twin of the paper's eq. (1)-(5) within that tolerance (measured 12.211, 24.182, 38.216, 52.424, 64.947, 74.187
     against 12.214, 24.199, 38.231, 52.434, 64.976, 74.209: at most 0.07 % under), and the published curve within
     0.6 + 2 % of it: 0.6 twice the +-0.3 of reading the plot, 2 % an allowance for the paper's slicing method,
-    whose slice thickness is not printed (largest gap 0.98 at 40 deg, 2.5 %, against 1.38 allowed)."""
+    whose slice thickness is not printed (largest gap 0.98 at 40 deg, 2.5 %, against 1.38 allowed). The box's top is
+    z = 8; with z = 7.5 the evaluator misses its tolerance at 40 deg (next test)."""
     fig = MW["figure_9"]
     tol = fig["tolerance"]
     p = MW["normalized_platform"]
@@ -74,6 +75,24 @@ def test_masory_and_wangs_fig9_volumes():
         allowed = tol["absolute"] + tol["relative"] * published
         assert abs(ours - published) <= allowed, deg
         assert abs(twin - published) <= allowed, deg
+
+
+@pytest.mark.xfail(strict=True, reason="known shortfall of the adaptive evaluator (issue 28): in the box z in [0, 7.5] "
+                   "at 40 deg it gives 38.082 at volume tolerance 0.2 %, 0.39 % under the twin's 38.231, while its own "
+                   "error estimate says 0.06 %; the box [0, 8] gives 38.216, tolerance 0.05 % gives 38.222")
+def test_masory_and_wang_at_40_deg_in_the_box_up_to_lmax():
+    """The same case as above at 40 deg with the box's top at Lmax = 7.5 (the natural bound; the workspace's top is
+    at 7.22) must meet the volume tolerance asked, 0.2 %, against the twin (38.231). It does not yet: strict xfail,
+    so a fix shows up as a failure of this marker."""
+    p = MW["normalized_platform"]
+    design = _mw_design()
+    cfg = load_config(ROOT / "configs" / "hexapod.yaml", [
+        *(f"design.{k}={v!r}" for k, v in design.items()),
+        f"options.leg_length={p['leg_length']}", f"options.cone_limit={math.radians(40.0)!r}",
+        "options.orientation=[0.0, 0.0, 0.0]", "grid.region.z=[0.0, 7.5]", "grid.tolerance.volume=0.002"])
+    twin = masory_wang_level_volume(p["platform_radius"], p["base_radius"], design["platform_half_angle"],
+                                    design["base_half_angle"], *p["leg_length"], math.radians(40.0))
+    assert evaluate_config(cfg).measure == pytest.approx(twin, rel=0.002)
 
 
 def _ren_group(g):
