@@ -117,8 +117,8 @@ def test_ren_deltas_layout_and_twin(group):
     volume (theta in [-15, 90] deg, z <= 0, the adaptive evaluator at 0.2 %) equals the twin's on a 5 mm grid within
     0.6 % (the evaluator's 0.2 % plus the grid's count error; measured 4.0171 vs 4.0210 and 9.1309 vs 9.1302 x 10^7
     mm^3). Table 2's own volumes (2.21 and 8.37 x 10^7 mm^3) are recorded in the data file, not asserted: their
-    'reachable point density method' is not specified enough to reproduce (7-10 % below scalesynth on eight groups,
-    82 % on group 7)."""
+    'reachable point density method' is not specified enough to reproduce (scalesynth's volumes are 7-10 % above
+    theirs on eight groups, 82 % above on group 7)."""
     row = _ren_group(group)
     L, l, R, r = (row[k] / 1000 for k in ("L_mm", "l_mm", "R_mm", "r_mm"))
     limits = [math.radians(v) for v in REN["conventions"]["theta_limits_deg"]]
