@@ -122,3 +122,42 @@ def linear_delta_volume(design, options, zlim, n=2000):
     bottom = np.maximum(-s_hi - h.min(axis=0), zlim[0])
     height = np.where((d2 <= ll * ll).all(axis=0), np.clip(top - bottom, 0.0, None), 0.0)
     return float(height.sum() * (hi[0] - lo[0]) * (hi[1] - lo[1]) / n**2)
+
+
+def ren_thetas(L, l, R, r, x, y, z):
+    """Arm angles (3, *shape), elbows out (the root with the larger cos theta), and the reach mask, written from Ren,
+    Zheng and Wang 2026, eq. (6)-(10): leg i at alpha_i = 0, 120, 240 deg, [(R - r + L cos t) cos a - x]^2 +
+    [(R - r + L cos t) sin a - y]^2 + (L sin t + z)^2 = l^2, with t = tan(theta / 2) the quadratic
+    A t^2 + B t + C = 0, A = K - 2 L (a - w), B = 4 L z, C = K + 2 L (a - w), a = R - r, w = x cos a_i + y sin a_i,
+    K = a^2 + L^2 + x^2 + y^2 + z^2 - l^2 - 2 a w (re-derived here: the paper's eq. (8) prints C's last term as
+    -2 L (R - r)); theta = 2 arctan t."""
+    x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x, y, z)))
+    a = R - r
+    ok = np.ones(x.shape, dtype=bool)
+    out = []
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for alpha in PHIS:
+            w = x * np.cos(alpha) + y * np.sin(alpha)
+            k = a * a + L * L + x * x + y * y + z * z - l * l - 2 * a * w
+            qa, qb, qc = k - 2 * L * (a - w), 4 * L * z, k + 2 * L * (a - w)
+            disc = qb * qb - 4 * qa * qc
+            ok &= disc >= 0
+            s = np.sqrt(np.clip(disc, 0.0, None))
+            t1, t2 = 2 * np.arctan((-qb + s) / (2 * qa)), 2 * np.arctan((-qb - s) / (2 * qa))
+            out.append(np.where(np.cos(t1) >= np.cos(t2), t1, t2))
+    return np.array(out), ok
+
+
+def ren_volume(L, l, R, r, theta_limits, h, z_max=0.0):
+    """Volume of the points at or below z_max whose three elbows-out angles (ren_thetas) lie in theta_limits (rad,
+    not wrapped), counted on a cell-centred grid of step h over the box |x|, |y| <= R - r + L + l,
+    z in [-(L + l), z_max] (lengths in one unit, volume in its cube)."""
+    lo, hi = theta_limits
+    reach = R - r + L + l
+    xs = np.arange(-reach, reach, h) + 0.5 * h
+    x, y = np.meshgrid(xs, xs, indexing="ij")
+    count = 0
+    for z in np.arange(-(L + l), z_max, h) + 0.5 * h:
+        th, ok = ren_thetas(L, l, R, r, x, y, z)
+        count += int((ok & np.all((th >= lo) & (th <= hi), axis=0)).sum())
+    return count * h ** 3

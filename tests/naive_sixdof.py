@@ -133,3 +133,33 @@ def hexa_fields(design, options, x, y, z):
             jq[i, i] = f @ (L * (-np.sin(th[i]) * e[i] - np.cos(th[i]) * zz))
         out[idx] = _sv(jx, jq, length)
     return out
+
+
+def masory_wang_level_volume(rp, rb, alpha_p, alpha_b, lo, hi, theta_max, n=200):
+    """Workspace volume of a Stewart platform held level (no rotation), written from Masory and Wang 1995: the joints
+    of their eq. (1), b_i = rb (cos, sin)(a_bi), p_i = rp (cos, sin)(a_pi) with a_b = (ab, 120 - ab, 120 + ab,
+    240 - ab, 240 + ab, 360 - ab) deg (a_p alike), leg i from B_i to P + p_i; leg lengths in [lo, hi] (their
+    eq. (4)) and the joint angles of eq. (5a), (5b) with perpendicular mounting (n_b = n_p = z), i.e. every leg
+    within theta_max of the vertical. Along a vertical line at horizontal distance rho from c_i = b_i - p_i leg i
+    holds z in [max(rho cot theta_max, sqrt(lo^2 - rho^2)), sqrt(hi^2 - rho^2)]; the six intervals' intersection
+    is integrated over (x, y) by the midpoint rule, n cells along the longer side of the box where every leg's
+    horizontal reach hi sin theta_max covers (lengths in the paper's units, volume in their cube). Angles in
+    rad."""
+    deg = np.radians([0.0, 120.0, 120.0, 240.0, 240.0, 360.0])
+    sign = np.array([1.0, -1.0, 1.0, -1.0, 1.0, -1.0])
+    ab, ap = deg + sign * alpha_b, deg + sign * alpha_p
+    c = np.stack([rb * np.cos(ab) - rp * np.cos(ap), rb * np.sin(ab) - rp * np.sin(ap)], axis=1)
+    reach = hi * np.sin(theta_max)
+    (x0, y0), (x1, y1) = (c - reach).max(axis=0), (c + reach).min(axis=0)
+    if x1 <= x0 or y1 <= y0:
+        return 0.0
+    h = max(x1 - x0, y1 - y0) / n
+    x, y = np.meshgrid(x0 + (np.arange(int(np.ceil((x1 - x0) / h))) + 0.5) * h,
+                       y0 + (np.arange(int(np.ceil((y1 - y0) / h))) + 0.5) * h, indexing="ij")
+    z_lo, z_hi = np.zeros(x.shape), np.full(x.shape, np.inf)
+    for cx, cy in c:
+        rho2 = (x - cx) ** 2 + (y - cy) ** 2
+        top = np.where(rho2 <= hi * hi, np.sqrt(np.clip(hi * hi - rho2, 0.0, None)), -np.inf)
+        bottom = np.maximum(np.sqrt(rho2) / np.tan(theta_max), np.sqrt(np.clip(lo * lo - rho2, 0.0, None)))
+        z_lo, z_hi = np.maximum(z_lo, bottom), np.minimum(z_hi, top)
+    return float(np.clip(z_hi - z_lo, 0.0, None).sum() * h * h)
