@@ -18,6 +18,7 @@ from scalesynth.config import config_from_dict, load_config
 from scalesynth.cycle.clearance import clearance
 from scalesynth.errors import ConfigError, InvalidParameter
 from scalesynth.evaluate import evaluate_config
+from scalesynth.kernels import grid as kgrid
 from scalesynth.mechanisms import get
 from scalesynth.mechanisms.describe import from_description, kernel2, parse_description
 from scalesynth.stiffness.legs import DEFLECTION_CAP, response_2x2
@@ -242,6 +243,27 @@ def test_flags_off_leave_zeros_and_the_same_bits():
                                                               ("clearance_metrics",)]
     assert FIVEBAR.kernel_clearance(FIVEBAR.resolve_options({"interference_free": True}))
     assert not FIVEBAR.kernel_clearance(FIVEBAR.resolve_options({}))
+
+
+def test_evaluators_run_the_lci_kernel_while_the_fields_are_off():
+    """stats_kernel: point_lci unless a design sets a flag (then point_fields; lci_only: point_lci), and its
+    statistics rows equal point_fields' bit for bit with the flags off (slots 3-5: the buffers' zeros), so an
+    evaluation without the fields compiles neither stage."""
+    d = FIVEBAR.default_design()
+    off = FIVEBAR.pack(d, FIVEBAR.resolve_options(LIMITS))
+    on = FIVEBAR.pack(d, FIVEBAR.resolve_options({**LIMITS, "stiffness_metrics": True}))
+    free = FIVEBAR.pack(d, FIVEBAR.resolve_options({**LIMITS, "interference_free": True}))
+    assert FIVEBAR.stats_kernel(off[None]) is kernel2.point_lci
+    assert FIVEBAR.stats_kernel(np.stack([off, on])) is kernel2.point_fields
+    assert FIVEBAR.stats_kernel(free[None]) is kernel2.point_fields
+    assert FIVEBAR.stats_kernel(np.stack([off, on]), lci_only=True) is kernel2.point_lci
+    lo, hi = FIVEBAR.bounding_box(d, FIVEBAR.resolve_options(LIMITS))
+    shape = np.array([48, 40, 1], dtype=np.int64)
+    step = np.r_[(hi[:2] - lo[:2]) / shape[:2], 1.0]
+    edges = np.array([0.0, 0.1, 0.3, 1.0])
+    rows = [kgrid.population_stats(k, 6, off[None], lo[None], step[None], shape, edges)
+            for k in (kernel2.point_lci, kernel2.point_fields)]
+    assert rows[0][0, 0] > 100 and np.array_equal(rows[0], rows[1])
 
 
 def test_interference_free_in_every_kernel():

@@ -220,6 +220,13 @@ class PlanarMechanism(DescribedMechanism):
         """point_fields without the stiffness and clearance stages (slots 0-2 bit for bit): kernel2.point_lci."""
         return _k.point_lci
 
+    def stats_kernel(self, packed: np.ndarray, lci_only: bool = False):
+        """point_lci unless a design of ``packed`` sets the stiffness or clearance flag (options.stiffness_metrics,
+        clearance_metrics, interference_free): then point_fields. With the flags off both give slots 0-2 bit for bit
+        and 0 in slots 3-5, and an evaluation without the fields compiles neither stage."""
+        needs = np.any(packed[..., _k.STIFF] > 0.0) or np.any(packed[..., _k.CLEAR] > 0.0)
+        return _k.point_fields if needs and not lci_only else _k.point_lci
+
     @property
     def reach_kernel(self):
         return _k.point_reach
