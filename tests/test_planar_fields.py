@@ -366,3 +366,24 @@ def test_task_max_deflection_is_the_worst_cell():
     assert worst == (-50.0, -868.75)
     assert rep["task_max_deflection_mm"] == pytest.approx(cells[worst], rel=1e-12)
     assert rep["task_max_deflection_mm"] == pytest.approx(1.48005, abs=5e-6)
+
+
+def test_the_cycle_reads_the_kernels_fields_like_the_hand_written():
+    """configs/fivebar_packing.yaml's Adept cycle on the described five-bar with both flags on (the cycle then reads
+    the clearance, and the deflection, from the field kernel): every cycle metric equals the hand-written
+    mechanism's (1e-9 relative), clearance and deflection included."""
+    import yaml
+
+    data = yaml.safe_load((ROOT / "configs" / "fivebar_packing.yaml").read_text())
+    data.pop("output", None)
+    data["objectives"] = [{"metric": "cycle_min_clearance", "sense": "max"}]
+    data["constraints"] = []
+    hand = evaluate_config(config_from_dict(data)).metrics
+    data["mechanism"] = "planar-fivebar-described"
+    del data["options"]["mode"]
+    data["options"].update(stiffness_metrics=True, clearance_metrics=True)
+    ours = evaluate_config(config_from_dict(data)).metrics
+    keys = [k for k in ours if k.startswith("cycle_")]
+    assert "cycle_min_clearance_mm" in keys and hand["cycle_feasible"] == 1.0
+    for k in keys:
+        assert ours[k] == pytest.approx(hand[k], rel=1e-9), k
