@@ -5,8 +5,10 @@ Usage: NUMBA_NUM_THREADS=1 python benchmarks/planar_template.py [N] [DESIGNS]   
 
 The same random designs (the fivebar_packing config's bounds, elbows out, the spec's corrected arm limits), the same
 N x N grid over each design's box, population_stats (the evaluator's accumulator) with: the described kernel (LCI,
-sigma_min, sigma_max), the hand kernel's kinematic_fields (those three plus the clearance) and its full
-point_fields (plus stiffness and deflection). Best of 3 after a compile run; ratios are of one run.
+sigma_min, sigma_max; its LCI kernel point_lci), the described field kernel with its stiffness and clearance fields
+off, with each on and with both (options.stiffness_metrics, clearance_metrics), the hand kernel's kinematic_fields
+(those three plus the clearance) and its full point_fields (plus stiffness and deflection). Best of 3 after a compile
+run; ratios are of one run.
 """
 
 import sys
@@ -51,8 +53,17 @@ def main(argv):
     edges = np.array([0.0, 0.1, 0.3, 1.0])
     ph = np.array([hand.pack(d, ho) for d in designs])
     pd = np.array([desc.pack(d, do) for d in designs])
+    stiff = desc.resolve_options({**LIMITS, "stiffness_metrics": True})
+    clear = desc.resolve_options({**LIMITS, "clearance_metrics": True})
+    both = desc.resolve_options({**LIMITS, "stiffness_metrics": True, "clearance_metrics": True})
+    ps, pc, pb = (np.array([desc.pack(d, o) for d in designs]) for o in (stiff, clear, both))
+    nf = desc.n_fields
     runs = {
-        "described (3 fields)": lambda: kgrid.population_stats(desc.field_kernel, 3, pd, lo, step, shape, edges),
+        "described (3 fields)": lambda: kgrid.population_stats(desc.lci_kernel, 3, pd, lo, step, shape, edges),
+        "described, fields off": lambda: kgrid.population_stats(desc.field_kernel, nf, pd, lo, step, shape, edges),
+        "described + stiffness": lambda: kgrid.population_stats(desc.field_kernel, nf, ps, lo, step, shape, edges),
+        "described + clearance": lambda: kgrid.population_stats(desc.field_kernel, nf, pc, lo, step, shape, edges),
+        "described, all 6": lambda: kgrid.population_stats(desc.field_kernel, nf, pb, lo, step, shape, edges),
         "hand kinematic_fields": lambda: kgrid.population_stats(pf.kinematic_fields, 6, ph, lo, step, shape, edges),
         "hand point_fields (6)": lambda: kgrid.population_stats(hand.field_kernel, 6, ph, lo, step, shape, edges),
     }
@@ -73,7 +84,7 @@ def main(argv):
     rates["numpy twin"] = len(pts) / (time.perf_counter() - t) / 1e6
     base = rates["described (3 fields)"]
     for name, rate in rates.items():
-        print(f"{name:24s} {rate:9.2f} Mvox/s   described / this = {base / rate:6.2f}")
+        print(f"{name:24s} {rate:9.2f} Mvox/s {1e3 / rate:8.1f} ns/voxel   described / this = {base / rate:6.2f}")
 
 
 if __name__ == "__main__":

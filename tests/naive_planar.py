@@ -73,3 +73,84 @@ def fields(legs, pts):
         sv = np.linalg.svd(jacobian(legs, p, qs)[2], compute_uv=False)
         out[k] = (sv[-1] / sv[0], sv[-1], sv[0])
     return out
+
+
+# ----- per-voxel stiffness and clearance (the described 2T template's fields), from textbook statics ---------------
+def stiffness(legs, sections, p, qs, load):
+    """(stiffness_min, |deflection|) of the pin where both links meet, ideal joints: each link is a two-force member
+    (pinned at both ends), so leg i is a spring along its unit link f_i of compliance l / EA_link + f_i^T C_A f_i,
+    C_A the 2 x 2 compliance of the actuated point: RR, the crank as a cantilever (axial L / EA, transverse
+    L^3 / 3 EI) plus the actuator spring's turn (L^2 / k across the crank); PR, the carriage's spring along the rail
+    (1 / k) and the rigid rail across. K = sum f f^T / c; eigvalsh and solve. ``sections``: per leg a dict of
+    EA_arm, EI_arm, EA_link, k."""
+    K = np.zeros((2, 2))
+    for leg, q, s in zip(legs, qs, sections, strict=True):
+        a, _ = actuated(leg, q)
+        f = np.asarray(p, dtype=float) + np.asarray(leg.get("platform", (0.0, 0.0))) - a
+        f = f / np.linalg.norm(f)
+        if leg["type"] == "RR":
+            t = (a - np.asarray(leg["base"], dtype=float)) / leg["arm"]
+            n = np.array([-t[1], t[0]])
+            L = leg["arm"]
+            ca = L / s["EA_arm"] * np.outer(t, t) + (L**3 / (3 * s["EI_arm"]) + L**2 / s["k"]) * np.outer(n, n)
+        else:
+            e = np.array([np.cos(leg["rail"]), np.sin(leg["rail"])])
+            ca = np.outer(e, e) / s["k"]
+        c = leg["link"] / s["EA_link"] + f @ ca @ f
+        K += np.outer(f, f) / c
+    w = np.linalg.eigvalsh(K)
+    return w[0], float(np.linalg.norm(np.linalg.solve(K, load)))
+
+
+def _point_segment(p, a, b):
+    d = b - a
+    t = 0.0 if d @ d == 0 else float(np.clip((p - a) @ d / (d @ d), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * d)))
+
+
+def _cross(u, v):
+    return u[0] * v[1] - u[1] * v[0]
+
+
+def segment_distance(a, b, c, d):
+    """Distance of the plane segments a-b and c-d: 0 where they cross, else the least of the four end-to-segment
+    distances."""
+    a, b, c, d = (np.asarray(v, dtype=float) for v in (a, b, c, d))
+    d1, d2 = _cross(b - a, c - a) * _cross(b - a, d - a), _cross(d - c, a - c) * _cross(d - c, b - c)
+    if d1 < 0 and d2 < 0:
+        return 0.0
+    return min(_point_segment(a, c, d), _point_segment(b, c, d), _point_segment(c, a, b), _point_segment(d, a, b))
+
+
+def clearance(legs, radii, p, qs):
+    """Smallest gap between the capsules of bodies that share no joint: base B2-B1, per leg arm B-A (RR) or rail
+    over the stroke and a carriage ball at A (PR), the link A-Q, the platform Q1-Q2; joints: base-arm, arm-link,
+    base-rail, rail-carriage, carriage-link, rail-link, link-platform and link-link where Q1 = Q2. ``radii`` by body
+    name (base, arm1, forearm2, ...)."""
+    p = np.asarray(p, dtype=float)
+    caps = {"base": (legs[1]["base"], legs[0]["base"])}
+    joined = set()
+    qpts = []
+    for i, (leg, q) in enumerate(zip(legs, qs, strict=True), 1):
+        a, _ = actuated(leg, q)
+        qp = p + np.asarray(leg.get("platform", (0.0, 0.0)))
+        qpts.append(qp)
+        if leg["type"] == "RR":
+            caps[f"arm{i}"] = (leg["base"], a)
+            joined |= {("base", f"arm{i}"), (f"arm{i}", f"forearm{i}")}
+        else:
+            e = np.array([np.cos(leg["rail"]), np.sin(leg["rail"])])
+            b = np.asarray(leg["base"], dtype=float)
+            caps[f"rail{i}"] = (b + leg["limits"][0] * e, b + leg["limits"][1] * e)
+            caps[f"carriage{i}"] = (a, a)
+            joined |= {("base", f"rail{i}"), (f"rail{i}", f"carriage{i}"), (f"carriage{i}", f"forearm{i}"),
+                       (f"rail{i}", f"forearm{i}")}
+        caps[f"forearm{i}"] = (a, qp)
+        joined.add((f"forearm{i}", "platform"))
+    caps["platform"] = tuple(qpts)
+    if np.allclose(qpts[0], qpts[1], rtol=0, atol=0):
+        joined.add(("forearm1", "forearm2"))
+    names = list(caps)
+    gaps = [segment_distance(*caps[u], *caps[v]) - radii[u] - radii[v] for i, u in enumerate(names)
+            for v in names[i + 1:] if (u, v) not in joined and (v, u) not in joined]
+    return min(gaps)

@@ -81,7 +81,8 @@ def _point_fields_2t(packed, x, y, out):
 def _reachable(mech, design, options, rng, k):
     """k random points where the kernel's LCI exceeds 1e-2 (away from singularities, for finite differences)."""
     lo, hi = mech.bounding_box(design, options)
-    return reachable_points(_point_fields_2t, mech.pack(design, options), lo[:2], hi[:2], rng, k, min_lci=1e-2)
+    return reachable_points(_point_fields_2t, mech.pack(design, options), lo[:2], hi[:2], rng, k, min_lci=1e-2,
+                            n_fields=mech.n_fields)
 
 
 @pytest.mark.parametrize("name", ["fivebar", "offset-rr", "biglide"])
@@ -123,8 +124,8 @@ def test_kernel_equals_the_numpy_twin(name):
         legs[0]["limits"], legs[1]["limits"] = options["alpha1_limits"], options["alpha2_limits"]
     pts = _box_points(mech, design, options, rng, 400)
     want = naive_planar.fields(legs, pts)
-    got = kgrid.population_points_fields(mech.field_kernel, 3, mech.pack(design, options)[None, :],
-                                         np.column_stack([pts, np.zeros(len(pts))]))[0]
+    got = kgrid.population_points_fields(mech.field_kernel, mech.n_fields, mech.pack(design, options)[None, :],
+                                         np.column_stack([pts, np.zeros(len(pts))]))[0][:, :3]
     reach = want[:, 0] >= 0.0
     assert 40 < reach.sum() < 400  # both reachable and unreachable points
     np.testing.assert_array_equal(got[:, 0] >= 0.0, reach)
@@ -175,7 +176,7 @@ def test_described_fivebar_equals_the_hand_written_on_random_designs():
         shape = np.array([61, 53, 1], dtype=np.int64)
         step = np.r_[(hi[:2] - lo[:2]) / shape[:2], 1.0]
         hand = kgrid.sample_fields(HAND.field_kernel, 6, HAND.pack(d, hand_opts), lo, step, shape)[..., :3]
-        ours = kgrid.sample_fields(mech.field_kernel, 3, mech.pack(d, desc_opts), lo, step, shape)
+        ours = kgrid.sample_fields(mech.field_kernel, 6, mech.pack(d, desc_opts), lo, step, shape)[..., :3]
         reach = hand[..., 0] >= 0.0
         assert reach.sum() > 50, (design, mode, opts)
         np.testing.assert_array_equal(ours[..., 0] >= 0.0, reach)
@@ -183,7 +184,7 @@ def test_described_fivebar_equals_the_hand_written_on_random_designs():
         edges = np.array([0.0, 0.1, 0.3, 1.0])
         sh = kgrid.population_stats(HAND.field_kernel, 6, HAND.pack(d, hand_opts)[None], lo[None], step[None],
                                     shape, edges)[0]
-        so = kgrid.population_stats(mech.field_kernel, 3, mech.pack(d, desc_opts)[None], lo[None], step[None],
+        so = kgrid.population_stats(mech.field_kernel, 6, mech.pack(d, desc_opts)[None], lo[None], step[None],
                                     shape, edges)[0]
         assert so[0] == sh[0]  # reachable cells: the area
         col = kgrid.field_column(0, kgrid.STAT_SUM)

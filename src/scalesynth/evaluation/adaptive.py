@@ -71,7 +71,7 @@ def adaptive_population_stats(
     interval_kernel = mech.interval_kernel_for(options) if intervals else None
     axis = column_axis(mech, options, intervals)
     half = HalfBox.of(mech, options, lo, hi, plan, mirror, axis)
-    kernel = mech.lci_kernel if lci_only else mech.field_kernel
+    kernel = mech.stats_kernel(packed, lci_only)
     reach = mech.reach_kernel
     box_lo, box_hi = half.lo, hi
     if axis != ndim - 1:

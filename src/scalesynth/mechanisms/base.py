@@ -212,6 +212,13 @@ class Mechanism(ABC):
         kernel itself; a mechanism overrides it with one that skips the costly fields."""
         return self.field_kernel
 
+    def stats_kernel(self, packed: np.ndarray, lci_only: bool = False):
+        """The kernel the workspace evaluators run over the designs ``packed`` (n, N): ``lci_kernel`` for
+        ``lci_only``, else the field kernel. A mechanism whose opt-in fields are off in every design may answer a
+        kernel that writes the other fields and leaves those slots alone (the evaluators' buffers hold 0 there, what
+        the field kernel writes with its flags off), so that a run without them never compiles their stages."""
+        return self.lci_kernel if lci_only else self.field_kernel
+
     @property
     def interval_kernel(self):
         """None, or a Numba kernel ``intervals(p, x, y, zlo, zhi, out) -> k`` (3-D tasks): the reachable set of the
@@ -349,8 +356,8 @@ class Mechanism(ABC):
         faster kernel that feeds the same accumulator (kernels.grid.gather_column, accumulate_cells)."""
         from scalesynth.kernels import grid as _grid
 
-        kernel = self.lci_kernel if lci_only else self.field_kernel
-        return _grid.population_stats(kernel, self.n_fields, packed, lo, step, shape, edges)
+        return _grid.population_stats(self.stats_kernel(packed, lci_only), self.n_fields, packed, lo, step, shape,
+                                      edges)
 
     def derived_columns(self, design: Mapping[str, float]) -> dict[str, float]:
         """Extra result columns derived from a design (e.g. m_minus_n); none by default."""

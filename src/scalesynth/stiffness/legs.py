@@ -402,6 +402,29 @@ def response_upper(k, fx, fy, fz, length):
 
 
 @njit(cache=True, fastmath=FASTMATH)
+def response_2x2(k00, k01, k11, fx, fy):
+    """:func:`platform_response` of a planar platform that only translates (a pin where pinned links meet, e.g. the
+    described 2T mechanisms'): K the symmetric 2x2 translational stiffness (N/length) by its upper entries, F =
+    (fx, fy) N. stiffness_min = lambda_min(K) (= 1 / lambda_max(K^-1)), the deflection |K^-1 F| (length unit, capped
+    at DEFLECTION_CAP); singular (0, DEFLECTION_CAP, or 0 deflection under no load) unless lambda_min(K) >
+    SINGULAR_RTOL lambda_max(K) (the reference solver's eigenvalue-ratio test; no rotation, so no characteristic
+    length). lambda_min is det / lambda_max: no cancellation. Never NaN."""
+    zero = 0.0 if (fx == 0.0 and fy == 0.0) else DEFLECTION_CAP
+    half = 0.5 * (k00 + k11)
+    diff = 0.5 * (k00 - k11)
+    kmax = half + math.sqrt(diff * diff + k01 * k01)
+    det = k00 * k11 - k01 * k01
+    if not (kmax > 0.0 and math.isfinite(kmax)):
+        return 0.0, zero
+    kmin = det / kmax
+    if not kmin > SINGULAR_RTOL * kmax:
+        return 0.0, zero
+    dx = (k11 * fx - k01 * fy) / det
+    dy = (k00 * fy - k01 * fx) / det
+    return kmin, min(math.sqrt(dx * dx + dy * dy), DEFLECTION_CAP)
+
+
+@njit(cache=True, fastmath=FASTMATH)
 def response_translational(k00, k01, k02, k11, k12, k22, fx, fy, fz):
     """:func:`platform_response` of a platform whose rotations are held rigidly (only translations are DOFs, e.g.
     seed 000's PPaP chain): K is the symmetric 3x3 translational stiffness given by its upper entries (N/length).

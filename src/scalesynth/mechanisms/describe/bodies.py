@@ -323,6 +323,43 @@ def capsules6(legs, rad: Mapping[str, float], rot: np.ndarray) -> tuple[list, np
     return _with_radii(out, pairs, rad)
 
 
+def joints_coincide(legs) -> bool:
+    """Whether the two legs of a 2T mechanism meet at one platform joint (Q1 = Q2 at every pose: equal offsets r_p,
+    to 1e-12 of the mechanism's size, frame2's test): their links are then pinned together."""
+    scale = max(1.0, *(float(np.abs(leg.base).max()) + leg.arm + leg.forearm for leg in legs))
+    return bool(np.abs(legs[0].platform - legs[1].platform).max() <= 1e-12 * scale)
+
+
+def capsules2(legs, rad: Mapping[str, float]) -> tuple[list, np.ndarray]:
+    """(capsules, pairs) of a 2T (planar) mechanism: PlanarMechanism.link_geometry's bodies, in its order, in the
+    plane z = 0: ``base`` B2 -> B1, per leg i ``arm<i>`` B -> E and ``forearm<i>`` E -> Q (RR), or ``rail<i>`` over
+    the stroke, ``carriage<i>`` a ball at C and ``forearm<i>`` C -> Q (PR), ``platform`` Q1 -> Q2 (a ball at P + r_p
+    where the joints coincide, and then the two forearms are adjacent: pinned together). ``legs``: planar.PlanarLeg."""
+    def v3(a):
+        return np.array([float(a[0]), float(a[1]), 0.0])
+
+    out: list = [("base", (_FIXED, v3(legs[1].base)), (_FIXED, v3(legs[0].base)))]
+    pairs: list[tuple[str, str]] = []
+    zero = np.zeros(3)
+    for i, leg in enumerate(legs, 1):
+        e = float(i - 1)
+        if leg.rotary:
+            out.append((f"arm{i}", (_FIXED, v3(leg.base)), (e, zero)))
+            pairs += [("base", f"arm{i}"), (f"arm{i}", f"forearm{i}")]
+        else:
+            lo, hi = leg.limits
+            out.append((f"rail{i}", (_FIXED, v3(leg.base + lo * leg.u)), (_FIXED, v3(leg.base + hi * leg.u))))
+            out.append((f"carriage{i}", (e, zero), (e, zero)))
+            pairs += [("base", f"rail{i}"), (f"rail{i}", f"carriage{i}"), (f"carriage{i}", f"forearm{i}"),
+                      (f"rail{i}", f"forearm{i}")]
+        out.append((f"forearm{i}", (e, zero), (_PLATFORM, v3(leg.platform))))
+        pairs.append((f"forearm{i}", "platform"))
+    if joints_coincide(legs):
+        pairs.append(("forearm1", "forearm2"))
+    out.append(("platform", (_PLATFORM, v3(legs[0].platform)), (_PLATFORM, v3(legs[1].platform))))
+    return _with_radii(out, pairs, rad)
+
+
 def _with_radii(caps: list, pairs: list[tuple[str, str]], rad: Mapping[str, float]) -> tuple[list, np.ndarray]:
     return ([(body, a, b, rad[body]) for body, a, b in caps],
             links.kernel_pairs([body for body, *_ in caps], links.adjacency(pairs)))

@@ -99,3 +99,30 @@ def stiffness_model(mech, design: Mapping[str, float], opts: Mapping[str, Any], 
         notes.append("joints bonded: every passive joint welded (carries moments), actuators stay springs")
     return FrameModel(2, unit_name, tuple(links), tuple(frame_joints), tuple(bodies), "platform",
                       np.asarray(opts["load"], dtype=float), tuple(notes))
+
+
+def pack_stiffness(mech, design: Mapping[str, float], opts: Mapping[str, Any], p: np.ndarray) -> None:
+    """Fill the stiffness block of a packed vector (kernel2.py: flag, load, per leg the crank's EA and EI, the
+    link's EA and the actuator spring) from the same sections and options as stiffness_model; the legs' kinematic
+    slots are already packed. InvalidParameter where the legs' platform joints do not coincide (as there)."""
+    from scalesynth.errors import InvalidParameter
+    from scalesynth.mechanisms.describe import kernel2 as _k
+    from scalesynth.mechanisms.describe.bodies import joints_coincide
+    from scalesynth.mechanisms.describe.frame import link_groups
+    from scalesynth.stiffness.sections import tube_section
+
+    legs = mech.legs(design, opts)
+    if not joints_coincide(legs):
+        k = mech.plans[1].leg_index
+        raise InvalidParameter(f"legs[{k}] ({mech.description.legs[k].name}).platform: the per-voxel stiffness "
+                               "fields need every link pinned at one platform point (equal platform offsets)")
+    groups = {g: tube_section(opts, g, mech.default_length_unit) for g in link_groups(legs[0].type.code)}
+    bar = groups["forearm"]
+    arm = groups.get("arm", bar)  # PR: no crank (slots unused)
+    for i in range(len(legs)):
+        s = _k.SLEGS + i * _k.SSTRIDE
+        p[s + _k.EA_ARM], p[s + _k.EI_ARM] = arm.EA, arm.EI
+        p[s + _k.EA_BAR] = bar.EA
+        p[s + _k.K_ACT] = opts["actuator_stiffness"]
+    p[_k.STIFF] = 1.0
+    p[_k.LOAD : _k.LOAD + 2] = opts["load"]

@@ -22,6 +22,7 @@ from scalesynth.errors import InvalidParameter, InvalidPose
 from scalesynth.mechanisms import links
 from scalesynth.mechanisms.base import (
     DesignMetric,
+    Field,
     Option,
     Parameter,
     Solution,
@@ -34,14 +35,36 @@ from scalesynth.mechanisms.base import (
 from scalesynth.mechanisms.describe import bodies, expressions, frame, frame2
 from scalesynth.mechanisms.describe import kernel2 as _k
 from scalesynth.mechanisms.describe.legs import LEG_TYPES, LegType
-from scalesynth.mechanisms.describe.mechanism import DescribedMechanism, _footprint, _plans, _turn, _unit
+from scalesynth.mechanisms.describe.mechanism import (
+    CLEARANCE,
+    CLEARANCE_METRICS_OPTION,
+    INTERFERENCE_FREE_OPTION,
+    STIFFNESS_METRICS_OPTION,
+    DescribedMechanism,
+    _footprint,
+    _plans,
+    _turn,
+    _unit,
+    pack_clearance,
+)
 from scalesynth.mechanisms.describe.schema import Description
+from scalesynth.stiffness import legs as _sl
 from scalesynth.stiffness.sections import check_stiffness_options
 
 # capsule radii (m) when link_radius does not give them: the seed-004 five-bar's illustrative ones (25, 20, 15, 40 mm)
 PLANAR_RADII_M = {"base": 0.025, "arm": 0.02, "forearm": 0.015, "platform": 0.04, "rail": 0.02, "carriage": 0.03}
 LINK_RADIUS_DOC = ("capsule radius of every body, or {group or body: radius} (groups arm, forearm, rail, carriage, "
                    "base, platform); null = defaults (docs/describing.md)")
+# the per-voxel stiffness fields of kernel2._stiffness (frame2.py's frame, ideal joints): the 3T ones' contract with
+# a planar load and a platform that only translates
+STIFFNESS_FIELDS_2T = (
+    Field("stiffness_min", "N/{length}", "smallest eigenvalue of the platform pin's 2 x 2 stiffness (ideal joints, "
+          "Euler-Bernoulli links, actuator springs; the frame of `stiffness`); 0 at a singular pose; its metrics need "
+          "options.stiffness_metrics", "max", needs_options=("stiffness_metrics",)),
+    Field("deflection", "{length}", "magnitude of the deflection of P under options.load (default 150 N along -y); "
+          f"{_sl.DEFLECTION_CAP:g} at a singular pose; its metrics need options.stiffness_metrics", "min",
+          (0.0, _sl.DEFLECTION_CAP), needs_options=("stiffness_metrics",)),
+)
 
 
 @dataclass(frozen=True)
@@ -118,6 +141,8 @@ class PlanarMechanism(DescribedMechanism):
     def check_options(self, options: dict[str, Any]) -> None:
         bodies.check_link_radius(options, self._codes())
         check_stiffness_options(options, 2, frame.link_groups(self._codes()[0]))
+        for flag in ("stiffness_metrics", "clearance_metrics", "interference_free"):
+            links.check_flag_option(options, flag)
         for name, spec in self.description.options.items():
             if spec.kind == "range":
                 options[name] = parse_range(name, options[name])
@@ -155,9 +180,18 @@ class PlanarMechanism(DescribedMechanism):
         return out
 
     def pack(self, design: Mapping[str, float], options: Mapping[str, Any]) -> np.ndarray:
+        """The packed vector of kernel2.py: the legs, then (options.stiffness_metrics) the stiffness block
+        (frame2.pack_stiffness) and (clearance_metrics or interference_free) the capsules of bodies.capsules2."""
         p = np.zeros(_k.N_PACKED)
         p[0] = len(self.plans)
-        for i, leg in enumerate(self.legs(design, options)):
+        legs = self.legs(design, options)
+        if options.get("stiffness_metrics"):
+            frame2.pack_stiffness(self, design, options, p)
+        if options.get("clearance_metrics") or options.get("interference_free"):
+            caps, pairs = bodies.capsules2(legs, bodies.radii(options, self._codes(), self.default_length_unit,
+                                                              PLANAR_RADII_M))
+            pack_clearance(p, (_k.CLEAR, _k.FREE, _k.UNIFORM, _k.CAPS), options, caps, pairs)
+        for i, leg in enumerate(legs):
             k = _k.HEAD + i * _k.STRIDE
             p[k + _k.TYPE] = leg.type.code
             p[k + _k.BASE : k + _k.BASE + 2] = leg.base
@@ -180,6 +214,18 @@ class PlanarMechanism(DescribedMechanism):
     @property
     def field_kernel(self):
         return _k.point_fields
+
+    @property
+    def lci_kernel(self):
+        """point_fields without the stiffness and clearance stages (slots 0-2 bit for bit): kernel2.point_lci."""
+        return _k.point_lci
+
+    def stats_kernel(self, packed: np.ndarray, lci_only: bool = False):
+        """point_lci unless a design of ``packed`` sets the stiffness or clearance flag (options.stiffness_metrics,
+        clearance_metrics, interference_free): then point_fields. With the flags off both give slots 0-2 bit for bit
+        and 0 in slots 3-5, and an evaluation without the fields compiles neither stage."""
+        needs = np.any(packed[..., _k.STIFF] > 0.0) or np.any(packed[..., _k.CLEAR] > 0.0)
+        return _k.point_fields if needs and not lci_only else _k.point_lci
 
     @property
     def reach_kernel(self):
@@ -244,8 +290,7 @@ class PlanarMechanism(DescribedMechanism):
                           (f"rail{i}", f"forearm{i}")]
             seg(f"forearm{i}", e, j)
             pairs.append((f"forearm{i}", "platform"))
-        scale = max(1.0, *(float(np.abs(v).max()) for v in joints))
-        if np.abs(joints[0] - joints[1]).max() <= 1e-12 * scale:
+        if bodies.joints_coincide(legs):
             pairs.append(("forearm1", "forearm2"))
         base_a, base_b = legs[1].base, legs[0].base
         segs.insert(0, links.Segment("base", "base", links.point(*base_a), links.point(*base_b), rad["base"]))
@@ -350,7 +395,8 @@ def from_description_2t(desc: Description) -> PlanarMechanism:
     plans = _plans(desc)
     rotary = LEG_TYPES[plans[0].type].joint_unit == "angle"
     options = tuple(Option(name, spec.default, spec.doc) for name, spec in desc.options.items()) + (
-        Option("link_radius", None, LINK_RADIUS_DOC), *frame.options(desc.stiffness, desc.length_unit, rotary, True))
+        Option("link_radius", None, LINK_RADIUS_DOC), *frame.options(desc.stiffness, desc.length_unit, rotary, True),
+        STIFFNESS_METRICS_OPTION, CLEARANCE_METRICS_OPTION, INTERFERENCE_FREE_OPTION)
     sigma_unit = "{length}/rad" if rotary else "1"
     jac = ("J = dx/dq (platform motion per rad of crank rotation)" if rotary else
            "J = dx/dq (platform motion per unit carriage motion)")
@@ -367,7 +413,7 @@ def from_description_2t(desc: Description) -> PlanarMechanism:
                          for name, spec in desc.parameters.items()),
         options=options,
         default_length_unit=desc.length_unit,
-        fields=base_fields(sigma_unit, jac),
+        fields=(*base_fields(sigma_unit, jac), *STIFFNESS_FIELDS_2T, CLEARANCE),
         design_metrics=(
             DesignMetric("link_length_sum", "{length}", "every link length of every leg, summed (crank and link; "
                          "a parallelogram counted once)",
