@@ -54,11 +54,11 @@ def test_masory_and_wangs_fig9_volumes():
     """Fig. 9 (platform level): workspace volume against the joint limit 30..55 deg, read from the scan as 12.1,
     24.5, 39.2, 53.4, 65.6, 74.4 (Rp^3). The built-in hexapod (cone_limit = the joint limit, both joints perpendicular
     to their plates as in Fig. 9), by the adaptive evaluator at volume tolerance 0.2 %, meets the exact-column NumPy
-    twin of the paper's eq. (1)-(5) within that tolerance (measured 12.211, 24.182, 38.216, 52.424, 64.947, 74.187
-    against 12.214, 24.199, 38.231, 52.434, 64.976, 74.209: at most 0.07 % under), and the published curve within
+    twin of the paper's eq. (1)-(5) within that tolerance (measured 12.211, 24.193, 38.223, 52.424, 64.947, 74.192
+    against 12.214, 24.199, 38.231, 52.434, 64.976, 74.209: at most 0.05 % under), and the published curve within
     0.6 + 2 % of it: 0.6 twice the +-0.3 of reading the plot, 2 % an allowance for the paper's slicing method,
     whose slice thickness is not printed (largest gap 0.98 at 40 deg, 2.5 %, against 1.38 allowed). The box's top is
-    z = 8; with z = 7.5 the evaluator misses its tolerance at 40 deg (next test)."""
+    z = 8; the next test takes z = 7.5."""
     fig = MW["figure_9"]
     tol = fig["tolerance"]
     p = MW["normalized_platform"]
@@ -77,15 +77,12 @@ def test_masory_and_wangs_fig9_volumes():
         assert abs(twin - published) <= allowed, deg
 
 
-@pytest.mark.xfail(strict=True, reason="known shortfall of the adaptive evaluator (issue 28): in the box z in [0, 7.5] "
-                   "at 40 deg it gives 38.082 at volume tolerance 0.2 %, 0.39 % under the twin's 38.231, while its own "
-                   "error estimate says 0.06 %; the box [0, 8] gives 38.216, tolerance 0.05 % gives 38.222. Cause: the "
-                   "rim wedge at z 5.63-5.83 lies between two z-nodes on each of the ladder's first three rungs, so "
-                   "they agree on the same miss (docs/mechanisms/hexapod.md)")
 def test_masory_and_wang_at_40_deg_in_the_box_up_to_lmax():
     """The same case as above at 40 deg with the box's top at Lmax = 7.5 (the natural bound; the workspace's top is
-    at 7.22) must meet the volume tolerance asked, 0.2 %, against the twin (38.231). It does not yet: strict xfail,
-    so a fix shows up as a failure of this marker."""
+    at 7.22) meets the volume tolerance asked, 0.2 %, against the twin (38.231): measured 38.221. With one
+    z-confirmation per ladder rung it gave 38.082, 0.39 % under, its estimate 0.06 %: the rim wedge (z 5.63-5.83)
+    lay between two z-nodes on the first three rungs, which agreed on the miss (scalesynth.calibration,
+    NODE_ZCONFIRM)."""
     p = MW["normalized_platform"]
     design = _mw_design()
     cfg = load_config(ROOT / "configs" / "hexapod.yaml", [

@@ -39,13 +39,24 @@ LADDER_COLUMNS = (8, 12, 18, 28, 42)
 # design 8, 12 and 18 columns agreed within 5e-5 at 0.5500 while 28 and more (and uniform grids up to N = 384) give
 # 0.5503 (the z-cells made no difference there: 1, 2 or 3 per column per rung gave the same GCI to 3e-5)
 SAFETY = 0.5
+# z-confirmations per rung where the columns run on nodes and bisection: a part of the workspace thinner than a
+# z-cell is missed where no node falls inside it, and with one confirmation several rungs could miss the same part
+# and agree. The rim of Masory and Wang's hexapod at a 40 deg joint limit (a wedge between z = 5.63 and 5.83, with
+# 0.17 of its 38.2 volume in columns shorter than 0.2) lay between two nodes on the first three rungs in the box
+# z in [0, 7.5]: they agreed on 0.39 % too little at a 0.2 % tolerance. Two confirmations (z-cells x 4 where
+# needed) find it, at 1.75-2.1x the time per design of the Hexa and the hexapod (benchmarks/RESULTS.md). Interval
+# kernels give each column's reachable set in closed form, so no node can miss a part: one confirmation there.
+NODE_ZCONFIRM = 2
 
 
-def ladder_plan(rung: int):
-    """The evaluate.ColumnPlan of ``rung`` (0-based) of the ladder."""
+def ladder_plan(rung: int, nodes: bool = False):
+    """The evaluate.ColumnPlan of ``rung`` (0-based) of the ladder; ``nodes``: the columns run on nodes and bisection
+    (no interval kernel for these options), so each rung doubles its z-cells until two consecutive changes meet the
+    tolerance instead of one (``NODE_ZCONFIRM``)."""
     from scalesynth.evaluation.plans import ColumnPlan
 
-    return ColumnPlan(LADDER_COLUMNS[rung], LADDER_COLUMNS[rung], 5, 2, beta=1.0, zlevels=2, zconfirm=1, faces=True)
+    return ColumnPlan(LADDER_COLUMNS[rung], LADDER_COLUMNS[rung], 5, 2, beta=1.0, zlevels=2,
+                      zconfirm=NODE_ZCONFIRM if nodes else 1, faces=True)
 
 
 def has_plan(mech) -> bool:
@@ -85,7 +96,8 @@ def calibrated_population_stats(
 
     n = len(designs)
     ndim = len(mech.task_axes)
-    first = ladder_plan(0)
+    nodes = mech.interval_kernel_for(options) is None  # the columns' reach by nodes and bisection
+    first = ladder_plan(0, nodes)
     stats = cell = None
     err_v = np.full(n, np.inf)
     err_g = np.full(n, np.inf)
@@ -98,7 +110,7 @@ def calibrated_population_stats(
     for rung in range(len(LADDER_COLUMNS)):
         sub = [designs[i] for i in active]
         ad = adaptive_population_stats(mech, sub, options, packed[active], tolerance, edges, region,
-                                       plan=ladder_plan(rung), lci_only=lci_only)
+                                       plan=ladder_plan(rung, nodes), lci_only=lci_only)
         calls[active] += ad.evaluations
         if stats is None:  # rung 0: every design; the unit of the rows (its coarse cell)
             stats, cell = ad.stats.copy(), ad.cell.copy()
